@@ -1,0 +1,297 @@
+"""Parametric curves and surfaces ("patches", Definition 1 of the paper).
+
+A patch maps parameters u (shape (..., dim), dim = 1 for a curve, 2 for a surface) to points of
+R^3 in its body frame. Every patch provides, vectorised over leading axes:
+
+- ``position(u)``  -> (..., 3)
+- ``first(u)``     -> (..., 3, dim)       d r / d u
+- ``second(u)``    -> (..., 3, dim, dim)  d^2 r / d u d u
+
+and a box domain ``lower <= u <= upper``; a parameter may be periodic (a full circle), in which
+case it is wrapped instead of bounded. `posed` maps a patch to the world through a body pose,
+Eq. (20): r = p_WB + R_WB r'(u).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+
+class Patch:
+    """Base class. Subclasses set ``dim``, ``lower``, ``upper``, ``periodic`` and implement the
+    three evaluation methods."""
+
+    dim: int
+    lower: np.ndarray
+    upper: np.ndarray
+    periodic: tuple[bool, ...]
+
+    def position(self, u):
+        raise NotImplementedError
+
+    def first(self, u):
+        raise NotImplementedError
+
+    def second(self, u):
+        raise NotImplementedError
+
+    # Domain helpers -------------------------------------------------------------------------
+    def wrap(self, u):
+        """Wraps periodic parameters into [lower, upper)."""
+        u = np.array(u, dtype=float)
+        for k, per in enumerate(self.periodic):
+            if per:
+                span = self.upper[k] - self.lower[k]
+                u[..., k] = self.lower[k] + np.mod(u[..., k] - self.lower[k], span)
+        return u
+
+    def clip(self, u):
+        """Wraps periodic parameters and clips the others into the domain."""
+        u = self.wrap(u)
+        for k, per in enumerate(self.periodic):
+            if not per:
+                u[..., k] = np.clip(u[..., k], self.lower[k], self.upper[k])
+        return u
+
+    def margin(self, u):
+        """Per parameter, the distance to the nearest end of the domain (negative outside);
+        +inf for periodic parameters. Shape (..., dim)."""
+        u = np.asarray(u, dtype=float)
+        m = np.minimum(u - self.lower, self.upper - u)
+        for k, per in enumerate(self.periodic):
+            if per:
+                m[..., k] = np.inf
+        return m
+
+    def grid(self, n):
+        """A tensor grid of n points per parameter covering the domain, shape (n**dim, dim).
+        Periodic parameters are sampled without repeating the end point."""
+        axes = []
+        for k in range(self.dim):
+            if self.periodic[k]:
+                axes.append(np.linspace(self.lower[k], self.upper[k], n, endpoint=False))
+            else:
+                axes.append(np.linspace(self.lower[k], self.upper[k], n))
+        mesh = np.meshgrid(*axes, indexing="ij")
+        return np.stack([m.ravel() for m in mesh], axis=-1)
+
+    @property
+    def span(self):
+        return self.upper - self.lower
+
+
+class Circle(Patch):
+    """Circle of radius ``radius`` in the plane z = ``height`` of its frame, centred on the z axis;
+    u = (theta,), periodic on [0, 2 pi)."""
+
+    dim = 1
+    periodic = (True,)
+
+    def __init__(self, radius: float, height: float = 0.0):
+        self.radius = float(radius)
+        self.height = float(height)
+        self.lower = np.array([0.0])
+        self.upper = np.array([2.0 * np.pi])
+
+    def position(self, u):
+        th = np.asarray(u, dtype=float)[..., 0]
+        return np.stack([self.radius * np.cos(th), self.radius * np.sin(th),
+                         np.full_like(th, self.height)], axis=-1)
+
+    def first(self, u):
+        th = np.asarray(u, dtype=float)[..., 0]
+        d = np.stack([-self.radius * np.sin(th), self.radius * np.cos(th), np.zeros_like(th)],
+                     axis=-1)
+        return d[..., None]
+
+    def second(self, u):
+        th = np.asarray(u, dtype=float)[..., 0]
+        d = np.stack([-self.radius * np.cos(th), -self.radius * np.sin(th), np.zeros_like(th)],
+                     axis=-1)
+        return d[..., None, None]
+
+
+class Segment(Patch):
+    """Straight segment a + u (b - a), u in [0, 1]."""
+
+    dim = 1
+    periodic = (False,)
+
+    def __init__(self, a, b):
+        self.a = np.asarray(a, dtype=float)
+        self.b = np.asarray(b, dtype=float)
+        self.lower = np.array([0.0])
+        self.upper = np.array([1.0])
+
+    def position(self, u):
+        s = np.asarray(u, dtype=float)[..., :1]
+        return self.a + s * (self.b - self.a)
+
+    def first(self, u):
+        s = np.asarray(u, dtype=float)[..., 0]
+        return np.broadcast_to((self.b - self.a)[:, None], s.shape + (3, 1)).copy()
+
+    def second(self, u):
+        s = np.asarray(u, dtype=float)[..., 0]
+        return np.zeros(s.shape + (3, 1, 1))
+
+
+class PlaneRect(Patch):
+    """Rectangle o + u0 e0 + u1 e1, u in [0, a] x [0, b] (e0, e1 need not be unit)."""
+
+    dim = 2
+    periodic = (False, False)
+
+    def __init__(self, origin, e0, e1, size=(1.0, 1.0)):
+        self.o = np.asarray(origin, dtype=float)
+        self.e0 = np.asarray(e0, dtype=float)
+        self.e1 = np.asarray(e1, dtype=float)
+        self.lower = np.zeros(2)
+        self.upper = np.asarray(size, dtype=float)
+
+    def position(self, u):
+        u = np.asarray(u, dtype=float)
+        return self.o + u[..., :1] * self.e0 + u[..., 1:2] * self.e1
+
+    def first(self, u):
+        u = np.asarray(u, dtype=float)
+        return np.broadcast_to(np.stack([self.e0, self.e1], axis=-1),
+                               u.shape[:-1] + (3, 2)).copy()
+
+    def second(self, u):
+        u = np.asarray(u, dtype=float)
+        return np.zeros(u.shape[:-1] + (3, 2, 2))
+
+
+class Cone(Patch):
+    """Right circular cone about the z axis, rho = R0 - z cot(alpha), parameters
+    u = (theta, z) on the box [theta0, theta1] x [z0, z1] (Eq. 12 with R0 = R)."""
+
+    dim = 2
+    periodic = (False, False)
+
+    def __init__(self, R0: float, alpha: float, theta_range, z_range):
+        self.R0 = float(R0)
+        self.cot = 1.0 / np.tan(alpha)
+        self.lower = np.array([theta_range[0], z_range[0]], dtype=float)
+        self.upper = np.array([theta_range[1], z_range[1]], dtype=float)
+
+    def position(self, u):
+        u = np.asarray(u, dtype=float)
+        th, z = u[..., 0], u[..., 1]
+        rho = self.R0 - z * self.cot
+        return np.stack([rho * np.cos(th), rho * np.sin(th), z], axis=-1)
+
+    def first(self, u):
+        u = np.asarray(u, dtype=float)
+        th, z = u[..., 0], u[..., 1]
+        rho = self.R0 - z * self.cot
+        c, s = np.cos(th), np.sin(th)
+        r_th = np.stack([-rho * s, rho * c, np.zeros_like(th)], axis=-1)
+        r_z = np.stack([-self.cot * c, -self.cot * s, np.ones_like(th)], axis=-1)
+        return np.stack([r_th, r_z], axis=-1)
+
+    def second(self, u):
+        u = np.asarray(u, dtype=float)
+        th, z = u[..., 0], u[..., 1]
+        rho = self.R0 - z * self.cot
+        c, s = np.cos(th), np.sin(th)
+        zero = np.zeros_like(th)
+        r_thth = np.stack([-rho * c, -rho * s, zero], axis=-1)
+        r_thz = np.stack([self.cot * s, -self.cot * c, zero], axis=-1)
+        r_zz = np.stack([zero, zero, zero], axis=-1)
+        out = np.empty(th.shape + (3, 2, 2))
+        out[..., 0, 0] = r_thth
+        out[..., 0, 1] = r_thz
+        out[..., 1, 0] = r_thz
+        out[..., 1, 1] = r_zz
+        return out
+
+
+class Reparametrized(Patch):
+    """A patch composed with a parameter map phi: s -> u = phi(s), so that r(s) = base(phi(s)).
+
+    ``phi`` is an object with ``value(s)`` (..., dim), ``jac(s)`` (..., dim, dim) and
+    ``hess(s)`` (..., dim, dim, dim) (d u_i / d s_a d s_b), and the box ``lower``/``upper`` of s.
+    Derivatives follow the chain rule:
+        r_a = sum_i B_i u_i,a
+        r_ab = sum_ij B_ij u_i,a u_j,b + sum_i B_i u_i,ab
+    """
+
+    def __init__(self, base: Patch, phi):
+        self.base = base
+        self.phi = phi
+        self.dim = base.dim
+        self.lower = np.asarray(phi.lower, dtype=float)
+        self.upper = np.asarray(phi.upper, dtype=float)
+        self.periodic = (False,) * self.dim
+
+    def position(self, s):
+        return self.base.position(self.phi.value(s))
+
+    def first(self, s):
+        u = self.phi.value(s)
+        return np.einsum("...xi,...ia->...xa", self.base.first(u), self.phi.jac(s))
+
+    def second(self, s):
+        u = self.phi.value(s)
+        J = self.phi.jac(s)
+        return (np.einsum("...xij,...ia,...jb->...xab", self.base.second(u), J, J)
+                + np.einsum("...xi,...iab->...xab", self.base.first(u), self.phi.hess(s)))
+
+
+@dataclasses.dataclass(frozen=True)
+class Posed:
+    """A patch placed in the world by a body pose (R_WB, p_WB): Eq. (20)."""
+
+    patch: Patch
+    R: np.ndarray
+    p: np.ndarray
+
+    def position(self, u):
+        return self.patch.position(u) @ self.R.T + self.p
+
+    def first(self, u):
+        return np.einsum("xy,...ya->...xa", self.R, self.patch.first(u))
+
+    def second(self, u):
+        return np.einsum("xy,...yab->...xab", self.R, self.patch.second(u))
+
+
+def posed(patch: Patch, R_WB, p_WB) -> Posed:
+    """Eq. (20): r(q, u) = r_O(q) + A(q) r'(u)."""
+    return Posed(patch, np.asarray(R_WB, dtype=float), np.asarray(p_WB, dtype=float))
+
+
+class PolarCurve(Patch):
+    """Curve given in cylindrical coordinates by theta: r = (rho cos theta, rho sin theta, z).
+
+    ``radial(theta)`` and ``axial(theta)`` each return a triple (f, f', f'') of arrays; the
+    parameter is u = (theta,) on [lower, upper]."""
+
+    dim = 1
+    periodic = (False,)
+
+    def __init__(self, radial, axial, theta_range):
+        self.radial = radial
+        self.axial = axial
+        self.lower = np.array([min(theta_range)], dtype=float)
+        self.upper = np.array([max(theta_range)], dtype=float)
+
+    def _parts(self, u):
+        th = np.asarray(u, dtype=float)[..., 0]
+        return th, self.radial(th), self.axial(th), np.cos(th), np.sin(th)
+
+    def position(self, u):
+        th, (r, _, _), (z, _, _), c, s = self._parts(u)
+        return np.stack([r * c, r * s, z], axis=-1)
+
+    def first(self, u):
+        th, (r, r1, _), (z, z1, _), c, s = self._parts(u)
+        return np.stack([r1 * c - r * s, r1 * s + r * c, z1], axis=-1)[..., None]
+
+    def second(self, u):
+        th, (r, r1, r2), (z, z1, z2), c, s = self._parts(u)
+        return np.stack([r2 * c - 2 * r1 * s - r * c, r2 * s + 2 * r1 * c - r * s, z2],
+                        axis=-1)[..., None, None]

@@ -1,0 +1,245 @@
+"""APDS contact geometry of Sect. 4 (Eq. 12-17), in the APDS frame.
+
+APDS frame: origin at the centre of the guide ring, e3 along the docking axis towards the other
+APDS, ring face at zeta = 0, petals in 0 <= zeta <= H (see shared model notes).
+
+- Guide side i (i = 1..6), Eq. (14) in its sine form: the line of the auxiliary plane through the
+  outer circle at phi_i = (i - 1) pi / 3, lifted onto the cone zeta = (R - rho) tan(alpha1):
+      rho(theta) = R sin(alpha2) / sin(alpha2 + sigma_i (theta - phi_i)),
+  sigma_i = +1 for odd i (leans towards increasing theta), -1 for even i. Domain: from phi_i to
+  phi_i + sigma_i theta_end, theta_end = arcsin(R sin(alpha2) / (R - H cot(alpha1))) - alpha2,
+  the exact end at zeta = H (Eq. 15 is garbled in the paper).
+- Guide surface k (k = 1..3), Eq. (12)-(13): the cone rho = R - zeta cot(alpha1) between the
+  sides 2k - 1 and 2k. Its domain in (theta, zeta) is not a box, so the patch is parametrised by
+  s in [0, 1] across the petal and zeta in [0, H]:
+      theta = phi_{2k-1} + theta_1(zeta) + s (pi/3 - 2 theta_1(zeta)),
+  theta_1 as in Eq. (13). s = 0 and s = 1 are the two guide sides.
+- Inside circle of the guide ring, Eq. (16)-(17): rho = Rs, zeta = 0, theta in [0, 2 pi).
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+
+from drake_dock.core.patches import Circle, Cone, PolarCurve, Reparametrized
+from drake_dock.errors import InputError
+
+
+@dataclasses.dataclass
+class ApdsGeometry:
+    """Dimensions of an APDS (Sect. 8.2). Lengths in m, angles in degrees."""
+
+    R: float = 0.6          # outer radius of the guide ring
+    Rs: float = 0.4         # radius of the inside circle of the ring (passage radius)
+    H: float = 0.2          # petal height
+    alpha1_deg: float = 45.0  # cone angle between generatrix and ring plane
+    alpha2_deg: float = 30.0  # angle of an auxiliary plane with its radius line
+
+    def validate(self, prefix: str = "geometry") -> "ApdsGeometry":
+        for name in ("R", "Rs", "H", "alpha1_deg", "alpha2_deg"):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float)) or not math.isfinite(v):
+                raise InputError(f"{prefix}.{name}", v, "a finite number")
+        if self.R <= 0:
+            raise InputError(f"{prefix}.R", self.R, "R > 0 m")
+        for name in ("alpha1_deg", "alpha2_deg"):
+            v = getattr(self, name)
+            if not 0.0 < v < 90.0:
+                raise InputError(f"{prefix}.{name}", v, "0 < angle < 90 deg")
+        if not 0.0 < self.Rs < self.R:
+            raise InputError(f"{prefix}.Rs", self.Rs, f"0 < Rs < R = {self.R} m")
+        cot1 = 1.0 / math.tan(math.radians(self.alpha1_deg))
+        h_max = self.R / cot1
+        if not 0.0 < self.H < h_max:
+            raise InputError(f"{prefix}.H", self.H,
+                             f"0 < H < R tan(alpha1) = {h_max:.6g} m (H cot(alpha1) < R)",
+                             "the petal would reach the axis")
+        a2 = math.radians(self.alpha2_deg)
+        arg = self.R * math.sin(a2) / (self.R - self.H * cot1)
+        # The two sides of a petal must not meet below zeta = H: theta_end < pi/6.
+        if arg >= 1.0 or math.asin(arg) - a2 >= math.pi / 6:
+            limit = self.R * (1.0 - math.sin(a2) / math.sin(a2 + math.pi / 6)) / cot1
+            raise InputError(f"{prefix}.H", self.H,
+                             f"H < {limit:.6g} m for R = {self.R}, alpha1 = {self.alpha1_deg},"
+                             f" alpha2 = {self.alpha2_deg}", "the petal's sides would cross")
+        return self
+
+    # Derived quantities ---------------------------------------------------------------------
+    @property
+    def alpha1(self) -> float:
+        return math.radians(self.alpha1_deg)
+
+    @property
+    def alpha2(self) -> float:
+        return math.radians(self.alpha2_deg)
+
+    @property
+    def theta_end(self) -> float:
+        """Angular extent of a guide side, arcsin(R sin a2 / (R - H cot a1)) - a2 (rad)."""
+        return self.theta_1(self.H)
+
+    def theta_1(self, zeta):
+        """Eq. (13): angular inset of the petal's sides at height zeta."""
+        rho = self.R - np.asarray(zeta, dtype=float) / math.tan(self.alpha1)
+        return np.arcsin(self.R * math.sin(self.alpha2) / rho) - self.alpha2
+
+
+def side_phi(i: int) -> float:
+    return (i - 1) * math.pi / 3.0
+
+
+def side_sigma(i: int) -> int:
+    return 1 if i % 2 == 1 else -1
+
+
+def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
+    """Guide side n_i, Eq. (14) in the sine form; u = (theta,)."""
+    if i not in range(1, 7):
+        raise InputError("guide side", i, "1..6")
+    phi, sigma = side_phi(i), side_sigma(i)
+    A = g.R * math.sin(g.alpha2)
+    tan1 = math.tan(g.alpha1)
+
+    def radial(th):
+        w = g.alpha2 + sigma * (th - phi)
+        sw, cw = np.sin(w), np.cos(w)
+        rho = A / sw
+        return rho, -sigma * A * cw / sw**2, A * (1.0 + cw**2) / sw**3
+
+    def axial(th):
+        rho, r1, r2 = radial(th)
+        return (g.R - rho) * tan1, -r1 * tan1, -r2 * tan1
+
+    return PolarCurve(radial, axial, (phi, phi + sigma * g.theta_end))
+
+
+class _PetalMap:
+    """s = (s, zeta) in [0,1] x [0,H] -> u = (theta, zeta) on the cone, see module docstring."""
+
+    def __init__(self, g: ApdsGeometry, k: int):
+        self.g = g
+        self.phi0 = side_phi(2 * k - 1)
+        self.lower = np.array([0.0, 0.0])
+        self.upper = np.array([1.0, g.H])
+        self.cot1 = 1.0 / math.tan(g.alpha1)
+        self.A = g.R * math.sin(g.alpha2)
+
+    def _t1(self, z):
+        rho = self.g.R - z * self.cot1
+        x = self.A / rho
+        x1 = x * self.cot1 / rho                 # dx/dz
+        x2 = 2.0 * x * self.cot1**2 / rho**2     # d2x/dz2
+        q = np.sqrt(1.0 - x**2)
+        t1 = np.arcsin(x) - self.g.alpha2
+        return t1, x1 / q, x2 / q + x * x1**2 / q**3
+
+    def value(self, s):
+        s = np.asarray(s, dtype=float)
+        a, z = s[..., 0], s[..., 1]
+        t1, _, _ = self._t1(z)
+        return np.stack([self.phi0 + t1 + a * (math.pi / 3 - 2 * t1), z], axis=-1)
+
+    def jac(self, s):
+        s = np.asarray(s, dtype=float)
+        a, z = s[..., 0], s[..., 1]
+        t1, d1, _ = self._t1(z)
+        J = np.zeros(a.shape + (2, 2))
+        J[..., 0, 0] = math.pi / 3 - 2 * t1
+        J[..., 0, 1] = d1 * (1 - 2 * a)
+        J[..., 1, 1] = 1.0
+        return J
+
+    def hess(self, s):
+        s = np.asarray(s, dtype=float)
+        a, z = s[..., 0], s[..., 1]
+        _, d1, d2 = self._t1(z)
+        Hs = np.zeros(a.shape + (2, 2, 2))
+        Hs[..., 0, 0, 1] = Hs[..., 0, 1, 0] = -2 * d1
+        Hs[..., 0, 1, 1] = d2 * (1 - 2 * a)
+        return Hs
+
+
+def guide_surface(g: ApdsGeometry, k: int) -> Reparametrized:
+    """Guide surface k (Eq. 12-13) between sides 2k-1 and 2k; u = (s, zeta)."""
+    if k not in (1, 2, 3):
+        raise InputError("guide surface", k, "1..3")
+    phi0 = side_phi(2 * k - 1)
+    cone = Cone(g.R, g.alpha1, (phi0, phi0 + math.pi / 3), (0.0, g.H))
+    return Reparametrized(cone, _PetalMap(g, k))
+
+
+def ring_circle(g: ApdsGeometry) -> Circle:
+    """Inside circle of the guide ring, Eq. (16)-(17)."""
+    return Circle(g.Rs, 0.0)
+
+
+@dataclasses.dataclass
+class ApdsPatches:
+    sides: dict      # i -> guide side n_i
+    surfaces: dict   # k -> guide surface k
+    ring: Circle
+
+
+def apds_patches(g: ApdsGeometry) -> ApdsPatches:
+    return ApdsPatches({i: guide_side(g, i) for i in range(1, 7)},
+                       {k: guide_surface(g, k) for k in (1, 2, 3)}, ring_circle(g))
+
+
+# Visual mesh --------------------------------------------------------------------------------
+def apds_mesh(g: ApdsGeometry, *, n_s=12, n_z=8, n_ring=96, plate=0.01, ring_depth=0.04):
+    """Triangle mesh (vertices (V, 3), faces (F, 3)) of an APDS, made from the same equations as
+    the contact patches: each petal is the guide surface given a thickness ``plate`` along the
+    inward cone normal; the ring is the annulus Rs <= rho <= R of depth ``ring_depth`` below
+    zeta = 0."""
+    verts, faces = [], []
+
+    def add_grid(P, flip):
+        base = len(verts)
+        n0, n1 = P.shape[0], P.shape[1]
+        verts.extend(P.reshape(-1, 3))
+        for a in range(n0 - 1):
+            for b in range(n1 - 1):
+                i00, i01 = base + a * n1 + b, base + a * n1 + b + 1
+                i10, i11 = i00 + n1, i01 + n1
+                tris = [(i00, i10, i11), (i00, i11, i01)]
+                faces.extend([(t[0], t[2], t[1]) if flip else t for t in tris])
+
+    s = np.linspace(0, 1, n_s)
+    z = np.linspace(0, g.H, n_z)
+    S, Z = np.meshgrid(s, z, indexing="ij")
+    for k in (1, 2, 3):
+        P = guide_surface(g, k)
+        u = np.stack([S, Z], axis=-1)
+        X = P.position(u)
+        T = P.first(u)
+        nrm = np.cross(T[..., 0], T[..., 1])
+        nrm /= np.linalg.norm(nrm, axis=-1, keepdims=True)
+        # Outward (away from the axis) normal; the inner face is offset inwards.
+        sign = np.sign(np.einsum("...x,...x->...", nrm[..., :2], X[..., :2]))[..., None]
+        nrm = nrm * sign
+        inner = X - plate * nrm
+        add_grid(X, flip=False)
+        add_grid(inner, flip=True)
+        # Edges: close the plate along its four borders.
+        for Xa, Xb in ((X[0, :], inner[0, :]), (X[-1, :], inner[-1, :]),
+                       (X[:, 0], inner[:, 0]), (X[:, -1], inner[:, -1])):
+            add_grid(np.stack([Xa, Xb], axis=1), flip=False)
+            add_grid(np.stack([Xa, Xb], axis=1), flip=True)
+    th = np.linspace(0, 2 * np.pi, n_ring + 1)
+    c, sn = np.cos(th), np.sin(th)
+    for zz in (0.0, -ring_depth):
+        ann = np.stack([np.stack([g.Rs * c, g.Rs * sn, np.full_like(th, zz)], -1),
+                        np.stack([g.R * c, g.R * sn, np.full_like(th, zz)], -1)], axis=1)
+        add_grid(ann, flip=(zz == 0.0))
+    for rr in (g.Rs, g.R):
+        wall = np.stack([np.stack([rr * c, rr * sn, np.zeros_like(th)], -1),
+                         np.stack([rr * c, rr * sn, np.full_like(th, -ring_depth)], -1)], axis=1)
+        add_grid(wall, flip=(rr == g.Rs))
+    return np.asarray(verts), np.asarray(faces, dtype=int)
+
+
+def mesh_to_obj(verts, faces) -> str:
+    lines = [f"v {x:.9g} {y:.9g} {z:.9g}" for x, y, z in verts]
+    lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in faces]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,127 @@
+"""The three-body docking plant (Sect. 2-3) in Drake.
+
+A continuous-time MultibodyPlant with three floating bodies (quaternion floating joints; the
+paper's z-x-z Euler angles are singular at the example's attitude):
+
+- ``target``: the target spacecraft, frame at its mass centre;
+- ``target_apds``: the target's APDS, frame = APDS frame (ring centre = mass centre);
+- ``chaser``: the chaser spacecraft with its APDS fixed; the frame ``chaser_apds`` is welded at
+  ``chaser_apds_offset`` (a1, b1, c1) in the chaser frame, axes parallel.
+
+The Stewart element (Eq. 9-10) is Drake's LinearBushingRollPitchYaw between the frame
+``stewart_anchor`` on the target at p_TA = (a, b, c) and the APDS frame, which matches the
+paper's per-axis spring-damper to first order in the angles. No gravity (free flight in orbit).
+Visual geometry is generated from the same analytic patches as the contact model.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+from pydrake.common import MemoryFile
+from pydrake.geometry import Cylinder, InMemoryMesh, Mesh
+from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.multibody.tree import (FixedOffsetFrame, LinearBushingRollPitchYaw,
+                                    RotationalInertia, SpatialInertia)
+from pydrake.multibody.math import SpatialVelocity
+
+from drake_dock.docking.apds import apds_mesh, mesh_to_obj
+from drake_dock.docking.scene import InitialState
+
+BODY_NAMES = ("target", "target_apds", "chaser")
+APDS_NAMES = ("target_apds", "chaser_apds")
+
+_COLORS = {"target": [0.75, 0.75, 0.78, 1.0], "chaser": [0.85, 0.8, 0.6, 1.0],
+           "target_apds": [0.25, 0.45, 0.85, 1.0], "chaser_apds": [0.85, 0.4, 0.2, 1.0]}
+
+
+@dataclasses.dataclass
+class DockingPlant:
+    plant: object
+    scene_graph: object
+    bodies: dict          # name -> RigidBody
+    apds_frames: dict     # "target_apds" / "chaser_apds" -> Frame
+    bushing: object
+
+
+def _spatial_inertia(params):
+    I = RotationalInertia(*params.inertia)
+    return SpatialInertia.MakeFromCentralInertia(params.mass, np.zeros(3), I)
+
+
+def _apds_visual(geometry):
+    verts, faces = apds_mesh(geometry)
+    data = MemoryFile(mesh_to_obj(verts, faces), ".obj", "apds.obj")
+    return Mesh(InMemoryMesh(mesh_file=data))
+
+
+def add_docking_plant(builder, scenario) -> DockingPlant:
+    """Adds the plant and SceneGraph of the scenario's three bodies to ``builder``; finalized."""
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    plant.mutable_gravity_field().set_gravity_vector(np.zeros(3))
+    b = scenario.bodies
+    bodies = {name: plant.AddRigidBody(name, _spatial_inertia(getattr(b, name)))
+              for name in BODY_NAMES}
+    st = scenario.stewart
+    anchor = plant.AddFrame(FixedOffsetFrame(
+        "stewart_anchor", bodies["target"].body_frame(), RigidTransform(np.array(st.p_TA))))
+    chaser_apds = plant.AddFrame(FixedOffsetFrame(
+        "chaser_apds", bodies["chaser"].body_frame(),
+        RigidTransform(np.array(scenario.chaser_apds_offset))))
+    bushing = plant.AddForceElement(LinearBushingRollPitchYaw(
+        anchor, bodies["target_apds"].body_frame(),
+        np.array(st.torque_stiffness), np.array(st.torque_damping),
+        np.array(st.force_stiffness), np.array(st.force_damping)))
+    if plant.geometry_source_is_registered():
+        mesh = _apds_visual(scenario.geometry)
+        plant.RegisterVisualGeometry(bodies["target_apds"], RigidTransform(), mesh,
+                                     "target_apds_visual", np.array(_COLORS["target_apds"]))
+        plant.RegisterVisualGeometry(bodies["chaser"], RigidTransform(
+            np.array(scenario.chaser_apds_offset)), mesh, "chaser_apds_visual",
+            np.array(_COLORS["chaser_apds"]))
+        # Spacecraft hulls, for orientation only (not contact geometry).
+        c = float(st.p_TA[2])
+        plant.RegisterVisualGeometry(bodies["target"], RigidTransform([0, 0, (c - 1.0) / 2 - 1.0]),
+                                     Cylinder(1.2, c - 1.0), "target_hull",
+                                     np.array(_COLORS["target"]))
+        off = float(scenario.chaser_apds_offset[2])
+        plant.RegisterVisualGeometry(bodies["chaser"], RigidTransform([0, 0, off - 1.0 - 1.5]),
+                                     Cylinder(1.2, 3.0), "chaser_hull",
+                                     np.array(_COLORS["chaser"]))
+    plant.Finalize()
+    return DockingPlant(plant, scene_graph, bodies,
+                        {"target_apds": bodies["target_apds"].body_frame(),
+                         "chaser_apds": chaser_apds}, bushing)
+
+
+def set_initial_state(dp: DockingPlant, plant_context, state: InitialState):
+    """Writes the poses and spatial velocities of `InitialState` into the plant context."""
+    for name, (R, p) in state.X_WB.items():
+        dp.plant.SetFreeBodyPose(plant_context, dp.bodies[name],
+                                 RigidTransform(RotationMatrix(R), p))
+        w, v = state.V_WB[name]
+        dp.plant.SetFreeBodySpatialVelocity(plant_context, dp.bodies[name],
+                                            SpatialVelocity(w, v))
+
+
+def body_momenta(dp: DockingPlant, plant_context, about=np.zeros(3)):
+    """Total linear momentum and angular momentum about ``about`` (world frame) of the three
+    bodies, and their scales: sum |m v| and sum |m p x v| + |I w| over the bodies."""
+    P = np.zeros(3)
+    L = np.zeros(3)
+    sP = sL = 0.0
+    for name, body in dp.bodies.items():
+        X = dp.plant.EvalBodyPoseInWorld(plant_context, body)
+        V = dp.plant.EvalBodySpatialVelocityInWorld(plant_context, body)
+        m = body.default_mass()
+        I_B = body.default_rotational_inertia().CopyToFullMatrix3()
+        R = X.rotation().matrix()
+        p = X.translation() - about
+        mv = m * V.translational()
+        Iw = R @ I_B @ R.T @ V.rotational()
+        P += mv
+        L += np.cross(p, mv) + Iw
+        sP += np.linalg.norm(mv)
+        sL += np.linalg.norm(np.cross(p, mv)) + np.linalg.norm(Iw)
+    return P, L, sP, sL

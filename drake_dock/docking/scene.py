@@ -1,0 +1,157 @@
+"""The docking scene as a configuration of the generic core: the 12 contact pairs of Sect. 2.2
+and 8.1, the facing of the two APDSes and the initial configuration of Sect. 8.2."""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from scipy.optimize import brentq
+
+from drake_dock.core.patches import Patch, posed
+from drake_dock.core.seeking import seek_couple
+from drake_dock.docking.apds import ApdsGeometry, apds_patches
+from drake_dock.errors import InputError, NumericalError
+
+TARGET_APDS = "target_apds"
+CHASER_APDS = "chaser_apds"
+
+# Sect. 2.2: guide side n_i of the target faces n_j of the chaser.
+CC_SIDE_PAIRS = ((1, 5), (2, 4), (3, 3), (4, 2), (5, 1), (6, 6))
+
+
+@dataclasses.dataclass(frozen=True)
+class PairSpec:
+    """A potential contact pair. Body 1 carries the curve (Sect. 4.3); the normal of its couple
+    points from Body 2 to Body 1 (Definition 2)."""
+
+    name: str
+    kind: str            # "CC" or "CS"
+    body1: str
+    patch1: Patch
+    body2: str
+    patch2: Patch
+
+
+def apds_pairs(g: ApdsGeometry) -> list[PairSpec]:
+    """The paper's 12 pairs: six guide side vs guide side (C-C, Body 1 = the chaser's side, as
+    in Sect. 3.2), three chaser-ring vs target-surface and three target-ring vs chaser-surface
+    (C-S, Body 1 = the ring)."""
+    P = apds_patches(g)
+    pairs = [PairSpec(f"cc_T{i}_C{j}", "CC", CHASER_APDS, P.sides[j], TARGET_APDS, P.sides[i])
+             for i, j in CC_SIDE_PAIRS]
+    pairs += [PairSpec(f"cs_Cring_T{k}", "CS", CHASER_APDS, P.ring, TARGET_APDS, P.surfaces[k])
+              for k in (1, 2, 3)]
+    pairs += [PairSpec(f"cs_Tring_C{k}", "CS", TARGET_APDS, P.ring, CHASER_APDS, P.surfaces[k])
+              for k in (1, 2, 3)]
+    return pairs
+
+
+def rot_z(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rot_x(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+# Matched facing (model notes): the chaser's APDS frame is the target's turned by pi about a
+# transverse axis and by 240 deg about the docking axis, so that the pairs of Sect. 2.2 face.
+R_MATCHED = rot_z(math.radians(240.0)) @ rot_x(math.pi)
+
+
+def relative_pose(yaw_rad: float, d: float):
+    """Pose (R, p) of the chaser APDS in the target APDS frame: coaxial, ring faces d apart,
+    the target (with its APDS) turned by yaw about the axis from the matched facing."""
+    return rot_z(-yaw_rad) @ R_MATCHED, np.array([0.0, 0.0, d])
+
+
+def pair_couples(pairs, poses, **grid):
+    """Seeks the closest couple of every pair; ``poses`` maps body name -> (R_WB, p_WB)."""
+    return [seek_couple(posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2]),
+                        **grid) for pr in pairs]
+
+
+def _gaps_at(pairs, yaw, d, refs):
+    """Signed gaps of the pairs at ring-face distance d. A pair is a potential contact only
+    while its couple is interior (see `is_interior`); otherwise its gap is +inf and its side
+    reference is dropped. The sign is fixed by the side the couple lies on when the pair becomes
+    potential (model notes) and continued from ``refs`` (the previous unit directions)."""
+    R, p = relative_pose(yaw, d)
+    poses = {TARGET_APDS: (np.eye(3), np.zeros(3)), CHASER_APDS: (R, p)}
+    out, dirs = [], []
+    for cp, ref in zip(pair_couples(pairs, poses), refs):
+        if not cp.interior:
+            out.append(np.inf)
+            dirs.append(None)
+            continue
+        v = cp.p1 - cp.p2
+        s = 1.0 if ref is None or v @ ref >= 0 else -1.0
+        out.append(s * cp.distance)
+        dirs.append(s * v / max(cp.distance, 1e-300))
+    return np.array(out), dirs
+
+
+def first_contact_distance(g: ApdsGeometry, yaw_deg: float, *, step=1e-2, xtol=1e-13):
+    """Ring-face distance d at which the first of the 12 pairs closes when the chaser moves
+    along the axis from far away; returns (d, names of the pairs that close at d within 1e-9)."""
+    pairs = apds_pairs(g)
+    yaw = math.radians(yaw_deg)
+    d = 2.0 * g.H + 0.05   # petals do not overlap axially: every pair is apart
+    gaps, refs = _gaps_at(pairs, yaw, d, [None] * len(pairs))
+    while d > 0:
+        d_lo = d - step
+        gaps_lo, refs_lo = _gaps_at(pairs, yaw, d_lo, refs)
+        closing = np.flatnonzero((gaps_lo <= 0) & np.isfinite(gaps))
+        if closing.size:
+            roots = {}
+            for j in closing:
+                def f(dd, j=j):
+                    return _gaps_at([pairs[j]], yaw, dd, [refs[j]])[0][0]
+                roots[pairs[j].name] = brentq(f, d_lo, d, xtol=xtol, rtol=1e-15)
+            d_c = max(roots.values())
+            return d_c, sorted(n for n, r in roots.items() if r >= d_c - 1e-9)
+        d, gaps, refs = d_lo, gaps_lo, refs_lo
+    raise NumericalError(f"no pair closes for yaw = {yaw_deg} deg")
+
+
+@dataclasses.dataclass
+class InitialState:
+    """World poses (R, p) and spatial velocities (w, v) of the three bodies at t = 0."""
+
+    X_WB: dict
+    V_WB: dict
+    d_contact: float           # ring-face distance at first contact
+    d0: float                  # initial ring-face distance
+    closing_pairs: list
+
+
+def initial_state(scenario) -> InitialState:
+    """Sect. 8.2 (model notes): the target at the origin turned by yaw about its docking axis,
+    its APDS at the Stewart element's equilibrium, the chaser coaxial at ring-face distance
+    d_contact + approach_travel, moving at chaser_speed towards the target; all else at rest."""
+    ic = scenario.initial
+    g = scenario.geometry
+    if ic.approach_travel < 0:
+        raise InputError("initial.approach_travel", ic.approach_travel,
+                         ">= 0 m (a negative travel means initial interpenetration)")
+    d_c, closing = first_contact_distance(g, ic.target_yaw_deg)
+    d0 = d_c + ic.approach_travel
+    yaw = math.radians(ic.target_yaw_deg)
+    R_WT, p_WT = rot_z(yaw), np.zeros(3)
+    p_TA = np.asarray(scenario.stewart.p_TA, dtype=float)
+    R_WA, p_WA = R_WT, p_WT + R_WT @ p_TA
+    R_AC, p_AC = relative_pose(yaw, d0)
+    R_WCA, p_WCA = R_WA @ R_AC, p_WA + R_WA @ p_AC
+    # Chaser body: its APDS frame sits at chaser_apds_offset in the body frame, same axes.
+    p_C_CA = np.asarray(scenario.chaser_apds_offset, dtype=float)
+    R_WC, p_WC = R_WCA, p_WCA - R_WCA @ p_C_CA
+    axis = R_WA[:, 2]
+    zero = np.zeros(3)
+    return InitialState(
+        X_WB={"target": (R_WT, p_WT), "target_apds": (R_WA, p_WA), "chaser": (R_WC, p_WC)},
+        V_WB={"target": (zero, zero), "target_apds": (zero, zero),
+              "chaser": (zero, -ic.chaser_speed * axis)},
+        d_contact=d_c, d0=d0, closing_pairs=closing)

@@ -1,0 +1,38 @@
+"""Typed errors of drake_dock. Every error names what failed, the value and what was allowed
+(input), or the time and the couple (numerical failure)."""
+from __future__ import annotations
+
+
+class DrakeDockError(Exception):
+    """Base class of every error raised on purpose by drake_dock."""
+
+
+class InputError(DrakeDockError, ValueError):
+    """A bad input value: names the field, the value and the allowed range."""
+
+    def __init__(self, field: str, value, allowed: str, why: str = ""):
+        self.field = field
+        self.value = value
+        self.allowed = allowed
+        msg = f"{field} = {value!r} is not allowed: {allowed}"
+        if why:
+            msg += f" ({why})"
+        super().__init__(msg)
+
+
+class NumericalError(DrakeDockError, RuntimeError):
+    """A numerical failure, reported with the simulation time and the couples involved."""
+
+    def __init__(self, message: str, *, time: float | None = None, couples=()):
+        self.time = time
+        self.couples = tuple(couples)
+        where = []
+        if time is not None:
+            where.append(f"t = {time:.9g} s")
+        if self.couples:
+            where.append("couples " + ", ".join(map(str, self.couples)))
+        super().__init__(message + (f" [{'; '.join(where)}]" if where else ""))
+
+
+class SeekingError(NumericalError):
+    """The closest couple of a pair could not be found (Newton did not converge)."""

@@ -1,0 +1,217 @@
+"""The scenario: a typed dataclass tree loaded from YAML with Drake's ``yaml_load_typed``.
+
+Every value is validated on load; a bad one raises `InputError` naming the dotted field, the
+value and the allowed range. Unknown keys are errors too (named with their full path).
+"""
+
+import dataclasses
+import math
+import typing
+from pathlib import Path
+
+import yaml
+from pydrake.common.yaml import yaml_load_typed
+
+from drake_dock.docking.apds import ApdsGeometry
+from drake_dock.errors import InputError
+
+MODELS_DIR = Path(__file__).resolve().parent.parent / "models"
+PAPER_EXAMPLE = MODELS_DIR / "paper_example.yaml"
+
+
+@dataclasses.dataclass
+class RigidBodyParams:
+    """Mass (kg) and principal moments of inertia about the body's x, y, z axes (kg m^2),
+    about the mass centre (Table 1; its repeated 'I11' headings read as I_x, I_y, I_z)."""
+
+    mass: float = 1.0
+    inertia: list[float] = dataclasses.field(default_factory=lambda: [1.0, 1.0, 1.0])
+
+
+@dataclasses.dataclass
+class Bodies:
+    target: RigidBodyParams = dataclasses.field(
+        default_factory=lambda: RigidBodyParams(1000.0, [782.0, 774.0, 829.0]))
+    target_apds: RigidBodyParams = dataclasses.field(
+        default_factory=lambda: RigidBodyParams(150.0, [68.0, 68.0, 68.0]))
+    chaser: RigidBodyParams = dataclasses.field(
+        default_factory=lambda: RigidBodyParams(7600.0, [40211.0, 6402.0, 40242.0]))
+
+
+@dataclasses.dataclass
+class StewartParams:
+    """The Stewart spring-damper (Eq. 9-10, Table 2) between a frame on the target at
+    p_TA = (a, b, c) and the target APDS frame; gains per axis of that frame (z = docking axis)."""
+
+    p_TA: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 5.03])
+    force_stiffness: list[float] = dataclasses.field(default_factory=lambda: [938., 7.14e4, 947.])
+    force_damping: list[float] = dataclasses.field(default_factory=lambda: [520.0, 0.0, 532.0])
+    torque_stiffness: list[float] = dataclasses.field(default_factory=lambda: [105., 105., 938.])
+    torque_damping: list[float] = dataclasses.field(default_factory=lambda: [10.0, 10.0, 520.0])
+
+
+@dataclasses.dataclass
+class ContactParams:
+    """Contact parameters the paper does not give (see model notes): friction mu (sliding) and
+    mu_s (static), energetic restitution e, and the LZB stiffness K and exponent eta of Eq. (28),
+    equal for all couples."""
+
+    mu: float = 0.1
+    mu_s: float = 0.1
+    restitution: float = 0.5
+    stiffness: float = 1.0e9
+    eta: float = 1.5
+
+
+@dataclasses.dataclass
+class InitialCondition:
+    """Sect. 8.2: coaxial APDSes with matched petals, the target (with its APDS) turned by
+    target_yaw_deg about the axis, the chaser placed so that it travels approach_travel along the
+    axis before the first couple closes, moving at chaser_speed towards the target."""
+
+    target_yaw_deg: float = 5.0
+    approach_travel: float = 0.01
+    chaser_speed: float = 1.0
+
+
+@dataclasses.dataclass
+class SimulationParams:
+    duration: float = 1.0
+    accuracy: float = 1e-6
+    capture_distance: float = 0.005  # axial ring-centre distance ending the capture phase (m)
+
+
+@dataclasses.dataclass
+class Scenario:
+    geometry: ApdsGeometry = dataclasses.field(default_factory=ApdsGeometry)
+    bodies: Bodies = dataclasses.field(default_factory=Bodies)
+    stewart: StewartParams = dataclasses.field(default_factory=StewartParams)
+    chaser_apds_offset: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 1.9])
+    contact: ContactParams = dataclasses.field(default_factory=ContactParams)
+    initial: InitialCondition = dataclasses.field(default_factory=InitialCondition)
+    simulation: SimulationParams = dataclasses.field(default_factory=SimulationParams)
+
+
+# Validation ---------------------------------------------------------------------------------
+def _check_raw(node, schema, path):
+    """Walks the raw YAML against the dataclass tree, so that an unknown key or a value of the
+    wrong type is named by its dotted path before Drake's loader sees it."""
+    where = path.rstrip(".") or "scenario"
+    if dataclasses.is_dataclass(schema):
+        if not isinstance(node, dict):
+            raise InputError(where, node, "a mapping of fields")
+        hints = typing.get_type_hints(schema)
+        for key, value in node.items():
+            if key not in hints:
+                allowed = ", ".join(f.name for f in dataclasses.fields(schema))
+                raise InputError(f"{path}{key}", value, f"a known field of '{where}' ({allowed})",
+                                 "unknown key")
+            _check_raw(value, hints[key], f"{path}{key}.")
+    elif schema is float:
+        # Drake's typed loader applies float() to scalars (so '1.0e9', a YAML 1.1 string, loads).
+        ok = isinstance(node, (int, float, str)) and not isinstance(node, bool)
+        if ok and isinstance(node, str):
+            try:
+                float(node)
+            except ValueError:
+                ok = False
+        if not ok:
+            raise InputError(where, node, "a number")
+    elif typing.get_origin(schema) is list:
+        if not isinstance(node, list):
+            raise InputError(where, node, "a list of numbers")
+        (item,) = typing.get_args(schema)
+        for k, x in enumerate(node):
+            _check_raw(x, item, f"{where}[{k}].")
+
+
+def _finite(field, v):
+    if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
+        raise InputError(field, v, "a finite number")
+    return float(v)
+
+
+def _vector(field, v, n=3):
+    if not isinstance(v, list) or len(v) != n:
+        raise InputError(field, v, f"a list of {n} finite numbers")
+    return [_finite(f"{field}[{k}]", x) for k, x in enumerate(v)]
+
+
+def _positive(field, v):
+    if _finite(field, v) <= 0:
+        raise InputError(field, v, "> 0")
+
+
+def _nonnegative(field, v):
+    if _finite(field, v) < 0:
+        raise InputError(field, v, ">= 0")
+
+
+def validate(s: Scenario) -> Scenario:
+    s.geometry.validate("geometry")
+    for name in ("target", "target_apds", "chaser"):
+        b = getattr(s.bodies, name)
+        f = f"bodies.{name}"
+        _positive(f"{f}.mass", b.mass)
+        I = _vector(f"{f}.inertia", b.inertia)
+        for k, x in enumerate(I):
+            _positive(f"{f}.inertia[{k}]", x)
+        # Principal moments of a physical body obey the triangle inequalities.
+        for k in range(3):
+            if I[k] > I[(k + 1) % 3] + I[(k + 2) % 3]:
+                raise InputError(f"{f}.inertia", b.inertia,
+                                 "principal moments with I_k <= I_i + I_j for every k",
+                                 "not the inertia of a physical body")
+    _vector("stewart.p_TA", s.stewart.p_TA)
+    for name in ("force_stiffness", "force_damping", "torque_stiffness", "torque_damping"):
+        for k, x in enumerate(_vector(f"stewart.{name}", getattr(s.stewart, name))):
+            _nonnegative(f"stewart.{name}[{k}]", x)
+    _vector("chaser_apds_offset", s.chaser_apds_offset)
+    c = s.contact
+    _nonnegative("contact.mu", c.mu)
+    _nonnegative("contact.mu_s", c.mu_s)
+    if _finite("contact.restitution", c.restitution) < 0 or c.restitution > 1:
+        raise InputError("contact.restitution", c.restitution, "0 <= e <= 1")
+    _positive("contact.stiffness", c.stiffness)
+    _positive("contact.eta", c.eta)
+    ic = s.initial
+    if not -60.0 < _finite("initial.target_yaw_deg", ic.target_yaw_deg) < 60.0:
+        raise InputError("initial.target_yaw_deg", ic.target_yaw_deg, "-60 < yaw < 60 deg")
+    if _finite("initial.approach_travel", ic.approach_travel) < 0:
+        raise InputError("initial.approach_travel", ic.approach_travel,
+                         ">= 0 m (a negative travel means initial interpenetration)")
+    _finite("initial.chaser_speed", ic.chaser_speed)
+    _positive("simulation.duration", s.simulation.duration)
+    if not 0 < _finite("simulation.accuracy", s.simulation.accuracy) < 1:
+        raise InputError("simulation.accuracy", s.simulation.accuracy, "0 < accuracy < 1")
+    _positive("simulation.capture_distance", s.simulation.capture_distance)
+    return s
+
+
+def load_scenario(filename=None, *, data: str | None = None) -> Scenario:
+    """Loads and validates a scenario from a YAML file (default: the paper's example) or a
+    string. Raises `InputError` (a ValueError) naming the field for any bad value, and for an
+    unreadable file."""
+    if data is None:
+        filename = Path(filename) if filename is not None else PAPER_EXAMPLE
+        try:
+            data = filename.read_text()
+        except OSError as e:
+            raise InputError("scenario file", str(filename), "a readable YAML file",
+                             e.strerror or str(e)) from None
+    try:
+        raw = yaml.safe_load(data)
+    except yaml.YAMLError as e:
+        raise InputError("scenario file", str(filename or "<string>"), "valid YAML",
+                         str(e).splitlines()[0]) from None
+    if raw is None:
+        raw = {}
+    if not isinstance(raw, dict):
+        raise InputError("scenario", raw, "a mapping of fields")
+    _check_raw(raw, Scenario, "")
+    try:
+        s = yaml_load_typed(schema=Scenario, data=data)
+    except (RuntimeError, ValueError, TypeError) as e:
+        raise InputError("scenario", str(filename or "<string>"),
+                         "values of the documented types", str(e)) from None
+    return validate(s)
