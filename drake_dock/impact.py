@@ -82,6 +82,7 @@ class ImpactResult:
     events: list                   # ImpactEvent log
     kinetic_energy_minus: float
     kinetic_energy_plus: float
+    impulse_history: np.ndarray = None  # normal impulses P^3 (N s) after each accepted step
 
     @property
     def energy_lost(self):
@@ -434,6 +435,7 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
                 prob.set_friction_mode(y, j, events, 0.0)
     steps = 0
     primary = []
+    history = []
     t = 0.0
     atol = rtol * 1e-2
     h = None
@@ -478,6 +480,7 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
                 y = y_new
                 t = solver.t
                 g_old = g_new
+            history.append(y[prob.iP][:s] * m_s * v_s)
             energies = np.where(y[prob.ix] > 0, prob.kappa * np.maximum(y[prob.ix], 0)
                                 ** (eta_ + 1) / (eta_ + 1), 0.0)
             if energies.max() > 0:
@@ -498,4 +501,46 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
         restitution_work=-y[prob.iwe] * E_scale,
         friction_loss=y[prob.iwf] * E_scale,
         primary_sequence=primary, steps=steps, events=events,
-        kinetic_energy_minus=KE_minus, kinetic_energy_plus=0.5 * v_plus @ M @ v_plus)
+        kinetic_energy_minus=KE_minus, kinetic_energy_plus=0.5 * v_plus @ M @ v_plus,
+        impulse_history=np.array(history))
+
+
+def solve_lzb_fixed_step(M, Wn, v_minus, stiffness, eta, restitution, *, dP, law="paper"):
+    """First-order reference variant (frictionless): the same equations and restitution laws
+    as `solve_lzb`, advanced by explicit Euler steps of a fixed increment ``dP`` (N s) of the
+    primary impulse P* (the couple of largest force, Eq. 32), with phase changes applied at the
+    end of the step in which they occur (no event location). This is how fixed-step LZB codes
+    (e.g. Siconos's MultipleImpact) integrate; it is first order in dP. For benchmarks.
+    Returns v_plus."""
+    M, L, Wn, v, _, n, s = _check_inputs(M, Wn, v_minus, None)
+    K = _per_couple("stiffness", stiffness, s, positive=True)
+    eta_ = _per_couple("eta", eta, s, positive=True)
+    e = _per_couple("restitution", restitution, s, lo=0.0, hi=1.0)
+    MinvW = np.linalg.solve(M, Wn)
+    G = Wn.T @ MinvW
+    u0 = Wn.T @ v
+    if np.any(u0 > 0):
+        raise ValueError("v_minus: a couple is already separating")
+    zeros = np.zeros(s)
+    prob = _Problem(np.pad(G, ((0, 2 * s), (0, 2 * s))), np.concatenate([u0, np.zeros(2 * s)]),
+                    K, eta_, e, zeros, zeros, law, zeros, False)
+    y = prob.y0.copy()
+    events = []
+    g_old = prob.event_values(y)
+    j0 = int(np.argmin(u0))
+    # First step from zero energy (Eq. 33-34): the time in which the fastest couple's impulse
+    # reaches dP, x = |u| t, P = K |u|^eta t^(eta+1) / (eta+1).
+    t_step = (dP * (eta_[j0] + 1) / (K[j0] * abs(u0[j0]) ** eta_[j0])) ** (1 / (eta_[j0] + 1))
+    for _ in range(50_000_000):
+        if prob.finished(y) and _ > 0:
+            break
+        y = y + t_step * prob.rhs(0.0, y)
+        g_new = prob.event_values(y)
+        for kind, j in zip(*np.nonzero((g_old > 0) & (g_new <= 0))):
+            prob.apply_event(y, kind, j, events, 0.0)
+        g_old = prob.event_values(y)
+        lam = K * np.maximum(y[prob.ix], 0.0) ** eta_
+        if lam.max() > 0:
+            t_step = dP / lam.max()
+    P = y[prob.iP]
+    return v + MinvW @ P
