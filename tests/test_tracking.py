@@ -25,8 +25,10 @@ def chaser_motion(t, offset=0.0):
     return R, p, w, v
 
 
-@pytest.mark.parametrize("name, offset", [("cc_T2_C4", 0.0), ("cc_T6_C6", 0.0),
-                                          ("cs_Cring_T1", 0.15), ("cs_Tring_C3", -0.15)])
+# Curve-surface couples are tracked in test_couple.py on a scene that keeps a positive gap: the
+# contact form of the conditions (Eq. 37-38) describes a couple that is apart or touching, not
+# a ring passing through a surface.
+@pytest.mark.parametrize("name, offset", [("cc_T2_C4", 0.0), ("cc_T6_C6", 0.0)])
 def test_tracking_matches_reseeking(geom, name, offset):
     pair = next(p for p in apds_pairs(geom) if p.name == name)
     fixed = (np.eye(3), np.zeros(3))

@@ -1,0 +1,682 @@
+"""The rigid contact system: a Drake LeafSystem that simulates a MultibodyPlant's bodies with
+the paper's contact model (Sect. 5-7): analytic couples tracked by Eq. (47), acceleration-level
+constraints with Coulomb friction (Eq. 48-52) and LZB impacts (Sect. 6) triggered by witness
+functions. Generic over the plant and the declared pairs; the docking scene is one user.
+
+Design (see the README, "Hybrid simulation"): the system owns the state. A continuous-time
+MultibodyPlant has no constraints and no velocity jumps (model notes / Drake facts), so this
+system holds x = [q, v, u*, energy integrals] and uses the plant as a calculator on its own
+scratch context (mass matrix, force elements, Jacobians). The plant's bodies, force elements and
+gravity are the model; `state` is an output in the plant's layout, so poses can be sent to
+SceneGraph by MultibodyPositionToGeometryPose.
+
+Each declared pair is in one of three states:
+- ``far``: not tracked. Its last sought distance d_c and the relative pose then are kept; a
+  witness compares a conservative bound of the relative travel of patch 1 since then
+  (|delta(X21 c1)| + |delta R21|_F r1, c1 and r1 a bounding sphere of patch 1) with a clearance;
+  when it is reached the pair is sought again (Sect. 5.1).
+- ``tracked`` (a potential contact): its couple is interior to both domains, isolated (the
+  Jacobian of Eq. 40 is regular) and nearer than ``track_distance``; u* is continuous state
+  integrated with Eq. (47), projected on the closest-point conditions at each evaluation (one
+  Newton step; the projection is fed back with rate ``drift_feedback`` and must stay below
+  ``drift_tol``). Its gap witness triggers the impact.
+- ``contact``: tracked and constrained, sticking or sliding.
+
+Documented transitions:
+- gap reaches zero (tracked): LZB impact of every couple within ``impact_gap_tol`` that is
+  approaching, together with the couples in contact; a couple leaving the impact slower than
+  ``zeno_speed`` stays in contact (its remaining normal velocity is removed by a plastic
+  impulse, booked as impact loss): the Zeno guard.
+- lambda_n reaches zero, the sliding velocity reaches zero or reverses, the sticking force
+  reaches the static cone: the modes of the contact set are selected again (`select_modes`).
+- a couple reaches the end of its domain, or its Jacobian turns singular (Eq. 39 fails): the
+  pair is sought again; if the new couple is interior and isolated the pair continues with it
+  (a hand-over within the pair, only when not in contact), otherwise it becomes far (a contact
+  that runs off a patch end ends there). A contact couple whose Jacobian turns singular raises
+  `SingularCoupleError`.
+"""
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
+from pydrake.multibody.math import SpatialForce
+from pydrake.systems.framework import (EventStatus, LeafSystem, UnrestrictedUpdateEvent,
+                                       ValueProducer, WitnessFunctionDirection)
+
+from drake_dock.core.constraints import (DETACH, SLIDE, STICK, ContactRow, select_modes,
+                                         solve_given_modes)
+from drake_dock.core.couple import closest_point_conditions, evaluate_couple, _conditioning
+from drake_dock.core.patches import posed
+from drake_dock.core.seeking import seek_couple
+from drake_dock.core.tracking import SingularCoupleError
+from drake_dock.errors import NumericalError
+from drake_dock.impact import solve_lzb
+
+FAR, TRACKED, CONTACT = 0, 1, 2
+STATUS_NAMES = {FAR: "far", TRACKED: "tracked", CONTACT: "contact"}
+_KV = JacobianWrtVariable.kV
+
+# Layout of each couple's output port.
+COUPLE_FIELDS = (("status", 1), ("gap", 1), ("vn", 1), ("lambda_n", 1), ("lambda_t", 2),
+                 ("vt", 2), ("u", 3), ("p1", 3), ("p2", 3), ("frame", 9))
+COUPLE_SLICES = {}
+_o = 0
+for _name, _size in COUPLE_FIELDS:
+    COUPLE_SLICES[_name] = slice(_o, _o + _size)
+    _o += _size
+COUPLE_OUTPUT_SIZE = _o
+# Output status codes: 0 far, 1 tracked, 2 sliding, 3 sticking.
+
+
+class DriftError(NumericalError):
+    """The integrated couple drifted from the closest-point conditions beyond tolerance."""
+
+
+class ZenoError(NumericalError):
+    """More impacts than ``max_impacts``: an impact sequence that does not end."""
+
+
+@dataclasses.dataclass
+class ContactPair:
+    """A declared pair: ``patch1`` (a curve) on ``frame1``, ``patch2`` (a curve for "CC", a
+    surface for "CS") on ``frame2``; the couple's normal points from body 2 to body 1."""
+
+    name: str
+    kind: str
+    frame1: object
+    patch1: object
+    frame2: object
+    patch2: object
+
+
+@dataclasses.dataclass
+class ContactLaw:
+    """Contact parameters shared by the pairs: friction mu (sliding) and mu_s (static), and the
+    LZB parameters restitution e, stiffness K and exponent eta (Eq. 28, 36)."""
+
+    mu: float = 0.0
+    mu_s: float | None = None
+    restitution: float = 0.0
+    stiffness: float = 1e9
+    eta: float = 1.5
+    impact_law: str = "paper"
+
+
+@dataclasses.dataclass
+class ContactOptions:
+    baumgarte: float = 20.0          # omega (rad/s) of the constraint stabilisation
+    drift_feedback: float = 50.0     # 1/s, feedback of the couple projection into u*
+    drift_tol: float = 1e-6          # largest projection step, relative to the domain span
+    track_distance: float = 0.02     # m: nearer interior isolated couples are tracked
+    reseek_floor: float = 1e-4       # m: smallest relative travel between two re-seeks
+    conditioning_min: float = 1e-6   # |det J| / prod(row norms) below which J is singular
+    v_slip: float = 1e-9             # m/s: a couple slower than this may stick
+    zeno_speed: float = 1e-3         # m/s: the Zeno guard (see the module docstring)
+    impact_gap_tol: float = 1e-8     # m: couples this near join an impact
+    impact_rtol: float = 1e-10
+    max_impacts: int = 10000
+
+
+@dataclasses.dataclass
+class PairState:
+    status: int = FAR
+    sigma: float = 1.0
+    stick: bool = False
+    slide_dir: np.ndarray | None = None
+    clearance: float = 0.0
+    ref_X21: tuple | None = None     # pose of frame 1 in frame 2 at the last seek
+    distance: float = math.inf       # distance at the last seek
+
+
+@dataclasses.dataclass
+class ContactModes:
+    """The abstract state: per pair status and mode, and the impact log."""
+
+    pairs: list
+    impacts: list = dataclasses.field(default_factory=list)   # dicts: t, couples, impulses
+    impact_loss: float = 0.0
+    mode_changes: int = 0
+
+
+@dataclasses.dataclass
+class _Eval:
+    q: np.ndarray
+    v: np.ndarray
+    qdot: np.ndarray
+    vdot: np.ndarray
+    udot: np.ndarray
+    evals: list            # CoupleEval or None per pair
+    lam_n: np.ndarray
+    lam_t: np.ndarray
+    contact_force: np.ndarray
+    friction_power: float
+    applied_power: float
+    external_power: float
+    bound: np.ndarray      # relative travel bound per far pair
+    poses: list
+
+
+def _bounding_sphere(patch, n=41):
+    pts = patch.position(patch.grid(n))
+    c = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    r = float(np.linalg.norm(pts - c, axis=1).max())
+    return c, 1.02 * r + 1e-9
+
+
+class RigidContactSystem(LeafSystem):
+    """See the module docstring. ``plant`` is a finalized continuous-time MultibodyPlant (it
+    need not be part of the diagram); ``pairs`` the declared `ContactPair`s; ``wrench_bodies``
+    names bodies that get an input port ``<body>_wrench`` (6-vector [torque, force], world
+    frame, applied at the body origin)."""
+
+    def __init__(self, plant, pairs, law: ContactLaw = ContactLaw(),
+                 options: ContactOptions = ContactOptions(), wrench_bodies=()):
+        super().__init__()
+        if not plant.is_finalized():
+            raise ValueError("plant: must be finalized")
+        if plant.time_step() != 0.0:
+            raise ValueError(f"plant: must be continuous (time_step = {plant.time_step()})")
+        names = [p.name for p in pairs]
+        if len(set(names)) != len(names):
+            raise ValueError(f"pairs: names must be unique, got {names}")
+        for p in pairs:
+            want = (1, 1) if p.kind == "CC" else (1, 2) if p.kind == "CS" else None
+            if want is None or (p.patch1.dim, p.patch2.dim) != want:
+                raise ValueError(f"pairs[{p.name}]: kind {p.kind!r} needs patch dims {want}, "
+                                 f"got ({p.patch1.dim}, {p.patch2.dim})")
+        self.plant = plant
+        self.pairs = list(pairs)
+        self.law = law
+        self.options = options
+        self._ctx = plant.CreateDefaultContext()
+        self.nq, self.nv = plant.num_positions(), plant.num_velocities()
+        self._dims = [p.patch1.dim + p.patch2.dim for p in pairs]
+        self._uoff = np.concatenate([[0], np.cumsum(self._dims)]).astype(int)
+        self.nu = int(self._uoff[-1])
+        self._spans = [np.concatenate([p.patch1.span, p.patch2.span]) for p in pairs]
+        self._periodic = [np.array(p.patch1.periodic + p.patch2.periodic) for p in pairs]
+        self._spheres = [_bounding_sphere(p.patch1) for p in pairs]
+        frames = []
+        for p in pairs:
+            for f in (p.frame1, p.frame2):
+                if all(f is not g for g in frames):
+                    frames.append(f)
+        self._frames = frames
+        self._fidx = [(next(i for i, g in enumerate(frames) if g is p.frame1),
+                       next(i for i, g in enumerate(frames) if g is p.frame2)) for p in pairs]
+        self._mu_s = law.mu if law.mu_s is None else law.mu_s
+
+        # State: x = [q, v, u*, friction loss, work of plant forces, work of inputs].
+        self.ie = self.nq + self.nv + self.nu
+        self.DeclareContinuousState(self.ie + 3)
+        self._mode_index = self.DeclareAbstractState(AbstractValue.Make(
+            ContactModes([PairState() for _ in pairs])))
+        self._gf_port = self.DeclareVectorInputPort("generalized_force", self.nv)
+        self._wrench_ports = {}
+        for b in wrench_bodies:
+            body = plant.GetBodyByName(b)
+            self._wrench_ports[b] = (body, self.DeclareVectorInputPort(f"{b}_wrench", 6))
+        self._cache = self.DeclareCacheEntry(
+            "contact evaluation", ValueProducer(
+                allocate=lambda: AbstractValue.Make(None), calc=self._calc_eval),
+            prerequisites_of_calc={self.all_sources_ticket()})
+        self.DeclareVectorOutputPort("state", self.nq + self.nv, self._out_state,
+                                     prerequisites_of_calc={self.xc_ticket()})
+        self.DeclareVectorOutputPort("generalized_contact_force", self.nv, self._out_gf)
+        self.DeclareVectorOutputPort("energy", 6, self._out_energy)
+        self._couple_ports = [
+            self.DeclareVectorOutputPort(f"couple_{p.name}", COUPLE_OUTPUT_SIZE,
+                                         lambda c, o, i=i: self._out_couple(c, o, i))
+            for i, p in enumerate(pairs)]
+        self.DeclareInitializationUnrestrictedUpdateEvent(self._on_event)
+        ev = UnrestrictedUpdateEvent(self._on_event)
+        down = WitnessFunctionDirection.kPositiveThenNonPositive
+        self._w = []
+        for i, p in enumerate(pairs):
+            self._w.append({
+                "gap": self.MakeWitnessFunction(f"{p.name} gap", down,
+                                                lambda c, i=i: self._w_gap(c, i), ev),
+                "end": self.MakeWitnessFunction(f"{p.name} domain end", down,
+                                                lambda c, i=i: self._w_end(c, i), ev),
+                "cond": self.MakeWitnessFunction(f"{p.name} Eq. 39", down,
+                                                 lambda c, i=i: self._w_cond(c, i), ev),
+                "lambda": self.MakeWitnessFunction(f"{p.name} lambda_n", down,
+                                                   lambda c, i=i: self._w_lambda(c, i), ev),
+                "slip": self.MakeWitnessFunction(f"{p.name} slip", down,
+                                                 lambda c, i=i: self._w_slip(c, i), ev),
+                "cone": self.MakeWitnessFunction(f"{p.name} friction cone", down,
+                                                 lambda c, i=i: self._w_cone(c, i), ev),
+                "clear": self.MakeWitnessFunction(f"{p.name} clearance", down,
+                                                  lambda c, i=i: self._w_clear(c, i), ev)})
+        self._memo = None
+        self.evaluations = 0
+
+    # ------------------------------------------------------------------ user helpers
+    def SetPositionsAndVelocities(self, context, q, v):
+        x = context.get_mutable_continuous_state_vector()
+        xv = x.CopyToVector()
+        xv[:self.nq], xv[self.nq:self.nq + self.nv] = q, v
+        x.SetFromVector(xv)
+
+    def set_from_plant_context(self, context, plant_context):
+        self.SetPositionsAndVelocities(context, self.plant.GetPositions(plant_context),
+                                       self.plant.GetVelocities(plant_context))
+
+    def get_modes(self, context) -> ContactModes:
+        return context.get_abstract_state(self._mode_index).get_value()
+
+    def get_couple_output_port(self, name):
+        return self._couple_ports[[p.name for p in self.pairs].index(name)]
+
+    # ------------------------------------------------------------------ evaluation
+    def _frame_kinematics(self, ctx):
+        poses, twists = [], []
+        for f in self._frames:
+            X = f.CalcPoseInWorld(ctx)
+            V = f.CalcSpatialVelocityInWorld(ctx)
+            poses.append((X.rotation().matrix(), X.translation()))
+            twists.append((V.rotational(), V.translational()))
+        return poses, twists
+
+    def _couple(self, i, u, poses, twists, sigma, time):
+        p = self.pairs[i]
+        a, b = self._fidx[i]
+        ev = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
+                             twists[b], u, sigma)
+        rel = np.abs(ev.drift) / self._spans[i]
+        if rel.max() > self.options.drift_tol:
+            raise DriftError(f"couple drift {rel.max():.3e} of the domain span exceeds "
+                             f"drift_tol = {self.options.drift_tol:g}", time=time,
+                             couples=[p.name])
+        return ev
+
+    def _row(self, i, ev, poses, ctx):
+        """W^3, W^1, W^2 (Eq. 11) from Drake's point Jacobians and the bias terms (Eq. 52)."""
+        p = self.pairs[i]
+        a, b = self._fidx[i]
+        world = self.plant.world_frame()
+        R1, o1 = poses[a]
+        R2, o2 = poses[b]
+        r1 = R1.T @ (ev.p1 - o1)
+        r2 = R2.T @ (ev.p2 - o2)
+        J = (self.plant.CalcJacobianTranslationalVelocity(ctx, _KV, p.frame1, r1, world, world)
+             - self.plant.CalcJacobianTranslationalVelocity(ctx, _KV, p.frame2, r2, world,
+                                                              world))
+        ab = (self.plant.CalcBiasTranslationalAcceleration(ctx, _KV, p.frame1, r1, world, world)
+              - self.plant.CalcBiasTranslationalAcceleration(ctx, _KV, p.frame2, r2, world,
+                                                               world)).ravel()
+        Wn = J.T @ ev.n
+        Wt = J.T @ np.column_stack([ev.ta, ev.tb])
+        return ContactRow(p.name, Wn, Wt, ev.bias_n + ev.n @ ab,
+                          ev.bias_t + np.array([ev.ta @ ab, ev.tb @ ab]), ev.gap, ev.vn, ev.vt,
+                          self.law.mu, self._mu_s)
+
+    def _set_scratch(self, q, v):
+        self.plant.SetPositions(self._ctx, q)
+        self.plant.SetVelocities(self._ctx, v)
+        return self._ctx
+
+    def _free_acceleration(self, context, ctx, v):
+        """M, M^-1, a0 = M^-1 tau (every force but contact), and the power of the plant's
+        force elements and of the inputs. Drake's inverse dynamics at zero acceleration gives
+        C(q, v) v - tau for any set of forces."""
+        zero = np.zeros(self.nv)
+        ID = self.plant.CalcInverseDynamics
+        bias = ID(ctx, zero, MultibodyForces(self.plant))
+        fe = MultibodyForces(self.plant)
+        self.plant.CalcForceElementsContribution(ctx, fe)
+        tau_el = bias - ID(ctx, zero, fe)
+        tau_in = np.zeros(self.nv)
+        if self._gf_port.HasValue(context):
+            tau_in += self._gf_port.Eval(context)
+        wf, any_in = MultibodyForces(self.plant), False
+        for body, port in self._wrench_ports.values():
+            if port.HasValue(context):
+                w = port.Eval(context)
+                body.AddInForce(ctx, np.zeros(3), SpatialForce(w[:3], w[3:]),
+                                self.plant.world_frame(), wf)
+                any_in = True
+        if any_in:
+            tau_in += bias - ID(ctx, zero, wf)
+        M = self.plant.CalcMassMatrix(ctx)
+        Minv = np.linalg.inv(M)
+        return M, Minv, Minv @ (tau_el + tau_in - bias), float(tau_el @ v), float(tau_in @ v)
+
+    def _calc_eval(self, context, value):
+        self.evaluations += 1
+        t = context.get_time()
+        x = context.get_continuous_state_vector().CopyToVector()
+        q, v, u = x[:self.nq], x[self.nq:self.nq + self.nv], x[self.nq + self.nv:self.ie]
+        modes = self.get_modes(context)
+        ctx = self._set_scratch(q, v)
+        poses, twists = self._frame_kinematics(ctx)
+        k = len(self.pairs)
+        evals = [None] * k
+        udot = np.zeros(self.nu)
+        bound = np.zeros(k)
+        rows, row_pairs, smodes, dirs = [], [], [], []
+        for i, st in enumerate(modes.pairs):
+            sl = slice(self._uoff[i], self._uoff[i + 1])
+            if st.status == FAR:
+                bound[i] = self._travel_bound(i, poses, st)
+                continue
+            ev = self._couple(i, u[sl], poses, twists, st.sigma, t)
+            evals[i] = ev
+            udot[sl] = ev.udot + self.options.drift_feedback * ev.drift
+            if st.status == CONTACT:
+                rows.append(self._row(i, ev, poses, ctx))
+                row_pairs.append(i)
+                if st.stick:
+                    smodes.append(STICK)
+                    dirs.append(None)
+                else:
+                    smodes.append(SLIDE)
+                    s = math.hypot(*ev.vt)
+                    dirs.append(ev.vt / s if s > self.options.v_slip or st.slide_dir is None
+                                else st.slide_dir)
+        M, Minv, a0, p_plant, p_in = self._free_acceleration(context, ctx, v)
+        sol = solve_given_modes(Minv, a0, rows, smodes, dirs, omega=self.options.baumgarte,
+                                time=t)
+        lam_n, lam_t = np.zeros(k), np.zeros((k, 2))
+        for j, i in enumerate(row_pairs):
+            lam_n[i], lam_t[i] = sol.lam_n[j], sol.lam_t[j]
+        qdot = self.plant.MapVelocityToQDot(ctx, v)
+        value.set_value(_Eval(q, v, qdot, sol.vdot, udot, evals, lam_n, lam_t,
+                              sol.generalized_force, sol.power_lost_to_friction(rows), p_plant,
+                              p_in, bound, poses))
+
+    def _travel_bound(self, i, poses, st):
+        if st.ref_X21 is None:
+            return math.inf
+        a, b = self._fidx[i]
+        R1, p1 = poses[a]
+        R2, p2 = poses[b]
+        R21, p21 = R2.T @ R1, R2.T @ (p1 - p2)
+        R0, p0 = st.ref_X21
+        c, r = self._spheres[i]
+        return float(np.linalg.norm(R21 @ c + p21 - (R0 @ c + p0))
+                     + np.linalg.norm(R21 - R0) * r)
+
+    def eval(self, context) -> _Eval:
+        return self._cache.Eval(context)
+
+    def DoCalcTimeDerivatives(self, context, derivatives):
+        E = self._cache.Eval(context)
+        derivatives.get_mutable_vector().SetFromVector(np.concatenate(
+            [E.qdot, E.vdot, E.udot, [E.friction_power, E.applied_power, E.external_power]]))
+
+    # ------------------------------------------------------------------ outputs
+    def _out_state(self, context, out):
+        out.SetFromVector(context.get_continuous_state_vector().CopyToVector()[:self.nq + self.nv])
+
+    def _out_gf(self, context, out):
+        out.SetFromVector(self._cache.Eval(context).contact_force)
+
+    def _out_energy(self, context, out):
+        """[kinetic, potential (plant elements that implement it), friction loss, work of the
+        plant's forces, work of the inputs, impact loss]."""
+        E = self._cache.Eval(context)
+        x = context.get_continuous_state_vector().CopyToVector()
+        ctx = self._set_scratch(E.q, E.v)
+        ke = 0.5 * E.v @ self.plant.CalcMassMatrix(ctx) @ E.v
+        try:
+            pe = self.plant.CalcPotentialEnergy(ctx)
+        except RuntimeError:
+            pe = math.nan
+        out.SetFromVector([ke, pe, x[self.ie], x[self.ie + 1], x[self.ie + 2],
+                           self.get_modes(context).impact_loss])
+
+    def _out_couple(self, context, out, i):
+        E = self._cache.Eval(context)
+        st = self.get_modes(context).pairs[i]
+        y = np.zeros(COUPLE_OUTPUT_SIZE)
+        ev = E.evals[i]
+        S = COUPLE_SLICES
+        if ev is None:
+            p = self.pairs[i]
+            a, b = self._fidx[i]
+            u = context.get_continuous_state_vector().CopyToVector()[
+                self.nq + self.nv + self._uoff[i]:self.nq + self.nv + self._uoff[i + 1]]
+            n1 = p.patch1.dim
+            y[S["gap"]] = st.distance - E.bound[i]
+            y[S["u"]][:len(u)] = u
+            y[S["p1"]] = posed(p.patch1, *E.poses[a]).position(u[:n1])
+            y[S["p2"]] = posed(p.patch2, *E.poses[b]).position(u[n1:])
+            y[S["frame"]] = np.eye(3).ravel()
+        else:
+            y[S["status"]] = st.status + (1 if st.status == CONTACT and st.stick else 0)
+            y[S["gap"]], y[S["vn"]] = ev.gap, ev.vn
+            y[S["lambda_n"]], y[S["lambda_t"]] = E.lam_n[i], E.lam_t[i]
+            y[S["vt"]] = ev.vt
+            y[S["u"]][:len(ev.u)] = ev.u
+            y[S["p1"]], y[S["p2"]] = ev.p1, ev.p2
+            y[S["frame"]] = ev.frame.ravel()
+        out.SetFromVector(y)
+
+    # ------------------------------------------------------------------ witnesses
+    def DoGetWitnessFunctions(self, context):
+        out = []
+        for i, st in enumerate(self.get_modes(context).pairs):
+            w = self._w[i]
+            if st.status == FAR:
+                out.append(w["clear"])
+                continue
+            out += [w["end"], w["cond"]]
+            if st.status == TRACKED:
+                out.append(w["gap"])
+            else:
+                out += [w["lambda"], w["cone"] if st.stick else w["slip"]]
+        return out
+
+    def _status(self, context, i):
+        return self.get_modes(context).pairs[i]
+
+    def _w_gap(self, context, i):
+        ev = self._cache.Eval(context).evals[i]
+        return 1.0 if ev is None else ev.gap
+
+    def _w_end(self, context, i):
+        ev = self._cache.Eval(context).evals[i]
+        if ev is None:
+            return 1.0
+        m = np.concatenate([self.pairs[i].patch1.margin(ev.u[:self.pairs[i].patch1.dim]),
+                            self.pairs[i].patch2.margin(ev.u[self.pairs[i].patch1.dim:])])
+        return float(np.min(m / self._spans[i]))
+
+    def _w_cond(self, context, i):
+        ev = self._cache.Eval(context).evals[i]
+        return 1.0 if ev is None else ev.conditioning - self.options.conditioning_min
+
+    def _w_lambda(self, context, i):
+        return float(self._cache.Eval(context).lam_n[i]) if \
+            self._status(context, i).status == CONTACT else 1.0
+
+    def _w_slip(self, context, i):
+        st = self._status(context, i)
+        ev = self._cache.Eval(context).evals[i]
+        if st.status != CONTACT or st.stick or ev is None or st.slide_dir is None:
+            return 1.0
+        return float(ev.vt @ st.slide_dir)
+
+    def _w_cone(self, context, i):
+        st = self._status(context, i)
+        E = self._cache.Eval(context)
+        if st.status != CONTACT or not st.stick:
+            return 1.0
+        return float(self._mu_s * E.lam_n[i] - math.hypot(*E.lam_t[i]))
+
+    def _w_clear(self, context, i):
+        st = self._status(context, i)
+        if st.status != FAR:
+            return 1.0
+        return float(st.clearance - self._cache.Eval(context).bound[i])
+
+    # ------------------------------------------------------------------ events
+    def _on_event(self, context, event, state):
+        x = context.get_continuous_state_vector().CopyToVector()
+        key = (context.get_time(), x.tobytes(), self.get_modes(context).mode_changes)
+        if self._memo is None or self._memo[0] != key:
+            self._memo = (key,) + self._resolve(context, x)
+        _, x_new, modes_new = self._memo
+        state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(x_new)
+        state.get_mutable_abstract_state(self._mode_index).set_value(copy.deepcopy(modes_new))
+        return EventStatus.Succeeded()
+
+    def _seek(self, i, poses, modes, u, time, was_contact):
+        """Sect. 5.1 for pair i, and the status that follows (module docstring)."""
+        p = self.pairs[i]
+        a, b = self._fidx[i]
+        st = modes.pairs[i]
+        P1, P2 = posed(p.patch1, *poses[a]), posed(p.patch2, *poses[b])
+        c = seek_couple(P1, P2)
+        R1, p1 = poses[a]
+        R2, p2 = poses[b]
+        st.ref_X21 = (R2.T @ R1, R2.T @ (p1 - p2))
+        st.distance = c.distance
+        _, Fu = closest_point_conditions(p.kind, p.patch1, poses[a], p.patch2, poses[b], c.u)
+        isolated = _conditioning(Fu) > 10 * self.options.conditioning_min
+        sl = slice(self._uoff[i], self._uoff[i + 1])
+        u[sl] = c.u
+        opt = self.options
+        if c.interior and isolated and c.distance < opt.track_distance and not was_contact:
+            ev = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
+                                 poses[b], (np.zeros(3),) * 2, c.u, 1.0, project=False)
+            st.sigma = 1.0 if ev.gap >= 0.0 else -1.0
+            st.status = TRACKED
+        else:
+            st.status = FAR
+            if c.distance >= opt.track_distance:
+                st.clearance = max(c.distance - 0.5 * opt.track_distance, 0.5 * c.distance,
+                                   opt.reseek_floor)
+            else:
+                st.clearance = max(0.5 * c.distance, opt.reseek_floor)
+        st.stick, st.slide_dir = False, None
+
+    def _resolve(self, context, x):
+        """All the transitions due at this state (module docstring); returns (x, modes)."""
+        t = context.get_time()
+        opt = self.options
+        modes = copy.deepcopy(self.get_modes(context))
+        modes.mode_changes += 1
+        q = x[:self.nq]
+        v = x[self.nq:self.nq + self.nv].copy()
+        u = x[self.nq + self.nv:self.ie].copy()
+        ctx = self._set_scratch(q, v)
+        poses, twists = self._frame_kinematics(ctx)
+        initial = all(st.ref_X21 is None and st.status == FAR for st in modes.pairs)
+        # 1. Seeking: at initialisation, for far pairs whose clearance is used up, and for
+        #    couples at a domain end or with a singular Jacobian.
+        for i, st in enumerate(modes.pairs):
+            sl = slice(self._uoff[i], self._uoff[i + 1])
+            if initial or (st.status == FAR and self._travel_bound(i, poses, st)
+                           >= st.clearance):
+                self._seek(i, poses, modes, u, t, False)
+                continue
+            if st.status == FAR:
+                continue
+            ev = evaluate_couple(self.pairs[i].kind, self.pairs[i].patch1,
+                                 poses[self._fidx[i][0]], twists[self._fidx[i][0]],
+                                 self.pairs[i].patch2, poses[self._fidx[i][1]],
+                                 twists[self._fidx[i][1]], u[sl], st.sigma)
+            u[sl] = ev.u
+            p = self.pairs[i]
+            margin = np.concatenate([p.patch1.margin(ev.u[:p.patch1.dim]),
+                                     p.patch2.margin(ev.u[p.patch1.dim:])]) / self._spans[i]
+            if ev.conditioning <= opt.conditioning_min and st.status == CONTACT:
+                raise SingularCoupleError(
+                    f"the Jacobian of a couple in contact turned singular (Eq. 39 fails; "
+                    f"conditioning {ev.conditioning:.2e})", time=t, couples=[p.name])
+            if margin.min() <= 0.0 or ev.conditioning <= opt.conditioning_min:
+                self._seek(i, poses, modes, u, t, st.status == CONTACT)
+        # 2. Impacts and 3. modes.
+        v = self._impacts_and_modes(context, t, modes, ctx, poses, twists, q, v, u)
+        x_new = x.copy()
+        x_new[self.nq:self.nq + self.nv] = v
+        x_new[self.nq + self.nv:self.ie] = u
+        return x_new, modes
+
+    def _impacts_and_modes(self, context, t, modes, ctx, poses, twists, q, v, u):
+        opt = self.options
+        evs = {}
+
+        def evaluate_all(v):
+            self._set_scratch(q, v)
+            ps, tw = self._frame_kinematics(ctx)
+            for i, st in enumerate(modes.pairs):
+                if st.status != FAR:
+                    sl = slice(self._uoff[i], self._uoff[i + 1])
+                    evs[i] = self._couple(i, u[sl], ps, tw, st.sigma, t)
+            return ps
+
+        poses = evaluate_all(v)
+        M = self.plant.CalcMassMatrix(ctx)
+        hit = [i for i, st in enumerate(modes.pairs) if st.status == TRACKED
+               and evs[i].gap <= opt.impact_gap_tol and evs[i].vn < 0.0]
+        candidates = set()
+        if hit:
+            if len(modes.impacts) >= opt.max_impacts:
+                raise ZenoError(f"more than max_impacts = {opt.max_impacts} impacts",
+                                time=t, couples=[self.pairs[i].name for i in hit])
+            S = hit + [i for i, st in enumerate(modes.pairs)
+                       if st.status == CONTACT and evs[i].vn <= 0.0]
+            rows = [self._row(i, evs[i], poses, ctx) for i in S]
+            Wn = np.column_stack([r.Wn for r in rows])
+            Wt = np.column_stack([r.Wt for r in rows])
+            law = self.law
+            res = solve_lzb(M, Wn, v, law.stiffness, law.eta, law.restitution, Wt=Wt,
+                            mu=law.mu, mu_s=self._mu_s, law=law.impact_law,
+                            rtol=opt.impact_rtol)
+            v = res.v_plus
+            modes.impacts.append({"t": t, "couples": [self.pairs[i].name for i in S],
+                                  "normal_impulse": res.normal_impulse.tolist(),
+                                  "tangential_impulse": res.tangential_impulse.tolist(),
+                                  "energy_lost": res.kinetic_energy_minus
+                                  - res.kinetic_energy_plus})
+            modes.impact_loss += res.kinetic_energy_minus - res.kinetic_energy_plus
+            vn = Wn.T @ v
+            slow = [i for i, s in zip(S, vn) if s < opt.zeno_speed]
+            v = self._plastic(M, v, [rows[S.index(i)].Wn for i in slow], modes)
+            candidates.update(slow)
+            poses = evaluate_all(v)
+        # Contact set: couples in contact, couples just held by the Zeno guard and resting
+        # couples (closed and not moving apart).
+        for i, st in enumerate(modes.pairs):
+            if st.status == CONTACT or (st.status == TRACKED and evs[i].gap <= opt.impact_gap_tol
+                                         and abs(evs[i].vn) <= opt.zeno_speed):
+                candidates.add(i)
+        cand = sorted(candidates)
+        self._set_scratch(q, v)
+        rows = [self._row(i, evs[i], poses, ctx) for i in cand]
+        M, Minv, a0, _, _ = self._free_acceleration(context, ctx, v)
+        sol = select_modes(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t)
+        for j, i in enumerate(cand):
+            st = modes.pairs[i]
+            m = sol.modes[j]
+            if m == DETACH:
+                st.status, st.stick, st.slide_dir = TRACKED, False, None
+            else:
+                st.status = CONTACT
+                st.stick = m == STICK
+                st.slide_dir = None if st.stick else np.asarray(sol.dirs[j], dtype=float)
+        return v
+
+    def _plastic(self, M, v, Wns, modes):
+        """Removes the remaining approach/separation speed of the couples held by the Zeno
+        guard (a plastic impulse; only non-negative impulses are kept)."""
+        active = list(range(len(Wns)))
+        Minv = np.linalg.inv(M)
+        ke0 = 0.5 * v @ M @ v
+        while active:
+            W = np.column_stack([Wns[k] for k in active])
+            P = -np.linalg.solve(W.T @ Minv @ W, W.T @ v)
+            if np.all(P >= 0.0):
+                v = v + Minv @ W @ P
+                break
+            active = [k for k, pk in zip(active, P) if pk >= 0.0]
+        modes.impact_loss += ke0 - 0.5 * v @ M @ v
+        return v

@@ -1,0 +1,231 @@
+"""Acceleration-level contact constraints with Coulomb friction (Eq. 48-52), plain numpy.
+
+For the couples of the contact set, with generalized mass M, free acceleration a0 = M^-1 tau
+(everything but the contact forces) and, per couple, the directions Wn = W^3, Wt = [W^1, W^2]
+of Eq. (11) and the velocity-product terms b (so that g'' = Wn.v' + bn and the tangential
+relative acceleration is Wt^T v' + bt), each couple takes one mode:
+
+- ``stick``:  g'' = 0 and Wt^T v' + bt = 0, force (lam_n, lam_t) inside the static cone
+  |lam_t| <= mu_s lam_n (Eq. 51);
+- ``slide``:  g'' = 0, lam_t = -mu lam_n s with s the unit sliding direction (Eq. 50), lam_n >= 0;
+- ``detach``: no force, g'' >= 0.
+
+M v' = tau + sum (Wn lam_n + Wt lam_t). The constraint equations are stabilised (Baumgarte):
+g'' + 2 omega g' + omega^2 g = 0 and, when sticking, a_t + omega v_t = 0, so that the drift of a
+long contact decays instead of growing; omega = 0 gives Eq. (52) as printed.
+
+`select_modes` enumerates the modes of the contact set (3^k choices, k <= 8) and keeps the
+consistent ones. None consistent, or several with different accelerations that differ in their
+normal modes, is the Painleve paradox of a rigid model: it raises `PainleveError` with the time
+and the couples. Several consistent choices that differ only in stick against start-of-sliding
+(possible when mu_s > mu) are resolved by preferring stick: a couple at rest stays at rest.
+"""
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+
+import numpy as np
+
+from drake_dock.errors import NumericalError
+
+STICK, SLIDE, DETACH = "stick", "slide", "detach"
+MAX_ENUMERATED = 8
+
+
+class PainleveError(NumericalError):
+    """No consistent contact mode, or several (Painleve inconsistency or indeterminacy)."""
+
+
+class SingularContactError(NumericalError):
+    """The constraint equations of the contact set are singular (redundant or degenerate
+    contact Jacobian); the rigid model cannot distribute the contact forces."""
+
+
+@dataclasses.dataclass
+class ContactRow:
+    """One couple of the contact set, in the generalized coordinates."""
+
+    name: str
+    Wn: np.ndarray        # (nv,)
+    Wt: np.ndarray        # (nv, 2)
+    bn: float
+    bt: np.ndarray        # (2,)
+    gap: float
+    vn: float
+    vt: np.ndarray        # (2,)
+    mu: float
+    mu_s: float
+
+
+@dataclasses.dataclass
+class ContactSolution:
+    modes: tuple
+    dirs: list            # unit sliding direction (2,) per couple, or None
+    vdot: np.ndarray
+    lam_n: np.ndarray     # (k,)
+    lam_t: np.ndarray     # (k, 2)
+    gddot: np.ndarray     # (k,) g'' (without the stabilisation terms)
+    at: np.ndarray        # (k, 2) tangential relative accelerations
+    generalized_force: np.ndarray  # sum Wn lam_n + Wt lam_t
+
+    def power_lost_to_friction(self, rows):
+        """sum -lam_t . v_t over the couples (>= 0 for sliding, 0 for sticking)."""
+        return float(sum(-(lt @ r.vt) for lt, r in zip(self.lam_t, rows)))
+
+
+def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None) -> ContactSolution:
+    """Contact forces and accelerations for the given modes (``dirs[i]`` the sliding direction
+    of a sliding couple). Raises `SingularContactError` if the constraint matrix is singular."""
+    cols, cons, rhs = [], [], []
+    for r, m, s in zip(rows, modes, dirs):
+        if m == STICK:
+            cols += [r.Wn, r.Wt[:, 0], r.Wt[:, 1]]
+            cons += [r.Wn, r.Wt[:, 0], r.Wt[:, 1]]
+            rhs += [r.bn + 2 * omega * r.vn + omega ** 2 * r.gap,
+                    r.bt[0] + omega * r.vt[0], r.bt[1] + omega * r.vt[1]]
+        elif m == SLIDE:
+            cols.append(r.Wn - r.mu * (r.Wt @ s))
+            cons.append(r.Wn)
+            rhs.append(r.bn + 2 * omega * r.vn + omega ** 2 * r.gap)
+    vdot = a0
+    lam = np.zeros(0)
+    Cf = None
+    if cols:
+        C = np.column_stack(cols)
+        D = np.column_stack(cons)
+        MinvC = Minv @ C
+        A = D.T @ MinvC
+        b = -(np.asarray(rhs) + D.T @ a0)
+        cond = np.linalg.cond(A)
+        if not np.isfinite(cond) or cond > 1e12:
+            raise SingularContactError(
+                f"contact constraint matrix singular (cond = {cond:.3e}) for modes {modes}",
+                time=time, couples=[r.name for r, m in zip(rows, modes) if m != DETACH])
+        lam = np.linalg.solve(A, b)
+        vdot = a0 + MinvC @ lam
+        Cf = C @ lam
+    k = len(rows)
+    lam_n, lam_t = np.zeros(k), np.zeros((k, 2))
+    j = 0
+    for i, (r, m, s) in enumerate(zip(rows, modes, dirs)):
+        if m == STICK:
+            lam_n[i], lam_t[i] = lam[j], lam[j + 1:j + 3]
+            j += 3
+        elif m == SLIDE:
+            lam_n[i] = lam[j]
+            lam_t[i] = -r.mu * lam[j] * np.asarray(s)
+            j += 1
+    gddot = np.array([r.Wn @ vdot + r.bn for r in rows])
+    at = np.array([r.Wt.T @ vdot + r.bt for r in rows]).reshape(k, 2)
+    return ContactSolution(tuple(modes), list(dirs), vdot, lam_n, lam_t, gddot, at,
+                           Cf if Cf is not None else np.zeros_like(a0))
+
+
+def _slide_start(Minv, a0, rows, modes, dirs, i_start, omega, time, max_iter=200):
+    """Sliding directions of couples that start to slide from rest: friction opposes the
+    tangential relative acceleration it produces (fixed point s = a_t/|a_t|)."""
+    dirs = list(dirs)
+    sol = None
+    for _ in range(max_iter):
+        sol = solve_given_modes(Minv, a0, rows, modes, dirs, omega=omega, time=time)
+        change = 0.0
+        for i in i_start:
+            a = sol.at[i]
+            na = math.hypot(a[0], a[1])
+            if na == 0.0:
+                return sol, False
+            new = a / na
+            change = max(change, float(np.abs(new - dirs[i]).max()))
+            dirs[i] = new
+        if change < 1e-13:
+            break
+    sol = solve_given_modes(Minv, a0, rows, modes, dirs, omega=omega, time=time)
+    ok = all(sol.at[i] @ dirs[i] > 0 for i in i_start)
+    return sol, ok
+
+
+def _consistent(sol, rows, starting, tol_f, tol_a):
+    for i, (r, m) in enumerate(zip(rows, sol.modes)):
+        if m == DETACH:
+            if sol.gddot[i] < -tol_a:
+                return False
+        else:
+            if sol.lam_n[i] < -tol_f:
+                return False
+            if m == STICK and math.hypot(*sol.lam_t[i]) > r.mu_s * sol.lam_n[i] + tol_f:
+                return False
+    return True
+
+
+def select_modes(Minv, a0, rows, *, v_slip=1e-9, omega=0.0, time=None, rtol=1e-9):
+    """One consistent choice of modes for the contact set (see the module docstring).
+
+    A couple whose sliding speed exceeds ``v_slip`` slides in its direction of motion (or
+    detaches); one at rest may stick, start to slide or detach."""
+    k = len(rows)
+    names = [r.name for r in rows]
+    if k == 0:
+        return solve_given_modes(Minv, a0, rows, (), [], omega=omega, time=time)
+    if k > MAX_ENUMERATED:
+        raise NumericalError(f"{k} couples in contact at once; mode enumeration is limited to "
+                             f"{MAX_ENUMERATED}", time=time, couples=names)
+    options, moving_dir = [], []
+    for r in rows:
+        speed = math.hypot(r.vt[0], r.vt[1])
+        if speed > v_slip:
+            options.append((SLIDE, DETACH))
+            moving_dir.append(np.asarray(r.vt) / speed)
+        else:
+            options.append((STICK, SLIDE, DETACH))
+            moving_dir.append(None)
+    # Force and acceleration scales for the consistency tolerances.
+    free = solve_given_modes(Minv, a0, rows, (DETACH,) * k, [None] * k, omega=omega, time=time)
+    a_scale = 1.0 + float(np.abs(free.gddot).max()) + float(np.abs(free.at).max())
+    found = []
+    for modes in itertools.product(*options):
+        dirs = [moving_dir[i] if m == SLIDE and moving_dir[i] is not None else None
+                for i, m in enumerate(modes)]
+        starting = [i for i, m in enumerate(modes) if m == SLIDE and moving_dir[i] is None]
+        try:
+            if starting:
+                # Start from the direction opposite to the sticking force (or the free
+                # tangential acceleration).
+                guess = solve_given_modes(
+                    Minv, a0, rows, [STICK if i in starting else m for i, m in enumerate(modes)],
+                    [d if d is not None else np.zeros(2) for d in dirs], omega=omega, time=time)
+                for i in starting:
+                    g = -guess.lam_t[i]
+                    if math.hypot(*g) == 0.0:
+                        g = free.at[i]
+                    ng = math.hypot(*g)
+                    dirs[i] = g / ng if ng > 0 else np.array([1.0, 0.0])
+                sol, ok = _slide_start(Minv, a0, rows, modes, dirs, starting, omega, time)
+                if not ok:
+                    continue
+            else:
+                sol = solve_given_modes(Minv, a0, rows, modes, dirs, omega=omega, time=time)
+        except SingularContactError:
+            continue
+        f_scale = 1.0 + float(np.abs(sol.lam_n).max())
+        if _consistent(sol, rows, starting, rtol * f_scale, rtol * a_scale):
+            found.append(sol)
+    if not found:
+        raise PainleveError("no consistent contact mode (Painleve inconsistency: the rigid "
+                            "model with this friction has no solution)", time=time,
+                            couples=names)
+    # Preference among consistent choices: more sticking couples, then more couples in contact.
+    found.sort(key=lambda s: (-s.modes.count(STICK), s.modes.count(DETACH)))
+    best = found[0]
+    v_scale = 1.0 + float(np.abs(best.vdot).max())
+    for other in found[1:]:
+        if np.abs(other.vdot - best.vdot).max() <= 1e-6 * v_scale:
+            continue
+        normal = [m == DETACH for m in best.modes] != [m == DETACH for m in other.modes]
+        if normal:
+            raise PainleveError(
+                f"several consistent contact modes with different accelerations "
+                f"({best.modes} and {other.modes}): Painleve indeterminacy", time=time,
+                couples=names)
+    return best

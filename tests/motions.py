@@ -1,0 +1,47 @@
+"""Prescribed smooth rigid motions with closed-form twists and accelerations, for kinematics
+tests."""
+import math
+
+import numpy as np
+
+from drake_dock.docking.scene import rot_x, rot_z
+
+
+class Motion:
+    """Pose R(t) = Rz(a(t)) Rx(b(t)) R0, p(t) = p0 + A sin(W t) + V t, with
+    a = A_a sin(w_a t), b = A_b sin(w_b t)."""
+
+    def __init__(self, R0=np.eye(3), p0=np.zeros(3), A=(0.0, 0.0, 0.0), W=(1.0, 1.0, 1.0),
+                 V=(0.0, 0.0, 0.0), a=(0.0, 1.0), b=(0.0, 1.0)):
+        self.R0, self.p0 = np.asarray(R0, float), np.asarray(p0, float)
+        self.A, self.W, self.V = (np.asarray(x, float) for x in (A, W, V))
+        self.a, self.b = a, b
+
+    def _ang(self, c, t):
+        A, w = c
+        return A * math.sin(w * t), A * w * math.cos(w * t), -A * w * w * math.sin(w * t)
+
+    def pose(self, t):
+        a, _, _ = self._ang(self.a, t)
+        b, _, _ = self._ang(self.b, t)
+        R = rot_z(a) @ rot_x(b) @ self.R0
+        p = self.p0 + self.A * np.sin(self.W * t) + self.V * t
+        return R, p
+
+    def twist(self, t):
+        a, ad, _ = self._ang(self.a, t)
+        _, bd, _ = self._ang(self.b, t)
+        w = ad * np.array([0.0, 0.0, 1.0]) + bd * (rot_z(a) @ np.array([1.0, 0.0, 0.0]))
+        v = self.A * self.W * np.cos(self.W * t) + self.V
+        return w, v
+
+    def acceleration(self, t, P):
+        """Acceleration of the material point at world position P."""
+        a, ad, add = self._ang(self.a, t)
+        _, bd, bdd = self._ang(self.b, t)
+        ez, ex = np.array([0.0, 0.0, 1.0]), rot_z(a) @ np.array([1.0, 0.0, 0.0])
+        w = ad * ez + bd * ex
+        alpha = add * ez + bdd * ex + bd * ad * np.cross(ez, ex)
+        acc = -self.A * self.W ** 2 * np.sin(self.W * t)
+        r = P - self.pose(t)[1]
+        return acc + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
