@@ -24,9 +24,10 @@ Each declared pair is in one of three states:
 
 Documented transitions:
 - gap reaches zero (tracked): LZB impact of every couple within ``impact_gap_tol`` that is
-  approaching, together with the couples in contact; a couple leaving the impact slower than
-  ``zeno_speed`` stays in contact (its remaining normal velocity is removed by a plastic
-  impulse, booked as impact loss): the Zeno guard.
+  approaching, together with the couples in contact. Zeno guard: an impact whose approach
+  speed is below ``zeno_speed`` is plastic (e = 0), so that a decaying bounce sequence ends in
+  persistent contact after finitely many impacts. Couples closed at the end of an impact enter
+  the contact set; the others separate.
 - lambda_n reaches zero, the sliding velocity reaches zero or reverses, the sticking force
   reaches the static cone: the modes of the contact set are selected again (`select_modes`).
 - a couple reaches the end of its domain, or its Jacobian turns singular (Eq. 39 fails): the
@@ -54,7 +55,7 @@ from drake_dock.core.couple import closest_point_conditions, evaluate_couple, _c
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.core.tracking import SingularCoupleError
-from drake_dock.errors import NumericalError
+from drake_dock.errors import NumericalError, SeekingError
 from drake_dock.impact import solve_lzb
 
 FAR, TRACKED, CONTACT = 0, 1, 2
@@ -84,7 +85,10 @@ class ZenoError(NumericalError):
 @dataclasses.dataclass
 class ContactPair:
     """A declared pair: ``patch1`` (a curve) on ``frame1``, ``patch2`` (a curve for "CC", a
-    surface for "CS") on ``frame2``; the couple's normal points from body 2 to body 1."""
+    surface for "CS") on ``frame2``; the couple's normal points from body 2 to body 1.
+    ``sigma`` (+-1) fixes the orientation of n (Definition 2) when the scene knows it (a body
+    that starts resting on a plane); by default it is taken when the pair becomes potential,
+    from the side the patches are on."""
 
     name: str
     kind: str
@@ -92,6 +96,7 @@ class ContactPair:
     patch1: object
     frame2: object
     patch2: object
+    sigma: float | None = None
 
 
 @dataclasses.dataclass
@@ -115,7 +120,7 @@ class ContactOptions:
     track_distance: float = 0.02     # m: nearer interior isolated couples are tracked
     reseek_floor: float = 1e-4       # m: smallest relative travel between two re-seeks
     conditioning_min: float = 1e-6   # |det J| / prod(row norms) below which J is singular
-    v_slip: float = 1e-9             # m/s: a couple slower than this may stick
+    v_slip: float = 1e-6             # m/s: a couple slower than this may stick
     zeno_speed: float = 1e-3         # m/s: the Zeno guard (see the module docstring)
     impact_gap_tol: float = 1e-8     # m: couples this near join an impact
     impact_rtol: float = 1e-10
@@ -233,7 +238,8 @@ class RigidContactSystem(LeafSystem):
             self.DeclareVectorOutputPort(f"couple_{p.name}", COUPLE_OUTPUT_SIZE,
                                          lambda c, o, i=i: self._out_couple(c, o, i))
             for i, p in enumerate(pairs)]
-        self.DeclareInitializationUnrestrictedUpdateEvent(self._on_event)
+        self.DeclareInitializationUnrestrictedUpdateEvent(
+            lambda context, state: self._on_event(context, None, state))
         ev = UnrestrictedUpdateEvent(self._on_event)
         down = WitnessFunctionDirection.kPositiveThenNonPositive
         self._w = []
@@ -251,6 +257,8 @@ class RigidContactSystem(LeafSystem):
                                                  lambda c, i=i: self._w_slip(c, i), ev),
                 "cone": self.MakeWitnessFunction(f"{p.name} friction cone", down,
                                                  lambda c, i=i: self._w_cone(c, i), ev),
+                "apex": self.MakeWitnessFunction(f"{p.name} gap rate", down,
+                                                 lambda c, i=i: self._w_apex(c, i), ev),
                 "clear": self.MakeWitnessFunction(f"{p.name} clearance", down,
                                                   lambda c, i=i: self._w_clear(c, i), ev)})
         self._memo = None
@@ -468,7 +476,7 @@ class RigidContactSystem(LeafSystem):
                 continue
             out += [w["end"], w["cond"]]
             if st.status == TRACKED:
-                out.append(w["gap"])
+                out += [w["gap"], w["apex"]]
             else:
                 out += [w["lambda"], w["cone"] if st.stick else w["slip"]]
         return out
@@ -479,6 +487,13 @@ class RigidContactSystem(LeafSystem):
     def _w_gap(self, context, i):
         ev = self._cache.Eval(context).evals[i]
         return 1.0 if ev is None else ev.gap
+
+    def _w_apex(self, context, i):
+        """The gap rate: a couple that separates and closes again within one integration step
+        would leave the gap's sign unchanged at the step's ends (a missed impact); stopping at
+        the gap's maximum (the apex) prevents that."""
+        ev = self._cache.Eval(context).evals[i]
+        return 1.0 if ev is None else ev.vn
 
     def _w_end(self, context, i):
         ev = self._cache.Eval(context).evals[i]
@@ -533,7 +548,10 @@ class RigidContactSystem(LeafSystem):
         a, b = self._fidx[i]
         st = modes.pairs[i]
         P1, P2 = posed(p.patch1, *poses[a]), posed(p.patch2, *poses[b])
-        c = seek_couple(P1, P2)
+        try:
+            c = seek_couple(P1, P2)
+        except SeekingError as e:
+            raise SeekingError(str(e), time=time, couples=[p.name]) from None
         R1, p1 = poses[a]
         R2, p2 = poses[b]
         st.ref_X21 = (R2.T @ R1, R2.T @ (p1 - p2))
@@ -541,12 +559,21 @@ class RigidContactSystem(LeafSystem):
         _, Fu = closest_point_conditions(p.kind, p.patch1, poses[a], p.patch2, poses[b], c.u)
         isolated = _conditioning(Fu) > 10 * self.options.conditioning_min
         sl = slice(self._uoff[i], self._uoff[i + 1])
-        u[sl] = c.u
+        uc = c.u
+        if c.interior and isolated:
+            # Finish on the contact form (the distance's gradient is flat at a tangent touch).
+            for _ in range(20):
+                F, Fu = closest_point_conditions(p.kind, p.patch1, poses[a], p.patch2,
+                                                 poses[b], uc)
+                uc = uc - np.linalg.solve(Fu, F)
+                if np.abs(F).max() <= 1e-15 * (1.0 + np.abs(Fu).max()):
+                    break
+        u[sl] = uc
         opt = self.options
         if c.interior and isolated and c.distance < opt.track_distance and not was_contact:
             ev = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
-                                 poses[b], (np.zeros(3),) * 2, c.u, 1.0, project=False)
-            st.sigma = 1.0 if ev.gap >= 0.0 else -1.0
+                                 poses[b], (np.zeros(3),) * 2, uc, 1.0, project=False)
+            st.sigma = p.sigma if p.sigma is not None else (1.0 if ev.gap >= 0.0 else -1.0)
             st.status = TRACKED
         else:
             st.status = FAR
@@ -613,6 +640,19 @@ class RigidContactSystem(LeafSystem):
                     evs[i] = self._couple(i, u[sl], ps, tw, st.sigma, t)
             return ps
 
+        # Modes the contact couples are leaving (their witness crossed zero): lambda_n, or
+        # the sticking force reaching the static cone.
+        leaving = {}
+        if any(st.status == CONTACT for st in modes.pairs):
+            E = self._cache.Eval(context)
+            for i, st in enumerate(modes.pairs):
+                if st.status == CONTACT:
+                    out = []
+                    if E.lam_n[i] <= 0.0:
+                        out += [STICK, SLIDE]
+                    if st.stick and self._mu_s * E.lam_n[i] - math.hypot(*E.lam_t[i]) <= 0.0:
+                        out.append(STICK)
+                    leaving[i] = tuple(out)
         poses = evaluate_all(v)
         M = self.plant.CalcMassMatrix(ctx)
         hit = [i for i, st in enumerate(modes.pairs) if st.status == TRACKED
@@ -628,32 +668,41 @@ class RigidContactSystem(LeafSystem):
             Wn = np.column_stack([r.Wn for r in rows])
             Wt = np.column_stack([r.Wt for r in rows])
             law = self.law
-            res = solve_lzb(M, Wn, v, law.stiffness, law.eta, law.restitution, Wt=Wt,
+            approach = float(-min(r.vn for r in rows))
+            # Zeno guard: an impact slower than zeno_speed is plastic.
+            e = law.restitution if approach >= opt.zeno_speed else 0.0
+            res = solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt,
                             mu=law.mu, mu_s=self._mu_s, law=law.impact_law,
                             rtol=opt.impact_rtol)
             v = res.v_plus
             modes.impacts.append({"t": t, "couples": [self.pairs[i].name for i in S],
+                                  "restitution": e,
                                   "normal_impulse": res.normal_impulse.tolist(),
                                   "tangential_impulse": res.tangential_impulse.tolist(),
                                   "energy_lost": res.kinetic_energy_minus
                                   - res.kinetic_energy_plus})
             modes.impact_loss += res.kinetic_energy_minus - res.kinetic_energy_plus
-            vn = Wn.T @ v
-            slow = [i for i, s in zip(S, vn) if s < opt.zeno_speed]
-            v = self._plastic(M, v, [rows[S.index(i)].Wn for i in slow], modes)
-            candidates.update(slow)
+            vn_plus = Wn.T @ v
+            for i, vn in zip(S, vn_plus):
+                if vn <= 1e-6 * approach:
+                    candidates.add(i)      # closed at the end of the impact: in contact
+                else:
+                    st = modes.pairs[i]    # separating
+                    st.status, st.stick, st.slide_dir = TRACKED, False, None
             poses = evaluate_all(v)
         # Contact set: couples in contact, couples just held by the Zeno guard and resting
         # couples (closed and not moving apart).
         for i, st in enumerate(modes.pairs):
-            if st.status == CONTACT or (st.status == TRACKED and evs[i].gap <= opt.impact_gap_tol
-                                         and abs(evs[i].vn) <= opt.zeno_speed):
+            if (st.status == CONTACT and not (hit and i not in candidates)) or (
+                    st.status == TRACKED and evs[i].gap <= opt.impact_gap_tol
+                    and abs(evs[i].vn) <= opt.v_slip):
                 candidates.add(i)
         cand = sorted(candidates)
         self._set_scratch(q, v)
         rows = [self._row(i, evs[i], poses, ctx) for i in cand]
         M, Minv, a0, _, _ = self._free_acceleration(context, ctx, v)
-        sol = select_modes(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t)
+        sol = select_modes(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
+                           avoid=[() if hit else leaving.get(i, ()) for i in cand])
         for j, i in enumerate(cand):
             st = modes.pairs[i]
             m = sol.modes[j]
@@ -663,20 +712,4 @@ class RigidContactSystem(LeafSystem):
                 st.status = CONTACT
                 st.stick = m == STICK
                 st.slide_dir = None if st.stick else np.asarray(sol.dirs[j], dtype=float)
-        return v
-
-    def _plastic(self, M, v, Wns, modes):
-        """Removes the remaining approach/separation speed of the couples held by the Zeno
-        guard (a plastic impulse; only non-negative impulses are kept)."""
-        active = list(range(len(Wns)))
-        Minv = np.linalg.inv(M)
-        ke0 = 0.5 * v @ M @ v
-        while active:
-            W = np.column_stack([Wns[k] for k in active])
-            P = -np.linalg.solve(W.T @ Minv @ W, W.T @ v)
-            if np.all(P >= 0.0):
-                v = v + Minv @ W @ P
-                break
-            active = [k for k, pk in zip(active, P) if pk >= 0.0]
-        modes.impact_loss += ke0 - 0.5 * v @ M @ v
         return v

@@ -99,11 +99,17 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None) -> C
         A = D.T @ MinvC
         b = -(np.asarray(rhs) + D.T @ a0)
         cond = np.linalg.cond(A)
-        if not np.isfinite(cond) or cond > 1e12:
-            raise SingularContactError(
-                f"contact constraint matrix singular (cond = {cond:.3e}) for modes {modes}",
-                time=time, couples=[r.name for r, m in zip(rows, modes) if m != DETACH])
-        lam = np.linalg.solve(A, b)
+        if np.isfinite(cond) and cond <= 1e10:
+            lam = np.linalg.solve(A, b)
+        else:
+            # Redundant constraints (a body resting on several sticking couples is statically
+            # indeterminate): the minimum-norm forces, if the equations are consistent.
+            lam = np.linalg.lstsq(A, b, rcond=1e-10)[0] if np.all(np.isfinite(A)) else None
+            if lam is None or np.linalg.norm(A @ lam - b) > 1e-8 * (1.0 + np.linalg.norm(b)):
+                raise SingularContactError(
+                    f"contact constraint equations singular and inconsistent (cond = "
+                    f"{cond:.3e}) for modes {modes}", time=time,
+                    couples=[r.name for r, m in zip(rows, modes) if m != DETACH])
         vdot = a0 + MinvC @ lam
         Cf = C @ lam
     k = len(rows)
@@ -159,11 +165,13 @@ def _consistent(sol, rows, starting, tol_f, tol_a):
     return True
 
 
-def select_modes(Minv, a0, rows, *, v_slip=1e-9, omega=0.0, time=None, rtol=1e-9):
+def select_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9, avoid=None):
     """One consistent choice of modes for the contact set (see the module docstring).
 
     A couple whose sliding speed exceeds ``v_slip`` slides in its direction of motion (or
-    detaches); one at rest may stick, start to slide or detach."""
+    detaches); one at rest may stick, start to slide or detach. ``avoid[i]`` lists modes that
+    couple i is leaving (its witness has just crossed zero): at a tie, where a mode it leaves
+    is still consistent within round-off, another consistent mode is taken."""
     k = len(rows)
     names = [r.name for r in rows]
     if k == 0:
@@ -216,7 +224,9 @@ def select_modes(Minv, a0, rows, *, v_slip=1e-9, omega=0.0, time=None, rtol=1e-9
                             "model with this friction has no solution)", time=time,
                             couples=names)
     # Preference among consistent choices: more sticking couples, then more couples in contact.
-    found.sort(key=lambda s: (-s.modes.count(STICK), s.modes.count(DETACH)))
+    avoid = avoid or [()] * k
+    found.sort(key=lambda s: (sum(m in a for m, a in zip(s.modes, avoid)),
+                              -s.modes.count(STICK), s.modes.count(DETACH)))
     best = found[0]
     v_scale = 1.0 + float(np.abs(best.vdot).max())
     for other in found[1:]:

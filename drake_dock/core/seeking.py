@@ -127,6 +127,10 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50):
         # valley, e.g. two coaxial arcs of equal radius where every couple is minimal).
         if np.linalg.norm(gfree) <= 1e-13 * np.linalg.norm(J) * (np.linalg.norm(d) + 1e-300):
             break
+        # Touching to round-off (a tangent touch makes |d|^2 flat to fourth order, where
+        # Newton on it only converges linearly): the contact form finishes it (couple.py).
+        if np.linalg.norm(gfree) <= 1e-15 * np.linalg.norm(J) ** 2:
+            break
         if free.any():
             # Newton step with the Hessian's eigenvalues made positive (|lambda|, floored), so
             # that the step always descends; unchanged near a strict minimum.

@@ -1,0 +1,141 @@
+"""Small scenes with known answers for the generic contact core (tests, benchmarks, tutorial):
+a disk rolling or sliding on an inclined plane (C-S), a rod lying across a fixed edge (C-C),
+Painleve's rod with a rounded tip (C-S), and a three-footed stool (three C-S couples).
+
+Each builder returns a `SmallScene`: a finalized continuous MultibodyPlant (not in a diagram;
+the contact system owns the state), the `RigidContactSystem`, and a function that writes an
+initial state into the system's context. Gravity is tilted instead of the plane (an incline of
+angle theta is a horizontal plane under g = 9.81 (sin theta, 0, -cos theta)).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from pydrake.math import RigidTransform, RotationMatrix
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import FixedOffsetFrame, RotationalInertia, SpatialInertia
+
+from drake_dock.contact_system import ContactLaw, ContactOptions, ContactPair, RigidContactSystem
+from drake_dock.core.patches import Circle, PlaneRect, Segment
+
+G = 9.81
+
+
+@dataclasses.dataclass
+class SmallScene:
+    plant: object
+    system: RigidContactSystem
+    body: object
+    params: dict
+
+    def set_state(self, context, X_WB, V_WB):
+        """Pose (R, p) and world spatial velocity (w, v) of the scene's moving body."""
+        ctx = self.plant.CreateDefaultContext()
+        R, p = X_WB
+        self.plant.SetFreeBodyPose(ctx, self.body, RigidTransform(RotationMatrix(R), p))
+        from pydrake.multibody.math import SpatialVelocity
+        self.plant.SetFreeBodySpatialVelocity(ctx, self.body, SpatialVelocity(*V_WB))
+        self.system.set_from_plant_context(context, ctx)
+
+
+def _plant(gravity):
+    plant = MultibodyPlant(0.0)
+    plant.mutable_gravity_field().set_gravity_vector(np.asarray(gravity, dtype=float))
+    return plant
+
+
+def rot_x(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restitution=0.0,
+                    options=ContactOptions()) -> SmallScene:
+    """A uniform disk (rim = a Circle, C-S) on a plane inclined by theta, its axle along y;
+    down-slope is +x. I_axle = m r^2 / 2."""
+    plant = _plant(G * np.array([math.sin(theta), 0.0, -math.cos(theta)]))
+    I_ax = 0.5 * mass * radius ** 2
+    I_d = 0.25 * mass * radius ** 2
+    body = plant.AddRigidBody("disk", SpatialInertia.MakeFromCentralInertia(
+        mass, np.zeros(3), RotationalInertia(I_d, I_ax, I_d)))
+    rim = plant.AddFrame(FixedOffsetFrame("rim", body.body_frame(),
+                                          RigidTransform(RotationMatrix(rot_x(math.pi / 2)),
+                                                         np.zeros(3))))
+    plant.Finalize()
+    plane = PlaneRect([-50.0, -5.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], size=(100.0, 10.0))
+    pair = ContactPair("rim_plane", "CS", rim, Circle(radius), plant.world_frame(), plane,
+                       sigma=1.0)
+    system = RigidContactSystem(plant, [pair], ContactLaw(mu=mu, mu_s=mu_s,
+                                                          restitution=restitution), options)
+    return SmallScene(plant, system, body, dict(theta=theta, mass=mass, radius=radius,
+                                                I_axle=I_ax, mu=mu,
+                                                mu_s=mu if mu_s is None else mu_s))
+
+
+def rod_on_edge(*, mass=1.5, half_length=0.4, mu=0.2, mu_s=None, wrench=True,
+                options=ContactOptions()) -> SmallScene:
+    """A rod (a Segment along its body y axis, through its mass centre) lying across a fixed
+    edge along the world x axis at height 0 (C-C); gravity -z. Input ``rod_wrench`` pushes or
+    pulls it."""
+    plant = _plant([0.0, 0.0, -G])
+    body = plant.AddRigidBody("rod", SpatialInertia.MakeFromCentralInertia(
+        mass, np.zeros(3), RotationalInertia(mass * half_length ** 2 / 3, 1e-3 * mass,
+                                             mass * half_length ** 2 / 3)))
+    plant.Finalize()
+    L = half_length
+    rod = Segment([0.0, -L, 0.0], [0.0, L, 0.0])
+    edge = Segment([-20.0, 0.0, 0.0], [20.0, 0.0, 0.0])
+    # n = sigma t1 x t2 must point up, from the edge (body 2) to the rod (body 1): y x x = -z.
+    pair = ContactPair("rod_edge", "CC", body.body_frame(), rod, plant.world_frame(), edge,
+                       sigma=-1.0)
+    system = RigidContactSystem(plant, [pair], ContactLaw(mu=mu, mu_s=mu_s), options,
+                                wrench_bodies=("rod",) if wrench else ())
+    return SmallScene(plant, system, body, dict(mass=mass, mu=mu,
+                                                mu_s=mu if mu_s is None else mu_s))
+
+
+def painleve_rod(theta, *, mass=1.0, half_length=0.5, tip_radius=0.01, mu=1.0,
+                 options=ContactOptions()) -> SmallScene:
+    """A uniform rod (axis = body x, mass centre at the origin, I = m l^2 / 3) with a rounded
+    tip: a Circle of radius ``tip_radius`` centred at (-l, 0, 0) in the body x-z plane, on the
+    horizontal plane z = 0 (C-S); gravity -z. The rod makes the angle theta with the plane."""
+    plant = _plant([0.0, 0.0, -G])
+    l = half_length
+    I = mass * l ** 2 / 3
+    body = plant.AddRigidBody("rod", SpatialInertia.MakeFromCentralInertia(
+        mass, np.zeros(3), RotationalInertia(1e-4 * I, I, I)))
+    tip = plant.AddFrame(FixedOffsetFrame("tip", body.body_frame(), RigidTransform(
+        RotationMatrix(rot_x(math.pi / 2)), np.array([-l, 0.0, 0.0]))))
+    plant.Finalize()
+    plane = PlaneRect([-50.0, -5.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], size=(100.0, 10.0))
+    pair = ContactPair("tip_plane", "CS", tip, Circle(tip_radius), plant.world_frame(), plane,
+                       sigma=1.0)
+    system = RigidContactSystem(plant, [pair], ContactLaw(mu=mu), options)
+    return SmallScene(plant, system, body, dict(theta=theta, mass=mass, l=l, I=I,
+                                                rho=tip_radius, mu=mu))
+
+
+def stool(*, mass=3.0, foot_radius=0.05, leg_radius=0.25, mu=0.3, restitution=0.0,
+          options=ContactOptions()) -> SmallScene:
+    """A body with three rounded feet (Circles in vertical planes, 120 deg apart) on the plane
+    z = 0: three C-S couples."""
+    plant = _plant([0.0, 0.0, -G])
+    body = plant.AddRigidBody("stool", SpatialInertia.MakeFromCentralInertia(
+        mass, np.zeros(3), RotationalInertia(0.1, 0.1, 0.15)))
+    plane = PlaneRect([-50.0, -50.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], size=(100., 100.))
+    pairs = []
+    for k in range(3):
+        a = 2 * math.pi * k / 3
+        R = np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0],
+                      [0, 0, 1]]) @ rot_x(math.pi / 2)
+        foot = plant.AddFrame(FixedOffsetFrame(f"foot{k}", body.body_frame(), RigidTransform(
+            RotationMatrix(R), np.array([leg_radius * math.cos(a), leg_radius * math.sin(a),
+                                         -0.2]))))
+        pairs.append(ContactPair(f"foot{k}_plane", "CS", foot, Circle(foot_radius),
+                                 plant.world_frame(), plane, sigma=1.0))
+    plant.Finalize()
+    system = RigidContactSystem(plant, pairs, ContactLaw(mu=mu, restitution=restitution),
+                                options)
+    return SmallScene(plant, system, body, dict(mass=mass, foot_radius=foot_radius))
