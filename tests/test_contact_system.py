@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from pydrake.systems.analysis import Simulator
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
@@ -22,8 +22,9 @@ def start(system, set_state, accuracy=ACC, diagram=None):
     root = sim.get_mutable_context()
     ctx = system.GetMyMutableContextFromRoot(root) if diagram else root
     set_state(ctx)
+    ApplySimulatorConfig(SimulatorConfig(integration_scheme="runge_kutta5",
+                                         accuracy=accuracy, max_step_size=0.05), sim)
     root.SetAccuracy(accuracy)
-    sim.get_mutable_integrator().set_target_accuracy(accuracy)
     sim.Initialize()
     return sim, root, ctx
 

@@ -147,11 +147,18 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
     if project and residual > 0.0 and cond > 1e-14:
         du = -np.linalg.solve(Fu, F)
         u = u + du
-        r1, T1, K1 = _geometry(patch1, R1, u[:n1])
-        r2, T2, K2 = _geometry(patch2, R2, u[n1:])
-        d = (r1 + p1o) - (r2 + p2o)
-        F, Fu = _residual(kind, d, T1, K1, T2, K2)
-        cond = _conditioning(Fu)
+        if np.abs(du).max() > 1e-9 * (1.0 + np.abs(u).max()):
+            r1, T1, K1 = _geometry(patch1, R1, u[:n1])
+            r2, T2, K2 = _geometry(patch2, R2, u[n1:])
+            d = (r1 + p1o) - (r2 + p2o)
+            F, Fu = _residual(kind, d, T1, K1, T2, K2)
+            cond = _conditioning(Fu)
+        else:
+            # A round-off-sized correction: the points move along their tangents (exact to
+            # O(du^2) < 1e-18); tangents and curvatures are kept.
+            r1 = r1 + T1 @ du[:n1]
+            r2 = r2 + T2 @ du[n1:]
+            d = (r1 + p1o) - (r2 + p2o)
     P1, P2 = r1 + p1o, r2 + p2o
     vm1 = v1 + cross(w1, r1)
     vm2 = v2 + cross(w2, r2)
