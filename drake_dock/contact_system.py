@@ -35,6 +35,8 @@ Documented transitions:
   (a hand-over within the pair, only when not in contact), otherwise it becomes far (a contact
   that runs off a patch end ends there). A contact couple whose Jacobian turns singular raises
   `SingularCoupleError`.
+- a pair sought while its patches cross each other (only possible past a patch end, where the
+  model has no contact) stays far and is sought again after half ``track_distance`` of travel.
 """
 from __future__ import annotations
 
@@ -51,7 +53,7 @@ from pydrake.systems.framework import (EventStatus, LeafSystem, UnrestrictedUpda
 
 from drake_dock.core.constraints import (DETACH, SLIDE, STICK, ContactRow, select_modes,
                                          solve_given_modes)
-from drake_dock.core.couple import closest_point_conditions, evaluate_couple, _conditioning
+from drake_dock.core.couple import closest_point_conditions, evaluate_couple
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.core.tracking import SingularCoupleError
@@ -556,8 +558,9 @@ class RigidContactSystem(LeafSystem):
         R2, p2 = poses[b]
         st.ref_X21 = (R2.T @ R1, R2.T @ (p1 - p2))
         st.distance = c.distance
-        _, Fu = closest_point_conditions(p.kind, p.patch1, poses[a], p.patch2, poses[b], c.u)
-        isolated = _conditioning(Fu) > 10 * self.options.conditioning_min
+        _, _, cond = closest_point_conditions(p.kind, p.patch1, poses[a], p.patch2, poses[b],
+                                              c.u, conditioning=True)
+        isolated = cond > 10 * self.options.conditioning_min
         sl = slice(self._uoff[i], self._uoff[i + 1])
         uc = c.u
         if c.interior and isolated:
@@ -570,14 +573,25 @@ class RigidContactSystem(LeafSystem):
                     break
         u[sl] = uc
         opt = self.options
-        if c.interior and isolated and c.distance < opt.track_distance and not was_contact:
+        crossing = False
+        if c.interior and isolated:
             ev = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
                                  poses[b], (np.zeros(3),) * 2, uc, 1.0, project=False)
-            st.sigma = p.sigma if p.sigma is not None else (1.0 if ev.gap >= 0.0 else -1.0)
+            sigma = p.sigma if p.sigma is not None else (1.0 if ev.gap >= 0.0 else -1.0)
+            # The patches cross each other (the contact-form couple is not the closest one,
+            # or lies on the wrong side of a declared normal): past a patch end, where the
+            # model has no contact. Such a pair is not made potential.
+            crossing = (abs(ev.gap) > c.distance + opt.impact_gap_tol
+                        or sigma * ev.gap < -opt.impact_gap_tol)
+        if c.interior and isolated and not crossing and c.distance < opt.track_distance \
+                and not was_contact:
+            st.sigma = sigma
             st.status = TRACKED
         else:
             st.status = FAR
-            if c.distance >= opt.track_distance:
+            if crossing:
+                st.clearance = 0.5 * opt.track_distance
+            elif c.distance >= opt.track_distance:
                 st.clearance = max(c.distance - 0.5 * opt.track_distance, 0.5 * c.distance,
                                    opt.reseek_floor)
             else:

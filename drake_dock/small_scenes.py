@@ -52,9 +52,9 @@ def rot_x(a):
 
 
 def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restitution=0.0,
-                    options=ContactOptions()) -> SmallScene:
+                    plane_end=50.0, options=ContactOptions()) -> SmallScene:
     """A uniform disk (rim = a Circle, C-S) on a plane inclined by theta, its axle along y;
-    down-slope is +x. I_axle = m r^2 / 2."""
+    down-slope is +x; the plane patch ends at x = ``plane_end``. I_axle = m r^2 / 2."""
     plant = _plant(G * np.array([math.sin(theta), 0.0, -math.cos(theta)]))
     I_ax = 0.5 * mass * radius ** 2
     I_d = 0.25 * mass * radius ** 2
@@ -64,7 +64,8 @@ def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restituti
                                           RigidTransform(RotationMatrix(rot_x(math.pi / 2)),
                                                          np.zeros(3))))
     plant.Finalize()
-    plane = PlaneRect([-50.0, -5.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], size=(100.0, 10.0))
+    plane = PlaneRect([-50.0, -5.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
+                      size=(50.0 + plane_end, 10.0))
     pair = ContactPair("rim_plane", "CS", rim, Circle(radius), plant.world_frame(), plane,
                        sigma=1.0)
     system = RigidContactSystem(plant, [pair], ContactLaw(mu=mu, mu_s=mu_s,

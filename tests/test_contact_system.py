@@ -24,7 +24,9 @@ def start(system, set_state, accuracy=ACC, diagram=None):
     set_state(ctx)
     ApplySimulatorConfig(SimulatorConfig(integration_scheme="runge_kutta5",
                                          accuracy=accuracy, max_step_size=0.05), sim)
-    root.SetAccuracy(accuracy)
+    # The context's accuracy sets Drake's witness isolation window (1e-2 of it, in seconds);
+    # the integrator keeps its own target accuracy.
+    root.SetAccuracy(max(accuracy, 1e-8))
     sim.Initialize()
     return sim, root, ctx
 
@@ -294,3 +296,57 @@ def test_stool_three_couples_share_weight():
     sim.AdvanceTo(0.2)
     lam = [couple(sc.system, ctx, f"foot{k}_plane")["lambda_n"] for k in range(3)]
     np.testing.assert_allclose(lam, sc.params["mass"] * G / 3, rtol=1e-8)
+
+
+# --------------------------------------------------------------------------- transitions
+def test_contact_ends_at_the_patch_end():
+    """A disk sliding (frictionless) off the end of the plane patch at x = 0.5: at the domain
+    end the contact is released (documented rule) and the disk falls freely."""
+    sc = disk_on_incline(0.0, mu=0.0, plane_end=0.5)
+    r = sc.params["radius"]
+    sim, root, ctx = start(sc.system, lambda c: sc.set_state(
+        c, (np.eye(3), np.array([0, 0, r])), (np.zeros(3), np.array([1.0, 0, 0]))))
+    sim.AdvanceTo(0.45)
+    assert couple(sc.system, ctx, "rim_plane")["status"] == 2
+    sim.AdvanceTo(0.6)
+    assert couple(sc.system, ctx, "rim_plane")["status"] == 0
+    x = ctx.get_continuous_state_vector().CopyToVector()
+    np.testing.assert_allclose(x[6], r - G * 0.1 ** 2 / 2, rtol=1e-7)
+    np.testing.assert_allclose(sc.system.eval(ctx).vdot[3:], [0, 0, -G], atol=1e-12)
+
+
+def test_parallel_edges_in_contact_raise_typed_error():
+    """The rod spins on the fixed edge until the two edges turn parallel: Eq. (39) fails for a
+    couple in contact, which is reported with the couple and the time: the conditioning
+    sin^2 / (1 + cos^2) of the angle phi between the edges reaches conditioning_min."""
+    from drake_dock.core.tracking import SingularCoupleError
+    sc = rod_on_edge(mu=0.0, wrench=False)
+    sim, root, ctx = start(sc.system, lambda c: sc.set_state(
+        c, (np.eye(3), np.zeros(3)), (np.array([0, 0, 2.0]), np.zeros(3))))
+    with pytest.raises(SingularCoupleError, match="rod_edge") as err:
+        sim.AdvanceTo(1.0)
+    c = ContactOptions().conditioning_min
+    phi = math.asin(math.sqrt(2 * c / (1 + c)))      # sin^2/(1 + cos^2) = c
+    np.testing.assert_allclose(err.value.time, (math.pi / 2 - phi) / 2.0, rtol=1e-6)
+
+
+def test_drift_is_measured_and_bounded():
+    """The projection of the integrated couple stays at round-off along a rolling run, and a
+    drift above drift_tol raises DriftError naming the couple."""
+    from drake_dock.contact_system import DriftError
+    sc = disk_on_incline(THETA, mu=0.3)
+    r = sc.params["radius"]
+    sim, root, ctx = start(sc.system, lambda c: sc.set_state(
+        c, (np.eye(3), np.array([0, 0, r])), (np.zeros(3), np.array([V0, 0, 0]))))
+    worst = 0.0
+    for t in np.linspace(0.05, 0.5, 10):
+        sim.AdvanceTo(t)
+        ev = sc.system.eval(ctx).evals[0]
+        worst = max(worst, float(np.abs(ev.drift).max()), ev.residual)
+    assert worst < 1e-9
+    sc2 = disk_on_incline(THETA, mu=0.3, options=ContactOptions(drift_tol=1e-300,
+                                                                drift_feedback=0.0))
+    with pytest.raises(DriftError, match="rim_plane"):
+        sim2, _, _ = start(sc2.system, lambda c: sc2.set_state(
+            c, (np.eye(3), np.array([0, 0, r])), (np.zeros(3), np.array([V0, 0, 0]))))
+        sim2.AdvanceTo(0.2)

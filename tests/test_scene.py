@@ -123,3 +123,46 @@ def test_seeking_matches_scipy_on_random_poses(geom, seed):
         cp = seek_couple(P1, P2)
         _, _, d = _scipy_closest(P1, P2, _starts(P1, P2, n=12, seed=seed) + [cp.u])
         assert cp.distance <= np.linalg.norm(d) + 1e-9, pair.name
+
+
+def _brute_force_closest(P1, P2, n_curve=400, n_surf=90):
+    """Dense sampling of both patches, then scipy L-BFGS from the 4 best samples: a reference
+    that shares nothing with the hierarchical grid + Newton."""
+    def samples(P):
+        return P.patch.grid(n_curve if P.patch.dim == 1 else n_surf)
+    U1, U2 = samples(P1), samples(P2)
+    X1, X2 = P1.position(U1), P2.position(U2)
+    d2 = (X1 ** 2).sum(1)[:, None] + (X2 ** 2).sum(1)[None, :] - 2 * X1 @ X2.T
+    best = np.argsort(d2, axis=None)[:4]
+    starts = [np.concatenate([U1[i], U2[j]]) for i, j in zip(*np.unravel_index(best, d2.shape))]
+    return _scipy_closest(P1, P2, starts)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_seeking_matches_brute_force_on_random_poses(geom, seed):
+    """Random relative poses, all 12 pairs: the distance of the couple found equals that of
+    dense sampling + scipy to 1e-9 m."""
+    rng = np.random.default_rng(100 + seed)
+    R = rot_z(rng.uniform(-0.6, 0.6)) @ rot_x(math.pi + rng.uniform(-0.3, 0.3))
+    p = np.array([*rng.uniform(-0.15, 0.15, 2), rng.uniform(0.05, 0.3)])
+    poses = {"target_apds": (np.eye(3), np.zeros(3)), "chaser_apds": (R, p)}
+    for pair in apds_pairs(geom):
+        P1, P2 = posed(pair.patch1, *poses[pair.body1]), posed(pair.patch2, *poses[pair.body2])
+        cp = seek_couple(P1, P2)
+        _, _, d = _brute_force_closest(P1, P2)
+        assert abs(cp.distance - np.linalg.norm(d)) < 1e-9, pair.name
+
+
+@pytest.mark.parametrize("kind", ["CS", "CC"])
+def test_seeking_matches_brute_force_points(geom, kind):
+    """Interior couples at a positive gap (the scenes of test_couple, random instants): the
+    same couple as dense sampling + scipy, both points within 1e-9 m."""
+    from test_couple import cc_scene, cs_scene
+    _, c1, m1, c2, m2 = cs_scene(geom) if kind == "CS" else cc_scene(geom)
+    for t in np.random.default_rng(7).uniform(0.0, 1.0, 4):
+        P1, P2 = posed(c1, *m1.pose(t)), posed(c2, *m2.pose(t))
+        cp = seek_couple(P1, P2)
+        assert cp.interior and cp.distance > 1e-3
+        u1, u2, _ = _brute_force_closest(P1, P2)
+        np.testing.assert_allclose(cp.p1, P1.position(u1), atol=1e-9)
+        np.testing.assert_allclose(cp.p2, P2.position(u2), atol=1e-9)

@@ -111,19 +111,31 @@ def _residual(kind, d, T1, K1, T2, K2):
     return F, Fu
 
 
-def _conditioning(Fu):
+def _conditioning(Fu, T1=None, T2=None):
+    """|det| / product of row norms of Fu with its columns scaled by the parameters' tangent
+    lengths (invariant to how the patches are parametrised): sin^2 / (1 + cos^2) of the angle
+    between the curves of a C-C couple at contact; 0 when Eq. (39) fails."""
+    if T1 is not None:
+        scale = np.sqrt(np.concatenate([np.einsum("xi,xi->i", T1, T1),
+                                        np.einsum("xi,xi->i", T2, T2)]))
+        if np.all(scale > 0):
+            Fu = Fu / scale
     rows = np.sqrt(np.einsum("ij,ij->i", Fu, Fu))
     den = float(np.prod(rows))
     return abs(float(np.linalg.det(Fu))) / den if den > 0 else 0.0
 
 
-def closest_point_conditions(kind, patch1, X1, patch2, X2, u):
-    """F(u) and Fu of the contact form for body poses X_i = (R_i, p_i)."""
+def closest_point_conditions(kind, patch1, X1, patch2, X2, u, *, conditioning=False):
+    """F(u) and Fu of the contact form for body poses X_i = (R_i, p_i) (and the conditioning
+    of Fu if asked)."""
     n1 = patch1.dim
     r1, T1, K1 = _geometry(patch1, X1[0], u[:n1])
     r2, T2, K2 = _geometry(patch2, X2[0], u[n1:])
     d = (r1 + X1[1]) - (r2 + X2[1])
-    return _residual(kind, d, T1, K1, T2, K2)
+    F, Fu = _residual(kind, d, T1, K1, T2, K2)
+    if conditioning:
+        return F, Fu, _conditioning(Fu, T1, T2)
+    return F, Fu
 
 
 def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
@@ -142,7 +154,7 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
     d = (r1 + p1o) - (r2 + p2o)
     F, Fu = _residual(kind, d, T1, K1, T2, K2)
     residual = float(np.sqrt(F @ F))
-    cond = _conditioning(Fu)
+    cond = _conditioning(Fu, T1, T2)
     du = np.zeros_like(u)
     if project and residual > 0.0 and cond > 1e-14:
         du = -np.linalg.solve(Fu, F)
@@ -152,7 +164,7 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
             r2, T2, K2 = _geometry(patch2, R2, u[n1:])
             d = (r1 + p1o) - (r2 + p2o)
             F, Fu = _residual(kind, d, T1, K1, T2, K2)
-            cond = _conditioning(Fu)
+            cond = _conditioning(Fu, T1, T2)
         else:
             # A round-off-sized correction: the points move along their tangents (exact to
             # O(du^2) < 1e-18); tangents and curvatures are kept.

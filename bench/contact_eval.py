@@ -1,0 +1,104 @@
+"""Per-evaluation cost of the rigid contact system with three active couples (a three-footed
+stool resting on a plane: three C-S couples sticking), side by side with the plant's own
+derivative evaluation, and the split of one evaluation into its parts. Prints microseconds and
+ratios measured in this run.
+
+    python bench/contact_eval.py [--repeats N]
+"""
+import argparse
+import time
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+
+from drake_dock.contact_system import STICK
+from drake_dock.core.constraints import solve_given_modes
+from drake_dock.small_scenes import stool
+
+
+def per_call(fn, repeats):
+    fn()
+    best = np.inf
+    for _ in range(5):
+        t0 = time.perf_counter()
+        for _ in range(repeats):
+            fn()
+        best = min(best, (time.perf_counter() - t0) / repeats)
+    return best * 1e6
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--repeats", type=int, default=300)
+    a = ap.parse_args()
+    sc = stool()
+    sys_ = sc.system
+    sim = Simulator(sys_)
+    ctx = sim.get_mutable_context()
+    sc.set_state(ctx, (np.eye(3), np.array([0, 0, 0.2 + sc.params["foot_radius"]])),
+                 (np.zeros(3), np.zeros(3)))
+    ctx.SetAccuracy(1e-8)
+    sim.Initialize()
+    sim.AdvanceTo(0.01)
+    modes = sys_.get_modes(ctx)
+    active = [p.status for p in modes.pairs]
+    assert active == [2, 2, 2], active
+    k = [0]
+
+    def full():
+        k[0] += 1
+        ctx.SetTime(0.01 + 1e-12 * k[0])     # invalidates the cache entry
+        sys_.EvalTimeDerivatives(ctx)
+
+    pctx = sc.plant.CreateDefaultContext()
+    sc.plant.SetPositions(pctx, ctx.get_continuous_state_vector().CopyToVector()[:7])
+    pd = sc.plant.AllocateTimeDerivatives()
+
+    def plant_only():
+        sc.plant.CalcTimeDerivatives(pctx, pd)
+
+    E = sys_.eval(ctx)
+    x = ctx.get_continuous_state_vector().CopyToVector()
+    q, v = x[:sys_.nq], x[sys_.nq:sys_.nq + sys_.nv]
+    sctx = sys_._set_scratch(q, v)
+    poses, twists = sys_._frame_kinematics(sctx)
+    u = x[sys_.nq + sys_.nv:sys_.ie]
+
+    def couples():
+        for i, st in enumerate(modes.pairs):
+            sys_._couple(i, u[sys_._uoff[i]:sys_._uoff[i + 1]], poses, twists, st.sigma, 0.0)
+
+    evs = [sys_._couple(i, u[sys_._uoff[i]:sys_._uoff[i + 1]], poses, twists, st.sigma, 0.0)
+           for i, st in enumerate(modes.pairs)]
+
+    def rows():
+        return [sys_._row(i, evs[i], poses, sctx) for i in range(3)]
+
+    R = rows()
+
+    def free():
+        sys_._free_acceleration(ctx, sctx, v)
+
+    M, Minv, a0, _, _ = sys_._free_acceleration(ctx, sctx, v)
+
+    def solve():
+        solve_given_modes(Minv, a0, R, [STICK] * 3, [None] * 3, omega=20.0)
+
+    n = a.repeats
+    t_full = per_call(full, n)
+    t_plant = per_call(plant_only, n)
+    parts = {"frame kinematics": per_call(lambda: sys_._frame_kinematics(sctx), n),
+             "3 couples (Eq. 47, frame, bias)": per_call(couples, n),
+             "3 rows W (Drake Jacobians)": per_call(rows, n),
+             "M, free acceleration": per_call(free, n),
+             "constraint solve (9 rows)": per_call(solve, n)}
+    print(f"contact system, 3 sticking couples: {t_full:8.1f} us per derivative evaluation")
+    print(f"plant alone (free flight):          {t_plant:8.1f} us")
+    print(f"ratio contact system / plant:       {t_full / t_plant:8.1f}x")
+    for name, t in parts.items():
+        print(f"  {name:34s} {t:8.1f} us  ({t / t_full:5.1%})")
+    print(f"evaluations so far: {sys_.evaluations}; final lambda_n: {E.lam_n.round(6)}")
+
+
+if __name__ == "__main__":
+    main()
