@@ -118,7 +118,7 @@ class ContactLaw:
 class ContactOptions:
     baumgarte: float = 20.0          # omega (rad/s) of the constraint stabilisation
     drift_feedback: float = 50.0     # 1/s, feedback of the couple projection into u*
-    drift_tol: float = 1e-6          # largest projection step, relative to the domain span
+    drift_tol: float = 1e-3          # largest projection step, relative to the domain span
     track_distance: float = 0.02     # m: nearer interior isolated couples are tracked
     reseek_floor: float = 1e-4       # m: smallest relative travel between two re-seeks
     conditioning_min: float = 1e-6   # |det J| / prod(row norms) below which J is singular

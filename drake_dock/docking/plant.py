@@ -21,7 +21,7 @@ import numpy as np
 from pydrake.common import MemoryFile
 from pydrake.geometry import Cylinder, InMemoryMesh, Mesh
 from pydrake.math import RigidTransform, RotationMatrix
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
 from pydrake.multibody.tree import (FixedOffsetFrame, LinearBushingRollPitchYaw,
                                     RotationalInertia, SpatialInertia)
 from pydrake.multibody.math import SpatialVelocity
@@ -57,8 +57,23 @@ def _apds_visual(geometry):
 
 
 def add_docking_plant(builder, scenario) -> DockingPlant:
-    """Adds the plant and SceneGraph of the scenario's three bodies to ``builder``; finalized."""
+    """Adds the plant and SceneGraph of the scenario's three bodies to ``builder``; finalized.
+    (Drake integrates this plant itself: free flight with the Stewart element, no contact.)"""
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
+    return _populate(plant, scene_graph, scenario)
+
+
+def make_docking_plant(scenario, scene_graph=None) -> DockingPlant:
+    """The same plant, not added to a diagram: the rigid contact system owns its state and uses
+    it as a calculator. With ``scene_graph`` (in the caller's builder) its visual geometry is
+    registered there, for MultibodyPositionToGeometryPose."""
+    plant = MultibodyPlant(0.0)
+    if scene_graph is not None:
+        plant.RegisterAsSourceForSceneGraph(scene_graph)
+    return _populate(plant, scene_graph, scenario)
+
+
+def _populate(plant, scene_graph, scenario) -> DockingPlant:
     plant.mutable_gravity_field().set_gravity_vector(np.zeros(3))
     b = scenario.bodies
     bodies = {name: plant.AddRigidBody(name, _spatial_inertia(getattr(b, name)))
