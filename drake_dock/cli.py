@@ -1,30 +1,83 @@
-"""``drake-dock``: a thin command line over `drake_dock.run.run`."""
+"""``drake-dock``: a thin command line over `drake_dock.run.run`.
+
+Exit codes: 0 success; 2 bad input (the message names the field, the value and the allowed
+range); 3 numerical failure (the message names the time and the couples). On failure no output
+directory is written, or the previous complete one is left untouched.
+"""
 from __future__ import annotations
 
 import argparse
 import sys
+import textwrap
 
-from drake_dock.errors import DrakeDockError
+from drake_dock.errors import DrakeDockError, InputError
 from drake_dock.scenario import PAPER_EXAMPLE
 
 
+class ProgressBar:
+    """A text progress bar on a stream (stderr): redrawn in place on a terminal, otherwise
+    printed at every tenth of the run."""
+
+    def __init__(self, stream=sys.stderr, width=40):
+        self.stream, self.width = stream, width
+        self.tty = hasattr(stream, "isatty") and stream.isatty()
+        self.last = -1
+
+    def __call__(self, t, t_end):
+        frac = min(max(t / t_end, 0.0), 1.0)
+        step = int(frac * (100 if self.tty else 10))
+        if step == self.last:
+            return
+        self.last = step
+        n = int(frac * self.width)
+        line = f"[{'#' * n}{'.' * (self.width - n)}] {frac:4.0%}  t = {t:.4f} s"
+        if self.tty:
+            self.stream.write("\r" + line)
+        else:
+            self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def close(self):
+        if self.tty and self.last >= 0:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def _error(kind, e) -> str:
+    return textwrap.fill(f"drake-dock: {kind}: {e}", width=100)
+
+
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="drake-dock", description=__doc__)
+    parser = argparse.ArgumentParser(prog="drake-dock", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
-    run_p = sub.add_parser("run", help="set up and run a docking scenario")
+    run_p = sub.add_parser("run", help="simulate a docking scenario and write its outputs")
     run_p.add_argument("scenario", nargs="?", default=str(PAPER_EXAMPLE),
                        help="scenario YAML (default: the paper's example)")
     run_p.add_argument("--out", required=True, help="output directory (replaced atomically)")
+    run_p.add_argument("--duration", type=float, default=None,
+                       help="override simulation.duration (s)")
+    run_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
     # Imported here so that `--help` stays fast.
     from drake_dock.run import format_summary, run
     from drake_dock.scenario import load_scenario
+    bar = None if args.no_progress else ProgressBar()
     try:
         scenario = load_scenario(args.scenario)
-        summary = run(scenario, args.out)
-    except DrakeDockError as e:
-        print(f"drake-dock: error: {e}", file=sys.stderr)
+        if args.duration is not None:
+            if not args.duration > 0:
+                raise InputError("--duration", args.duration, "> 0 s")
+            scenario.simulation.duration = args.duration
+        summary = run(scenario, args.out, progress=bar)
+    except InputError as e:
+        print(_error("bad input", e), file=sys.stderr)
         return 2
+    except DrakeDockError as e:
+        print(_error("numerical failure", e), file=sys.stderr)
+        return 3
+    finally:
+        if bar is not None:
+            bar.close()
     print(format_summary(summary))
     print(f"wrote {args.out}")
     return 0

@@ -166,6 +166,7 @@ class _Eval:
     external_power: float
     bound: np.ndarray      # relative travel bound per far pair
     poses: list
+    extra_power: np.ndarray
 
 
 def _bounding_sphere(patch, n=41):
@@ -179,10 +180,13 @@ class RigidContactSystem(LeafSystem):
     """See the module docstring. ``plant`` is a finalized continuous-time MultibodyPlant (it
     need not be part of the diagram); ``pairs`` the declared `ContactPair`s; ``wrench_bodies``
     names bodies that get an input port ``<body>_wrench`` (6-vector [torque, force], world
-    frame, applied at the body origin)."""
+    frame, applied at the body origin). ``extra_powers`` is a sequence of (name, f) with
+    f(q, v) -> power (W); each is integrated as continuous state and appended to the
+    ``energy`` output (e.g. the power of a damper, for an energy ledger)."""
 
     def __init__(self, plant, pairs, law: ContactLaw = ContactLaw(),
-                 options: ContactOptions = ContactOptions(), wrench_bodies=()):
+                 options: ContactOptions = ContactOptions(), wrench_bodies=(),
+                 extra_powers=()):
         super().__init__()
         if not plant.is_finalized():
             raise ValueError("plant: must be finalized")
@@ -218,9 +222,13 @@ class RigidContactSystem(LeafSystem):
                        next(i for i, g in enumerate(frames) if g is p.frame2)) for p in pairs]
         self._mu_s = law.mu if law.mu_s is None else law.mu_s
 
-        # State: x = [q, v, u*, friction loss, work of plant forces, work of inputs].
+        # State: x = [q, v, u*, friction loss, work of plant forces, work of inputs,
+        #             integrals of extra_powers].
         self.ie = self.nq + self.nv + self.nu
-        self.DeclareContinuousState(self.ie + 3)
+        self.extra_powers = list(extra_powers)
+        self.energy_names = ["kinetic", "potential", "friction_loss", "plant_work",
+                             "input_work", "impact_loss"] + [n for n, _ in self.extra_powers]
+        self.DeclareContinuousState(self.ie + 3 + len(self.extra_powers))
         self._mode_index = self.DeclareAbstractState(AbstractValue.Make(
             ContactModes([PairState() for _ in pairs])))
         self._gf_port = self.DeclareVectorInputPort("generalized_force", self.nv)
@@ -235,7 +243,7 @@ class RigidContactSystem(LeafSystem):
         self.DeclareVectorOutputPort("state", self.nq + self.nv, self._out_state,
                                      prerequisites_of_calc={self.xc_ticket()})
         self.DeclareVectorOutputPort("generalized_contact_force", self.nv, self._out_gf)
-        self.DeclareVectorOutputPort("energy", 6, self._out_energy)
+        self.DeclareVectorOutputPort("energy", len(self.energy_names), self._out_energy)
         self._couple_ports = [
             self.DeclareVectorOutputPort(f"couple_{p.name}", COUPLE_OUTPUT_SIZE,
                                          lambda c, o, i=i: self._out_couple(c, o, i))
@@ -398,7 +406,8 @@ class RigidContactSystem(LeafSystem):
         qdot = self.plant.MapVelocityToQDot(ctx, v)
         value.set_value(_Eval(q, v, qdot, sol.vdot, udot, evals, lam_n, lam_t,
                               sol.generalized_force, sol.power_lost_to_friction(rows), p_plant,
-                              p_in, bound, poses))
+                              p_in, bound, poses,
+                              np.array([f(q, v) for _, f in self.extra_powers], dtype=float)))
 
     def _travel_bound(self, i, poses, st):
         if st.ref_X21 is None:
@@ -418,7 +427,8 @@ class RigidContactSystem(LeafSystem):
     def DoCalcTimeDerivatives(self, context, derivatives):
         E = self._cache.Eval(context)
         derivatives.get_mutable_vector().SetFromVector(np.concatenate(
-            [E.qdot, E.vdot, E.udot, [E.friction_power, E.applied_power, E.external_power]]))
+            [E.qdot, E.vdot, E.udot, [E.friction_power, E.applied_power, E.external_power],
+             E.extra_power]))
 
     # ------------------------------------------------------------------ outputs
     def _out_state(self, context, out):
@@ -429,7 +439,8 @@ class RigidContactSystem(LeafSystem):
 
     def _out_energy(self, context, out):
         """[kinetic, potential (plant elements that implement it), friction loss, work of the
-        plant's forces, work of the inputs, impact loss]."""
+        plant's forces, work of the inputs, impact loss, integrals of extra_powers]
+        (`energy_names`)."""
         E = self._cache.Eval(context)
         x = context.get_continuous_state_vector().CopyToVector()
         ctx = self._set_scratch(E.q, E.v)
@@ -438,8 +449,9 @@ class RigidContactSystem(LeafSystem):
             pe = self.plant.CalcPotentialEnergy(ctx)
         except RuntimeError:
             pe = math.nan
-        out.SetFromVector([ke, pe, x[self.ie], x[self.ie + 1], x[self.ie + 2],
-                           self.get_modes(context).impact_loss])
+        out.SetFromVector(np.concatenate([[ke, pe, x[self.ie], x[self.ie + 1], x[self.ie + 2],
+                                           self.get_modes(context).impact_loss],
+                                          x[self.ie + 3:]]))
 
     def _out_couple(self, context, out, i):
         E = self._cache.Eval(context)
@@ -635,10 +647,17 @@ class RigidContactSystem(LeafSystem):
             if margin.min() <= 0.0 or ev.conditioning <= opt.conditioning_min:
                 self._seek(i, poses, modes, u, t, st.status == CONTACT)
         # 2. Impacts and 3. modes.
+        n_impacts = len(modes.impacts)
         v = self._impacts_and_modes(context, t, modes, ctx, poses, twists, q, v, u)
         x_new = x.copy()
         x_new[self.nq:self.nq + self.nv] = v
         x_new[self.nq + self.nv:self.ie] = u
+        if len(modes.impacts) > n_impacts:
+            # The states just before and just after the impact (for loggers: a step-end
+            # sample is the state before; this event's result is not seen by any step end).
+            modes.impacts[-1].update(x_minus=x.copy(), x_plus=x_new.copy(),
+                                     pairs_plus=copy.deepcopy(modes.pairs),
+                                     impact_loss_plus=modes.impact_loss)
         return x_new, modes
 
     def _impacts_and_modes(self, context, t, modes, ctx, poses, twists, q, v, u):
@@ -685,9 +704,16 @@ class RigidContactSystem(LeafSystem):
             approach = float(-min(r.vn for r in rows))
             # Zeno guard: an impact slower than zeno_speed is plastic.
             e = law.restitution if approach >= opt.zeno_speed else 0.0
-            res = solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt,
-                            mu=law.mu, mu_s=self._mu_s, law=law.impact_law,
-                            rtol=opt.impact_rtol)
+            try:
+                res = solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt,
+                                mu=law.mu, mu_s=self._mu_s, law=law.impact_law,
+                                rtol=opt.impact_rtol)
+            except NumericalError as err:
+                import os
+                if os.environ.get("DRAKE_DOCK_DUMP_LZB"):
+                    np.savez(os.environ["DRAKE_DOCK_DUMP_LZB"], M=M, Wn=Wn, Wt=Wt, v=v, e=e)
+                raise NumericalError(f"{err} (approach speed {approach:.3e} m/s)", time=t,
+                                     couples=[self.pairs[i].name for i in S]) from None
             v = res.v_plus
             modes.impacts.append({"t": t, "couples": [self.pairs[i].name for i in S],
                                   "restitution": e,

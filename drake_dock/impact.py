@@ -358,7 +358,9 @@ class _Problem:
         s = self.s
         x = y[self.ix]
         un = y[self.iun]
-        return bool(np.all(x <= 0) and np.all(self.phase == _COMP) and np.all(un >= 0))
+        # u is scaled by the largest approach speed: a residual approach of 1e-12 of it (the
+        # round-off left when symmetric couples end together) does not start a new impact.
+        return bool(np.all(x <= 0) and np.all(self.phase == _COMP) and np.all(un >= -1e-12))
 
 
 def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, mu_s=None,
@@ -440,8 +442,7 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     atol = rtol * 1e-2
     h = None
     while not prob.finished(y):
-        solver = DOP853(prob.rhs, t, y, np.inf, rtol=rtol, atol=atol,
-                        first_step=h)
+        solver = DOP853(prob.rhs, t, y, np.inf, rtol=rtol, atol=atol, first_step=h)
         g_old = prob.event_values(y)
         restart = False
         while not restart:
@@ -460,6 +461,7 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
             if crossed.any():
                 dense = solver.dense_output()
                 t_first, which = np.inf, None
+                roots = []
                 for kind, j in zip(*np.nonzero(crossed)):
                     f = lambda tt, kind=kind, j=j: prob.event_values(dense(tt))[kind, j]  # noqa
                     ta = solver.t_old
@@ -468,6 +470,7 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
                     else:
                         tr = brentq(f, ta, solver.t, xtol=1e-15 * max(1.0, abs(solver.t)),
                                     rtol=4 * np.finfo(float).eps)
+                    roots.append((tr, kind, j))
                     if tr < t_first:
                         t_first, which = tr, (kind, j)
                 # Move to the zero's far side (within round-off) so the crossing is consumed.
@@ -475,6 +478,14 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
                 t = t_first
                 impulse = y[prob.iP][:s].sum() * m_s * v_s
                 prob.apply_event(y, which[0], which[1], events, impulse)
+                # Simultaneous events (symmetric couples): every other crossing at the same
+                # instant is applied now; after the restart its function starts at <= 0 and
+                # its crossing would never be seen again.
+                same = 1e-12 * max(1.0, abs(t_first))
+                for tr, kind, j in sorted(roots):
+                    if (kind, j) != which and tr <= t_first + same \
+                            and prob.event_values(y)[kind, j] <= 0:
+                        prob.apply_event(y, kind, j, events, impulse)
                 restart = True
             else:
                 y = y_new

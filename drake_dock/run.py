@@ -1,76 +1,71 @@
-"""Builds and runs a docking scenario; writes the outputs atomically into a directory."""
+"""Runs a docking scenario end to end and writes its outputs atomically into a directory:
+``timeseries.npz``, ``summary.json``, the figures (PNG) and ``replay.html``.
+
+A failed run (bad input, numerical failure) leaves no directory, or the previous complete one
+untouched (`drake_dock.output.atomic_directory`).
+"""
 from __future__ import annotations
 
+import io
 import json
+from types import SimpleNamespace
 
-from pydrake.geometry import Meshcat, MeshcatParams, MeshcatVisualizer
-from pydrake.systems.framework import DiagramBuilder
+import numpy as np
 
-from drake_dock.docking.plant import add_docking_plant, set_initial_state
-from drake_dock.docking.scene import apds_pairs, initial_state, pair_couples
-from drake_dock.figures import initial_configuration_figure
+from drake_dock.docking.replay import replay_html
+from drake_dock.docking.results import momenta, momentum_reference_point, summary, timeseries
+from drake_dock.docking.simulate import simulate
+from drake_dock.figures import initial_configuration_figure, run_figures
 from drake_dock.output import atomic_directory
 
 
-def make_meshcat() -> Meshcat:
-    params = MeshcatParams()
-    params.host = "localhost"
-    params.port = 0  # any free port; nothing is served beyond this machine
-    return Meshcat(params)
+def _npz_bytes(arrays: dict) -> bytes:
+    """np.savez into memory. Zip entries carry a fixed timestamp, so equal arrays give equal
+    bytes (bitwise reproducible files)."""
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()
 
 
-def build_diagram(scenario, meshcat=None):
-    """The Drake Diagram of the scenario: plant, SceneGraph and, when given, Meshcat.
-    Returns (diagram, docking_plant)."""
-    builder = DiagramBuilder()
-    dp = add_docking_plant(builder, scenario)
-    if meshcat is not None:
-        MeshcatVisualizer.AddToBuilder(builder, dp.scene_graph, meshcat)
-    return builder.Build(), dp
-
-
-def run(scenario, out_dir) -> dict:
-    """Sets up the scenario and writes into ``out_dir`` (atomically): ``summary.json``,
-    ``initial_configuration.png`` and ``replay.html`` (meshcat, self-contained). The hybrid
-    contact simulation is not part of this version: the state is the initial condition."""
-    state = initial_state(scenario)
-    meshcat = make_meshcat()
-    diagram, dp = build_diagram(scenario, meshcat)
-    context = diagram.CreateDefaultContext()
-    plant_context = dp.plant.GetMyContextFromRoot(context)
-    set_initial_state(dp, plant_context, state)
-    poses = {}
-    for name, frame in dp.apds_frames.items():
-        X = frame.CalcPoseInWorld(plant_context)
-        poses[name] = (X.rotation().matrix(), X.translation())
-    pairs = [p for p in apds_pairs(scenario.geometry) if p.name in state.closing_pairs]
-    couples = dict(zip((p.name for p in pairs), pair_couples(pairs, poses)))
-    summary = {
-        "scenario_initial": {"target_yaw_deg": scenario.initial.target_yaw_deg,
-                             "approach_travel_m": scenario.initial.approach_travel,
-                             "chaser_speed_mps": scenario.initial.chaser_speed},
-        "first_contact_ring_distance_m": state.d_contact,
-        "initial_ring_distance_m": state.d0,
-        "closing_pairs": state.closing_pairs,
-        "closing_gaps_m": {n: c.distance for n, c in couples.items()},
-        "simulated": False,
-    }
+def run(scenario, out_dir, *, progress=None, state=None) -> dict:
+    """Simulates ``scenario`` and writes everything into ``out_dir``; returns the summary."""
+    result = simulate(scenario, progress=progress, state=state)
+    ts = timeseries(result)
+    summ = summary(result, ts)
+    params = [getattr(scenario.bodies, n) for n in ts["body_names"]]
+    P, L, _, _ = momenta(ts, [p.mass for p in params], [p.inertia for p in params],
+                         momentum_reference_point(scenario, ts))
+    nq = result.dd.dp.plant.num_positions()
+    html = replay_html(scenario, ts["t"], np.asarray(result.record.x)[:, :nq])
     with atomic_directory(out_dir) as tmp:
-        initial_configuration_figure(scenario.geometry, poses, couples,
+        (tmp / "timeseries.npz").write_bytes(_npz_bytes(ts))
+        summ["figures"] = run_figures(ts, summ, (P, L), tmp,
+                                      focus_couples=result.initial.closing_pairs)
+        poses = {n: (ts["R_WA"][0, j], ts["p_WA"][0, j])
+                 for j, n in enumerate(ts["apds_names"].tolist())}
+        cn = ts["couple_names"].tolist()
+        first = {c: SimpleNamespace(p1=ts["p1_W"][0, cn.index(c)], p2=ts["p2_W"][0, cn.index(c)])
+                 for c in result.initial.closing_pairs}
+        initial_configuration_figure(scenario.geometry, poses, first,
                                      tmp / "initial_configuration.png")
-        meshcat.StartRecording()
-        diagram.ForcedPublish(context)
-        meshcat.StopRecording()
-        meshcat.PublishRecording()
-        (tmp / "replay.html").write_text(meshcat.StaticHtml())
-        (tmp / "summary.json").write_text(json.dumps(summary, indent=2, allow_nan=False) + "\n")
-    return summary
+        (tmp / "replay.html").write_text(html)
+        (tmp / "summary.json").write_text(json.dumps(summ, indent=2, allow_nan=False) + "\n")
+    return summ
 
 
-def format_summary(summary) -> str:
-    lines = [f"first contact at ring-face distance {summary['first_contact_ring_distance_m']:.6f} m"
-             f" (start {summary['initial_ring_distance_m']:.6f} m)",
-             "pairs closing first: " + ", ".join(summary["closing_pairs"])]
-    return "\n".join(lines)
-
-
+def format_summary(s) -> str:
+    cap = (f"captured at t = {s['capture_time_s']:.6f} s" if s["captured"]
+           else f"not captured by t = {s['end_time_s']:.6f} s")
+    led = s["energy_ledger"]
+    md = s["momentum_drift_relative"]
+    return "\n".join([
+        f"{cap} (axial ring-centre distance <= {s['capture_distance_m']} m)",
+        f"impacts: {s['number_of_impacts']}; peak contact force {s['peak_contact_force_N']:.6g} N;"
+        f" largest impulse {s['largest_impulse_Ns']:.6g} N s",
+        f"momentum drift (relative): linear {md['linear']:.2e}, angular {md['angular']:.2e}",
+        f"energy: initial {led['initial_total_J']:.6g} J; dissipated by the damper "
+        f"{led['dissipated_damper_J']:.6g} J, friction {led['dissipated_friction_J']:.6g} J, "
+        f"impacts {led['dissipated_impacts_J']:.6g} J; ledger closure "
+        f"{led['closure_error_relative']:.2e}",
+        f"wall time {s['wall_time_s']:.2f} s for {s['end_time_s']:.4f} s simulated "
+        f"({s['derivative_evaluations']} derivative evaluations)"])

@@ -22,7 +22,8 @@ PAPER_EXAMPLE = MODELS_DIR / "paper_example.yaml"
 @dataclasses.dataclass
 class RigidBodyParams:
     """Mass (kg) and principal moments of inertia about the body's x, y, z axes (kg m^2),
-    about the mass centre (Table 1; its repeated 'I11' headings read as I_x, I_y, I_z)."""
+    about the mass centre (Table 1; its repeated 'I11' headings read as I_x, I_y, I_z). The
+    defaults are the paper's example read as axisymmetric about z (README, "Reading Table 1")."""
 
     mass: float = 1.0
     inertia: list[float] = dataclasses.field(default_factory=lambda: [1.0, 1.0, 1.0])
@@ -31,11 +32,11 @@ class RigidBodyParams:
 @dataclasses.dataclass
 class Bodies:
     target: RigidBodyParams = dataclasses.field(
-        default_factory=lambda: RigidBodyParams(1000.0, [782.0, 774.0, 829.0]))
+        default_factory=lambda: RigidBodyParams(1000.0, [778.0, 778.0, 829.0]))
     target_apds: RigidBodyParams = dataclasses.field(
         default_factory=lambda: RigidBodyParams(150.0, [68.0, 68.0, 68.0]))
     chaser: RigidBodyParams = dataclasses.field(
-        default_factory=lambda: RigidBodyParams(7600.0, [40211.0, 6402.0, 40242.0]))
+        default_factory=lambda: RigidBodyParams(7600.0, [40226.5, 40226.5, 6402.0]))
 
 
 @dataclasses.dataclass
@@ -77,7 +78,8 @@ class InitialCondition:
 @dataclasses.dataclass
 class SimulationParams:
     duration: float = 1.0
-    accuracy: float = 1e-6
+    accuracy: float = 1e-6           # integrator error control and witness isolation
+    max_step: float = 0.002          # largest integration step (s); also the sample spacing
     capture_distance: float = 0.005  # axial ring-centre distance ending the capture phase (m)
 
 
@@ -184,6 +186,7 @@ def validate(s: Scenario) -> Scenario:
     _positive("simulation.duration", s.simulation.duration)
     if not 0 < _finite("simulation.accuracy", s.simulation.accuracy) < 1:
         raise InputError("simulation.accuracy", s.simulation.accuracy, "0 < accuracy < 1")
+    _positive("simulation.max_step", s.simulation.max_step)
     _positive("simulation.capture_distance", s.simulation.capture_distance)
     return s
 

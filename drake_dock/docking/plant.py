@@ -22,7 +22,7 @@ from pydrake.common import MemoryFile
 from pydrake.geometry import Cylinder, InMemoryMesh, Mesh
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
-from pydrake.multibody.tree import (FixedOffsetFrame, LinearBushingRollPitchYaw,
+from pydrake.multibody.tree import (FixedOffsetFrame, LinearBushingRollPitchYaw, MultibodyForces,
                                     RotationalInertia, SpatialInertia)
 from pydrake.multibody.math import SpatialVelocity
 
@@ -140,3 +140,64 @@ def body_momenta(dp: DockingPlant, plant_context, about=np.zeros(3)):
         sP += np.linalg.norm(mv)
         sL += np.linalg.norm(np.cross(p, mv)) + np.linalg.norm(Iw)
     return P, L, sP, sL
+
+
+# The Stewart element's energy -------------------------------------------------------------
+def _half_rotation(R):
+    """R^(1/2): the rotation by half the angle about the same axis."""
+    from pydrake.common.eigen_geometry import AngleAxis
+    aa = RotationMatrix(R).ToAngleAxis()
+    return AngleAxis(0.5 * aa.angle(), aa.axis()).rotation()
+
+
+def stewart_deflection(dp: DockingPlant, plant_context):
+    """The Stewart element's deflection, the coordinates of LinearBushingRollPitchYaw: the
+    position of the APDS frame C from the anchor A expressed in the 'half-way' frame B
+    (R_AB = R_AC^(1/2)), and the roll-pitch-yaw angles of R_AC."""
+    from pydrake.math import RollPitchYaw
+    X_AC = dp.bodies["target_apds"].body_frame().CalcPose(plant_context, dp.bushing.frameA())
+    R = X_AC.rotation().matrix()
+    x = _half_rotation(R).T @ X_AC.translation()
+    return x, RollPitchYaw(X_AC.rotation()).vector()
+
+
+def stewart_potential(dp: DockingPlant, plant_context) -> float:
+    """Potential of the Stewart springs, 1/2 sum k x^2 + 1/2 sum k_t theta^2 (Eq. 9), with
+    Drake's bushing coordinates. Drake 1.51 does not implement the bushing's potential; the
+    rotational part of this one is exact for Drake's torque law, the translational part is
+    exact when R_AC turns about one axis of the bushing (the paper's example) and conservative
+    to second order in the tilt otherwise (measured in tests/test_plant.py)."""
+    x, rpy = stewart_deflection(dp, plant_context)
+    b = dp.bushing
+    k = np.asarray(b.force_stiffness_constants())
+    kt = np.asarray(b.torque_stiffness_constants())
+    return float(0.5 * k @ x**2 + 0.5 * kt @ rpy**2)
+
+
+class StewartDamperPower:
+    """f(q, v) -> the power of the Stewart element's dampers (<= 0): the bushing's generalized
+    forces with its stiffnesses set to zero, dotted with v. Uses its own plant context."""
+
+    def __init__(self, dp: DockingPlant):
+        self.plant = dp.plant
+        self.bushing = dp.bushing
+        self.ctx = dp.plant.CreateDefaultContext()
+        z = np.zeros(3)
+        self.bushing.SetForceStiffnessConstants(self.ctx, z)
+        self.bushing.SetTorqueStiffnessConstants(self.ctx, z)
+        self.forces = MultibodyForces(dp.plant)
+
+    def __call__(self, q, v) -> float:
+        self.plant.SetPositions(self.ctx, q)
+        self.plant.SetVelocities(self.ctx, v)
+        f = self.forces
+        f.SetZero()
+        self.plant.CalcForceElementsContribution(self.ctx, f)
+        return float(self.plant.CalcGeneralizedForces(self.ctx, f) @ v)
+
+
+def total_energy(dp: DockingPlant, plant_context) -> float:
+    """Kinetic energy plus the Stewart potential."""
+    v = dp.plant.GetVelocities(plant_context)
+    return float(0.5 * v @ dp.plant.CalcMassMatrix(plant_context) @ v
+                 + stewart_potential(dp, plant_context))

@@ -1,0 +1,144 @@
+"""The arrays of timeseries.npz and the numbers of summary.json, from a `RunResult`.
+
+Field layout (issue 5): t[N]; body_names[3]; p_WB[N,3,3], R_WB[N,3,3,3], v_WB[N,3,3], w_WB[N,3,3]
+(mass centres, world frame); apds_names[2]; p_WA[N,2,3], R_WA[N,2,3,3] (ring centre, e3 along the
+axis towards the other APDS); couple_names[12]; status[N,12] (0 far, 1 tracked, 2 sliding,
+3 sticking); active[N,12] (tracked or in contact); gap[N,12]; lambda_n[N,12]; lambda_t[N,12,2];
+u[N,12,3] (couple parameters, unused entries 0); p1_W[N,12,3], p2_W[N,12,3]; sample_kind[N]
+(0 step end, 1 just before an impact, 2 just after); ring_distance[N]; energy[N,k] with
+energy_names[k]; impact_t[M], impact_couples[M,12] (bool), impact_normal_impulse[M,12],
+impact_tangential_impulse[M,12,2], impact_restitution[M].
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from drake_dock.contact_system import COUPLE_SLICES
+from drake_dock.docking.plant import APDS_NAMES, BODY_NAMES, stewart_potential
+
+
+def timeseries(result) -> dict:
+    dd = result.dd
+    plant = dd.dp.plant
+    rec = result.record
+    pc = plant.CreateDefaultContext()
+    X = np.asarray(rec.x)
+    N = len(rec.t)
+    p_WB, R_WB = np.zeros((N, 3, 3)), np.zeros((N, 3, 3, 3))
+    v_WB, w_WB = np.zeros((N, 3, 3)), np.zeros((N, 3, 3))
+    p_WA, R_WA = np.zeros((N, 2, 3)), np.zeros((N, 2, 3, 3))
+    pe = np.zeros(N)
+    for k in range(N):
+        plant.SetPositionsAndVelocities(pc, X[k])
+        for j, name in enumerate(BODY_NAMES):
+            body = dd.dp.bodies[name]
+            Xb = plant.EvalBodyPoseInWorld(pc, body)
+            Vb = plant.EvalBodySpatialVelocityInWorld(pc, body)
+            p_WB[k, j], R_WB[k, j] = Xb.translation(), Xb.rotation().matrix()
+            v_WB[k, j], w_WB[k, j] = Vb.translational(), Vb.rotational()
+        for j, name in enumerate(APDS_NAMES):
+            Xa = dd.dp.apds_frames[name].CalcPoseInWorld(pc)
+            p_WA[k, j], R_WA[k, j] = Xa.translation(), Xa.rotation().matrix()
+        pe[k] = stewart_potential(dd.dp, pc)
+    C = np.asarray(rec.couples)
+    S = COUPLE_SLICES
+    status = C[:, :, S["status"]][..., 0].astype(np.int8)
+    names = [p.name for p in dd.contact.pairs]
+    M = len(result.impacts)
+    imp_c = np.zeros((M, len(names)), bool)
+    imp_n = np.zeros((M, len(names)))
+    imp_t = np.zeros((M, len(names), 2))
+    for m, imp in enumerate(result.impacts):
+        for c, pn, pt in zip(imp["couples"], imp["normal_impulse"], imp["tangential_impulse"]):
+            j = names.index(c)
+            imp_c[m, j], imp_n[m, j], imp_t[m, j] = True, pn, pt
+    energy = np.asarray(rec.energy)
+    energy_names = list(dd.contact.energy_names)
+    energy[:, energy_names.index("potential")] = pe   # the Stewart potential (see plant.py)
+    return dict(
+        t=np.asarray(rec.t), body_names=np.array(BODY_NAMES), p_WB=p_WB, R_WB=R_WB, v_WB=v_WB,
+        w_WB=w_WB, apds_names=np.array(APDS_NAMES), p_WA=p_WA, R_WA=R_WA,
+        couple_names=np.array(names), status=status, active=status >= 1,
+        gap=C[:, :, S["gap"]][..., 0], lambda_n=C[:, :, S["lambda_n"]][..., 0],
+        lambda_t=C[:, :, S["lambda_t"]], u=C[:, :, S["u"]], p1_W=C[:, :, S["p1"]],
+        p2_W=C[:, :, S["p2"]], sample_kind=np.asarray(rec.kind, dtype=np.int8),
+        ring_distance=np.asarray(rec.ring_distance), energy=energy,
+        energy_names=np.array(energy_names),
+        impact_t=np.array([imp["t"] for imp in result.impacts], dtype=float),
+        impact_couples=imp_c, impact_normal_impulse=imp_n, impact_tangential_impulse=imp_t,
+        impact_restitution=np.array([imp["restitution"] for imp in result.impacts], dtype=float))
+
+
+def momenta(ts: dict, masses, inertias, about):
+    """Total linear momentum P[N,3] and angular momentum L[N,3] about the fixed point
+    ``about``, from the sampled motion and the bodies' masses and principal inertias, and their
+    scales at t = 0: sum |m v| and sum |m (p - about) x v| + |I w|."""
+    m = np.asarray(masses, float)[None, :, None]
+    mv = m * ts["v_WB"]
+    r = ts["p_WB"] - np.asarray(about)[None, None, :]
+    R = ts["R_WB"]
+    Ib = np.stack([np.diag(I) for I in inertias])
+    Iw = np.einsum("nbij,bjk,nblk,nbl->nbi", R, Ib, R, ts["w_WB"])
+    P = mv.sum(1)
+    L = (np.cross(r, mv) + Iw).sum(1)
+    sP = np.linalg.norm(mv[0], axis=1).sum()
+    sL = (np.linalg.norm(np.cross(r[0], mv[0]), axis=1) + np.linalg.norm(Iw[0], axis=1)).sum()
+    return P, L, sP, sL
+
+
+def momentum_reference_point(scenario, ts) -> np.ndarray:
+    """A fixed world point off the docking axis: the target ring's rim at t = 0 (on the axis
+    the initial angular momentum and its scale are both zero)."""
+    return ts["p_WA"][0, 0] + scenario.geometry.R * ts["R_WA"][0, 0][:, 0]
+
+
+def energy_ledger(ts: dict) -> dict:
+    """kinetic + Stewart potential + dissipated (damper, friction, impacts) - input work must
+    equal the initial total; closure is the largest |residual| over the run relative to it."""
+    E = dict(zip(ts["energy_names"].tolist(), ts["energy"].T))
+    ke, pe = E["kinetic"], E["potential"]
+    damper = -E["stewart_damper_work"]
+    friction, impacts, inputs = E["friction_loss"], E["impact_loss"], E["input_work"]
+    total0 = ke[0] + pe[0]
+    residual = ke + pe + damper + friction + impacts - inputs - total0
+    return {"initial_total_J": float(total0), "kinetic_J": float(ke[-1]),
+            "stewart_potential_J": float(pe[-1]), "dissipated_damper_J": float(damper[-1]),
+            "dissipated_friction_J": float(friction[-1]),
+            "dissipated_impacts_J": float(impacts[-1]), "input_work_J": float(inputs[-1]),
+            "closure_error_relative": float(np.abs(residual).max() / abs(total0))}
+
+
+def summary(result, ts: dict) -> dict:
+    s = result.scenario
+    b = s.bodies
+    params = [getattr(b, n) for n in ts["body_names"]]
+    P, L, sP, sL = momenta(ts, [p.mass for p in params], [p.inertia for p in params],
+                           momentum_reference_point(s, ts))
+    lam = ts["lambda_n"]
+    k_peak = np.unravel_index(np.argmax(lam), lam.shape) if lam.size else None
+    peak = float(lam[k_peak]) if k_peak is not None else 0.0
+    imp = ts["impact_normal_impulse"]
+    return {
+        "captured": bool(result.captured),
+        "capture_time_s": result.capture_time,
+        "capture_distance_m": s.simulation.capture_distance,
+        "end_time_s": result.end_time,
+        "number_of_impacts": len(result.impacts),
+        "impact_times_s": ts["impact_t"].tolist(),
+        "largest_impulse_Ns": float(imp.max()) if imp.size else 0.0,
+        "peak_contact_force_N": peak,
+        "peak_contact_force_couple": (str(ts["couple_names"][k_peak[1]]) if peak > 0 else None),
+        "peak_contact_force_time_s": (float(ts["t"][k_peak[0]]) if peak > 0 else None),
+        "momentum_drift_relative": {
+            "linear": float(np.linalg.norm(P - P[0], axis=1).max() / sP),
+            "angular": float(np.linalg.norm(L - L[0], axis=1).max() / sL)},
+        "energy_ledger": energy_ledger(ts),
+        "first_contact_ring_distance_m": result.initial.d_contact,
+        "initial_ring_distance_m": result.initial.d0,
+        "first_closing_couples": list(result.initial.closing_pairs),
+        "samples": int(len(ts["t"])),
+        "mode_changes": result.mode_changes,
+        "derivative_evaluations": result.evaluations,
+        "wall_time_s": result.wall_time,
+    }
+

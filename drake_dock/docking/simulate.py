@@ -1,0 +1,153 @@
+"""Runs the docking Diagram with Drake's Simulator and records its outputs.
+
+The record holds one sample at the end of every integration step (so the step that ends at an
+impact's witness gives the state just before it) and, for each impact, one sample of the state
+just after it at the same time (from the impact log; no step end sees that state). The
+simulation ends at ``simulation.duration`` or at capture (`CaptureMonitor`'s witness).
+
+Integration: Runge-Kutta 5 with error control at ``simulation.accuracy``; the context's
+accuracy, which sets Drake's witness isolation window (1e-2 of it, in seconds), is the same
+value; the step is capped at ``simulation.max_step``.
+"""
+from __future__ import annotations
+
+import copy
+import dataclasses
+import time as _time
+
+import numpy as np
+from pydrake.systems.analysis import (ApplySimulatorConfig, Simulator, SimulatorConfig,
+                                      SimulatorStatus)
+
+from drake_dock.contact_system import COUPLE_OUTPUT_SIZE, ContactModes
+from drake_dock.docking.diagram import DockingDiagram, build_docking_diagram
+from drake_dock.docking.plant import set_initial_state
+from drake_dock.docking.scene import InitialState, initial_state
+
+STEP, PRE_IMPACT, POST_IMPACT = 0, 1, 2
+
+
+@dataclasses.dataclass
+class Record:
+    """Raw samples of a run (row k = sample k)."""
+
+    t: list = dataclasses.field(default_factory=list)
+    x: list = dataclasses.field(default_factory=list)        # plant [q, v]
+    couples: list = dataclasses.field(default_factory=list)  # (n_pairs, COUPLE_OUTPUT_SIZE)
+    energy: list = dataclasses.field(default_factory=list)
+    ring_distance: list = dataclasses.field(default_factory=list)
+    kind: list = dataclasses.field(default_factory=list)     # STEP / PRE_IMPACT / POST_IMPACT
+
+
+@dataclasses.dataclass
+class RunResult:
+    scenario: object
+    dd: DockingDiagram
+    initial: InitialState
+    record: Record
+    impacts: list              # the contact system's impact log
+    mode_changes: int
+    captured: bool
+    capture_time: float | None
+    end_time: float
+    wall_time: float           # seconds in Simulator.Initialize + AdvanceTo (build excluded)
+    evaluations: int
+
+
+def make_simulator(dd: DockingDiagram, scenario, state: InitialState) -> Simulator:
+    sim = Simulator(dd.diagram)
+    root = sim.get_mutable_context()
+    pc = dd.dp.plant.CreateDefaultContext()
+    set_initial_state(dd.dp, pc, state)
+    dd.contact.set_from_plant_context(dd.contact.GetMyMutableContextFromRoot(root), pc)
+    sp = scenario.simulation
+    ApplySimulatorConfig(SimulatorConfig(integration_scheme="runge_kutta5",
+                                         accuracy=sp.accuracy, max_step_size=sp.max_step,
+                                         use_error_control=True), sim)
+    root.SetAccuracy(sp.accuracy)
+    return sim
+
+
+class _Recorder:
+    def __init__(self, dd: DockingDiagram):
+        self.dd = dd
+        self.record = Record()
+        self.n_impacts = 0
+        self._scratch = dd.diagram.CreateDefaultContext()
+        d = dd.diagram
+        self._ports = [d.GetOutputPort(f"couple_{p.name}") for p in dd.contact.pairs]
+        self._state = d.GetOutputPort("state")
+        self._energy = d.GetOutputPort("energy")
+        self._ring = d.GetOutputPort("ring_distance")
+
+    def _append(self, context, kind):
+        r = self.record
+        r.t.append(context.get_time())
+        r.x.append(self._state.Eval(context).copy())
+        r.couples.append(np.stack([p.Eval(context) for p in self._ports]))
+        r.energy.append(self._energy.Eval(context).copy())
+        r.ring_distance.append(float(self._ring.Eval(context)[0]))
+        r.kind.append(kind)
+
+    def sample(self, root):
+        """A step end. Impacts logged since the last sample happened at that sample's time:
+        it becomes the pre-impact sample and the logged post-impact state follows it."""
+        contact = self.dd.contact
+        modes = contact.get_modes(contact.GetMyContextFromRoot(root))
+        new = modes.impacts[self.n_impacts:]
+        for imp in new:
+            if self.record.t and self.record.t[-1] == imp["t"]:
+                self.record.kind[-1] = PRE_IMPACT
+            self._post_impact(root, imp, modes)
+        self.n_impacts = len(modes.impacts)
+        if not self.record.t or root.get_time() > self.record.t[-1] or new:
+            self._append(root, STEP)
+
+    def _post_impact(self, root, imp, modes):
+        s = self._scratch
+        s.SetTimeStateAndParametersFrom(root)
+        s.SetTime(imp["t"])
+        contact = self.dd.contact
+        cc = contact.GetMyMutableContextFromRoot(s)
+        cc.SetContinuousState(imp["x_plus"])
+        after = ContactModes(copy.deepcopy(imp["pairs_plus"]), [], imp["impact_loss_plus"],
+                             modes.mode_changes)
+        cc.get_mutable_abstract_state(contact._mode_index).set_value(after)
+        self._append(s, POST_IMPACT)
+
+
+def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram | None = None,
+             progress=None, duration: float | None = None) -> RunResult:
+    """Builds (unless ``dd`` is given) and runs the scenario; ``progress(t, t_end)`` is called
+    after each step. Raises the contact system's typed errors (`NumericalError`)."""
+    state = state or initial_state(scenario)
+    dd = dd or build_docking_diagram(scenario)
+    sim = make_simulator(dd, scenario, state)
+    rec = _Recorder(dd)
+    t_end = scenario.simulation.duration if duration is None else duration
+
+    def monitor(root):
+        rec.sample(root)
+        if progress is not None:
+            progress(root.get_time(), t_end)
+        from pydrake.systems.framework import EventStatus
+        return EventStatus.Succeeded()
+
+    evals0 = dd.contact.evaluations
+    wall0 = _time.perf_counter()
+    sim.Initialize()
+    root = sim.get_context()
+    rec.sample(root)
+    sim.set_monitor(monitor)
+    status = sim.AdvanceTo(t_end)
+    wall = _time.perf_counter() - wall0
+    rec.sample(root)
+    captured = status.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition
+    modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
+    return RunResult(scenario, dd, state, rec.record, list(modes.impacts), modes.mode_changes,
+                     captured, root.get_time() if captured else None, root.get_time(), wall,
+                     dd.contact.evaluations - evals0)
+
+
+__all__ = ["simulate", "make_simulator", "RunResult", "Record", "STEP", "PRE_IMPACT",
+           "POST_IMPACT", "COUPLE_OUTPUT_SIZE"]
