@@ -59,7 +59,7 @@ class ContactParams:
 
     mu: float = 0.1
     mu_s: float = 0.1
-    restitution: float = 0.5
+    restitution: float = 0.1
     stiffness: float = 1.0e9
     eta: float = 1.5
 

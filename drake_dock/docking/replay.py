@@ -58,6 +58,11 @@ def replay_html(scenario, t, Q, *, fps=30.0, slow_motion=10.0, meshcat=None) -> 
     n = int(np.floor((t[-1] - t[0]) * slow_motion * fps)) + 1
     t_anim = np.arange(n) / fps
     Qf = interpolate_positions(t, np.asarray(Q), t[0] + t_anim / slow_motion, quats)
+    # Look at the two rings from the side, close enough to see the petals slide.
+    X = dp.plant.CreateDefaultContext()
+    dp.plant.SetPositions(X, Qf[0])
+    centre = 0.5 * sum(f.CalcPoseInWorld(X).translation() for f in dp.apds_frames.values())
+    meshcat.SetCameraPose(centre + np.array([1.3, -1.3, 0.5]), centre)
     meshcat.StartRecording(frames_per_second=fps)
     for ta, q in zip(t_anim, Qf):
         ctx.SetTime(float(ta))
