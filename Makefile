@@ -20,6 +20,8 @@ test: $(BIN)/.installed
 
 bench: $(BIN)/.installed
 	$(BIN)/python bench/lzb_chains.py
+	$(BIN)/python bench/contact_eval.py
+	$(BIN)/python bench/paper_example.py
 
 clean:
 	rm -rf $(VENV) out
