@@ -495,6 +495,29 @@ class RigidContactSystem(LeafSystem):
                 out += [w["lambda"], w["cone"] if st.stick else w["slip"]]
         return out
 
+    _W_FUNCS = {"gap": "_w_gap", "end": "_w_end", "cond": "_w_cond", "lambda": "_w_lambda",
+                "slip": "_w_slip", "cone": "_w_cone", "apex": "_w_apex", "clear": "_w_clear"}
+
+    def witness_values(self, context) -> dict:
+        """The values of the witnesses `DoGetWitnessFunctions` returns now, by description
+        (used by `drake_dock.stepping.WitnessApproach` to predict their zeros)."""
+        out = {}
+        for i, st in enumerate(self.get_modes(context).pairs):
+            if st.status == FAR:
+                kinds = ("clear",)
+            elif st.status == TRACKED:
+                kinds = ("end", "cond", "gap", "apex")
+            else:
+                kinds = ("end", "cond", "lambda", "cone" if st.stick else "slip")
+            for k in kinds:
+                out[f"{self.pairs[i].name} {k}"] = getattr(self, self._W_FUNCS[k])(context, i)
+        return out
+
+    def witness_epoch(self, context) -> int:
+        """Changes whenever an event has changed the state or the modes (a witness's history
+        from before it is not continued by its values after it)."""
+        return self.get_modes(context).mode_changes
+
     def _status(self, context, i):
         return self.get_modes(context).pairs[i]
 

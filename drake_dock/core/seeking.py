@@ -118,18 +118,28 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50):
         H = J.T @ J
         H[:n1, :n1] += S1
         H[n1:, n1:] -= S2
-        at_lo = (~periodic) & (u <= lower) & (g > 0)
-        at_hi = (~periodic) & (u >= upper) & (g < 0)
+        # Active set with a band (Bertsekas' projected Newton): a parameter within a band
+        # (at most 1e-3 of its span) from a bound that the gradient pushes outwards is moved onto the bound and
+        # held; approaching the bound by clipped, backtracked steps converges only linearly.
+        # The band shrinks with the coordinate's own Newton distance |g_i| / H_ii, so that it
+        # vanishes at a minimum that lies inside the domain close to a bound.
+        band = np.minimum(1e-3 * scale, np.abs(g) / np.maximum(np.abs(np.diag(H)), 1e-300))
+        at_lo = (~periodic) & (u <= lower + band) & (g > 0)
+        at_hi = (~periodic) & (u >= upper - band) & (g < 0)
         free = ~(at_lo | at_hi)
         step = np.zeros_like(u)
+        step[at_lo] = (lower - u)[at_lo]
+        step[at_hi] = (upper - u)[at_hi]
         gfree = np.where(free, g, 0.0)
         # Converged when the projected gradient vanishes to round-off (this also ends a flat
         # valley, e.g. two coaxial arcs of equal radius where every couple is minimal).
-        if np.linalg.norm(gfree) <= 1e-13 * np.linalg.norm(J) * (np.linalg.norm(d) + 1e-300):
+        on_bounds = np.all(step[~free] == 0.0)
+        if on_bounds and np.linalg.norm(gfree) <= 1e-13 * np.linalg.norm(J) * (
+                np.linalg.norm(d) + 1e-300):
             break
         # Touching to round-off (a tangent touch makes |d|^2 flat to fourth order, where
         # Newton on it only converges linearly): the contact form finishes it (couple.py).
-        if np.linalg.norm(gfree) <= 1e-15 * np.linalg.norm(J) ** 2:
+        if on_bounds and np.linalg.norm(gfree) <= 1e-15 * np.linalg.norm(J) ** 2:
             break
         if free.any():
             # Newton step with the Hessian's eigenvalues made positive (|lambda|, floored), so
@@ -137,6 +147,12 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50):
             w, V = np.linalg.eigh(H[np.ix_(free, free)])
             w = np.maximum(np.abs(w), 1e-10 * max(1.0, np.abs(w).max()))
             step[free] = -V @ ((V.T @ g[free]) / w)
+            # A nearly flat direction (a coaxial circle along a surface of revolution) gives a
+            # huge step that backtracking would shrink by many trials: cap it at a quarter
+            # of the domain instead.
+            reach = np.max(np.abs(step) / scale)
+            if reach > 0.25:
+                step *= 0.25 / reach
         # Backtracking on f keeps the iteration a descent method far from the minimum; a step
         # that cannot decrease f at all means f is at its minimum to round-off.
         f0 = 0.5 * d @ d
@@ -148,7 +164,7 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50):
             un = np.where(periodic, un, np.clip(un, lower, upper))
             dn, _ = parts(un)
             fn = 0.5 * dn @ dn
-            if fn <= f0 + 1e-4 * t * (g @ step):
+            if fn <= f0 + 1e-4 * (g @ (un - u)):
                 break
             t *= 0.25
             if t < 1e-12:

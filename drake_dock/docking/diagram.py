@@ -67,6 +67,9 @@ class CaptureMonitor(LeafSystem):
     def DoGetWitnessFunctions(self, context):
         return [self._witness]
 
+    def witness_values(self, context) -> dict:
+        return {"capture": self.distance(context) - self.capture_distance}
+
 
 def contact_law(scenario) -> ContactLaw:
     c = scenario.contact

@@ -73,7 +73,9 @@ def make_docking_plant(scenario, scene_graph=None) -> DockingPlant:
     return _populate(plant, scene_graph, scenario)
 
 
-def _populate(plant, scene_graph, scenario) -> DockingPlant:
+def _populate(plant, scene_graph, scenario, collision=None) -> DockingPlant:
+    """``collision(plant, bodies)``, if given, registers collision geometry before Finalize
+    (the compliant baseline, `compliant.py`)."""
     plant.mutable_gravity_field().set_gravity_vector(np.zeros(3))
     b = scenario.bodies
     bodies = {name: plant.AddRigidBody(name, _spatial_inertia(getattr(b, name)))
@@ -104,6 +106,8 @@ def _populate(plant, scene_graph, scenario) -> DockingPlant:
         plant.RegisterVisualGeometry(bodies["chaser"], RigidTransform([0, 0, off - 1.0 - 1.5]),
                                      Cylinder(1.2, 3.0), "chaser_hull",
                                      np.array(_COLORS["chaser"]))
+    if collision is not None:
+        collision(plant, bodies)
     plant.Finalize()
     return DockingPlant(plant, scene_graph, bodies,
                         {"target_apds": bodies["target_apds"].body_frame(),

@@ -23,6 +23,7 @@ from drake_dock.contact_system import COUPLE_OUTPUT_SIZE, ContactModes
 from drake_dock.docking.diagram import DockingDiagram, build_docking_diagram
 from drake_dock.docking.plant import set_initial_state
 from drake_dock.docking.scene import InitialState, initial_state
+from drake_dock.stepping import WitnessApproach
 
 STEP, PRE_IMPACT, POST_IMPACT = 0, 1, 2
 
@@ -117,17 +118,26 @@ class _Recorder:
 
 
 def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram | None = None,
-             progress=None, duration: float | None = None) -> RunResult:
+             progress=None, duration: float | None = None,
+             witness_approach: bool = True) -> RunResult:
     """Builds (unless ``dd`` is given) and runs the scenario; ``progress(t, t_end)`` is called
-    after each step. Raises the contact system's typed errors (`NumericalError`)."""
+    after each step. Raises the contact system's typed errors (`NumericalError`).
+    ``witness_approach`` shortens the steps before predicted witness zeros
+    (`drake_dock.stepping.WitnessApproach`); off, Drake's plain isolation is used."""
     state = state or initial_state(scenario)
     dd = dd or build_docking_diagram(scenario)
     sim = make_simulator(dd, scenario, state)
     rec = _Recorder(dd)
     t_end = scenario.simulation.duration if duration is None else duration
 
+    sp = scenario.simulation
+    approach = WitnessApproach(sim, [dd.contact, dd.capture], sp.max_step,
+                               0.01 * sp.accuracy) if witness_approach else None
+
     def monitor(root):
         rec.sample(root)
+        if approach is not None:
+            approach(root)
         if progress is not None:
             progress(root.get_time(), t_end)
         from pydrake.systems.framework import EventStatus

@@ -1,0 +1,78 @@
+"""Step control that lets Drake's witness isolation finish in one or two bisections.
+
+Drake's `Simulator` isolates a witness zero inside a step [t0, tf] by re-integrating from t0 to
+the midpoint c; when c does not trigger it ends the step at c with no event (simulator.cc,
+IsolateWitnessTriggers). A zero is therefore only isolated by a step that *starts* within the
+isolation window w of it; reaching that takes many steps, each bisecting down from its full
+length (about 900 derivative evaluations per event in the docking example at w = 1e-8 s).
+
+`WitnessApproach` is a simulator monitor that shortens the next step instead: after each step it
+predicts every witness's zero by the secant through its last two values (same epoch, see
+below) and caps the integrator's step so that the step ends w/2 before the earliest predicted
+zero; once within w, the step is capped at 2 w, so that it crosses the zero and a single
+bisection isolates it. The secant converges superlinearly, so a zero is reached in a few
+steps. Events, their times and the integration's error control are Drake's own; only the
+maximum step size changes, and it returns to its configured value after each event.
+
+Sources are systems with ``witness_values(context) -> {name: value}`` (the values of the
+witness functions they return now, all with direction positive-then-non-positive) and
+optionally ``witness_epoch(context)``, which changes whenever an event changes their state or
+modes (values from different epochs are not joined by a secant).
+"""
+import math
+
+
+class WitnessApproach:
+    """Simulator monitor. ``window`` is Drake's witness isolation window (0.01 x the context's
+    accuracy, in s, for error-controlled integration); ``max_step`` the configured maximum."""
+
+    #: consecutive shortened steps after which one step of the configured maximum is allowed
+    #: (a witness that hovers just above zero must not stall the run)
+    max_shortened = 40
+
+    def __init__(self, simulator, sources, max_step: float, window: float):
+        self.sim = simulator
+        self.sources = list(sources)
+        self.max_step = float(max_step)
+        self.window = float(window)
+        self._hist = {}
+        self._shortened = 0
+        self.shortened_steps = 0
+
+    def _values(self, root):
+        out = {}
+        for s in self.sources:
+            c = s.GetMyContextFromRoot(root)
+            epoch = s.witness_epoch(c) if hasattr(s, "witness_epoch") else 0
+            for k, w in s.witness_values(c).items():
+                out[(id(s), k)] = (epoch, float(w))
+        return out
+
+    def predicted_zero(self, root) -> float:
+        """Earliest predicted zero time (inf if none); updates the history."""
+        t = root.get_time()
+        best = math.inf
+        values = self._values(root)
+        for key, (epoch, w) in values.items():
+            h = self._hist.get(key)
+            if h is not None and h[0] == epoch and h[1] < t and w > 0.0:
+                rate = (w - h[2]) / (t - h[1])
+                if rate < 0.0:
+                    best = min(best, t + w / -rate)
+        self._hist = {k: (e, t, w) for k, (e, w) in values.items()}
+        return best
+
+    def __call__(self, root):
+        t = root.get_time()
+        t_zero = self.predicted_zero(root)
+        lead = t_zero - t
+        step = self.max_step
+        if lead < self.max_step + self.window and self._shortened < self.max_shortened:
+            step = lead - 0.5 * self.window if lead > self.window else 2.0 * self.window
+            step = max(step, 2.0 * self.window)
+        if step < self.max_step:
+            self._shortened += 1
+            self.shortened_steps += 1
+        else:
+            self._shortened = 0
+        self.sim.get_mutable_integrator().set_maximum_step_size(min(step, self.max_step))
