@@ -57,30 +57,63 @@ def main(argv=None) -> int:
     run_p.add_argument("--duration", type=float, default=None,
                        help="override simulation.duration (s)")
     run_p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    study_p = sub.add_parser("study", help="run a study")
+    study_p.add_argument("which", choices=["speed-accuracy"],
+                         help="speed-accuracy: drake_dock against Drake's compliant contact")
+    study_p.add_argument("scenario", nargs="?", default=str(PAPER_EXAMPLE),
+                         help="scenario YAML (default: the paper's example)")
+    study_p.add_argument("--out", required=True, help="output directory (replaced atomically)")
+    study_p.add_argument("--quick", action="store_true",
+                         help="a few points only (for CI): 2 drake_dock accuracies, 3 compliant")
     args = parser.parse_args(argv)
+    if args.command == "study":
+        return _study(args)
     # Imported here so that `--help` stays fast.
     from drake_dock.run import format_summary, run
     from drake_dock.scenario import load_scenario
     bar = None if args.no_progress else ProgressBar()
-    try:
+
+    def work():
         scenario = load_scenario(args.scenario)
         if args.duration is not None:
             if not args.duration > 0:
                 raise InputError("--duration", args.duration, "> 0 s")
             scenario.simulation.duration = args.duration
-        summary = run(scenario, args.out, progress=bar)
+        return [format_summary(run(scenario, args.out, progress=bar))]
+    try:
+        return _guarded(work, args.out)
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _guarded(work, out) -> int:
+    """Runs ``work() -> lines``; maps the typed errors to the exit codes."""
+    try:
+        lines = work()
     except InputError as e:
         print(_error("bad input", e), file=sys.stderr)
         return 2
     except DrakeDockError as e:
         print(_error("numerical failure", e), file=sys.stderr)
         return 3
-    finally:
-        if bar is not None:
-            bar.close()
-    print(format_summary(summary))
-    print(f"wrote {args.out}")
+    for line in lines:
+        print(line)
+    print(f"wrote {out}")
     return 0
+
+
+def _study(args) -> int:
+    from drake_dock.scenario import load_scenario
+    from drake_dock.study import StudyPlan, run_study, speedup_lines, write_study
+
+    def work():
+        scenario = load_scenario(args.scenario)
+        plan = StudyPlan.quick() if args.quick else StudyPlan.full()
+        result = run_study(scenario, plan, log=lambda s: print(s, flush=True))
+        write_study(result, args.out)
+        return speedup_lines(result)
+    return _guarded(work, args.out)
 
 
 if __name__ == "__main__":

@@ -59,7 +59,8 @@ class CompliantConfig:
     n_around: int = 12
     n_height: int = 4
     n_ring: int = 72
-    thickness: float = 0.02
+    thickness: float = 0.002
+    offset: str = "inward"          # petal plates grow from the surface: "inward" | "outward"
     ring_width: float = 0.05
     ring_depth: float = 0.04
 
@@ -133,7 +134,8 @@ def apds_pieces(g, cfg: CompliantConfig) -> list:
                 n = np.cross(T[..., 0], T[..., 1])
                 n /= np.linalg.norm(n, axis=-1, keepdims=True)
                 n *= np.sign(np.einsum("ix,ix->i", n[:, :2], X[:, :2]))[:, None]
-                pieces.append(np.vstack([X, X + cfg.thickness * n]))
+                side = 1.0 if cfg.offset == "outward" else -1.0
+                pieces.append(np.vstack([X, X + side * cfg.thickness * n]))
     th = np.linspace(0.0, 2 * math.pi, cfg.n_ring + 1)
     for a in range(cfg.n_ring):
         t3 = np.linspace(th[a], th[a + 1], 3)
@@ -200,11 +202,14 @@ class CompliantRun:
     force: np.ndarray                  # [N, 3] net contact force on the chaser over each step
     ring_distance: np.ndarray
     error: str | None = None
+    stopped: bool = False              # ended by the wall-time limit
 
 
 def run_compliant(scenario, state, cfg: CompliantConfig, *, t_max: float,
-                  cd: CompliantDiagram | None = None) -> CompliantRun:
-    """Runs until capture or ``t_max``; wall time covers Initialize and AdvanceTo."""
+                  cd: CompliantDiagram | None = None, wall_limit: float = math.inf
+                  ) -> CompliantRun:
+    """Runs until capture, ``t_max`` or ``wall_limit`` seconds of wall time (``stopped``);
+    wall time covers Initialize and AdvanceTo."""
     cd = cd or build_compliant_diagram(scenario, cfg)
     dp = cd.dp
     plant = dp.plant
@@ -229,10 +234,15 @@ def run_compliant(scenario, state, cfg: CompliantConfig, *, t_max: float,
         rec["v"].append(plant.EvalBodySpatialVelocityInWorld(c, chaser).translational().copy())
         rec["w"].append(plant.EvalBodySpatialVelocityInWorld(c, apds).rotational().copy())
 
+    stopped = [False]
+
     def monitor(r):
         sample()
         if rec["d"][-1] <= cap < rec["d"][-2]:
             return EventStatus.ReachedTermination(cd.diagram, "capture")
+        if _time.perf_counter() - w0 > wall_limit:
+            stopped[0] = True
+            return EventStatus.ReachedTermination(cd.diagram, "wall limit")
         return EventStatus.Succeeded()
 
     error = None
@@ -261,4 +271,4 @@ def run_compliant(scenario, state, cfg: CompliantConfig, *, t_max: float,
         win = (tm >= 0.5 * t_c) & (tm <= t_c)
         peak = float(np.linalg.norm(force[win], axis=1).max()) if win.any() else None
     return CompliantRun(cfg, captured, t_c, spin, vax, peak, wall, len(t) - 1, t, force, d,
-                        error)
+                        error, stopped[0])
