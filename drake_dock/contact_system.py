@@ -164,7 +164,7 @@ class _Eval:
     friction_power: float
     applied_power: float
     external_power: float
-    bound: np.ndarray      # relative travel bound per far pair
+    bound: np.ndarray      # relative travel bound per far pair (NaN until asked: `_bound`)
     poses: list
     extra_power: np.ndarray
 
@@ -376,12 +376,11 @@ class RigidContactSystem(LeafSystem):
         k = len(self.pairs)
         evals = [None] * k
         udot = np.zeros(self.nu)
-        bound = np.zeros(k)
+        bound = np.full(k, np.nan)
         rows, row_pairs, smodes, dirs = [], [], [], []
         for i, st in enumerate(modes.pairs):
             sl = slice(self._uoff[i], self._uoff[i + 1])
             if st.status == FAR:
-                bound[i] = self._travel_bound(i, poses, st)
                 continue
             ev = self._couple(i, u[sl], poses, twists, st.sigma, t)
             evals[i] = ev
@@ -418,8 +417,15 @@ class RigidContactSystem(LeafSystem):
         R21, p21 = R2.T @ R1, R2.T @ (p1 - p2)
         R0, p0 = st.ref_X21
         c, r = self._spheres[i]
-        return float(np.linalg.norm(R21 @ c + p21 - (R0 @ c + p0))
-                     + np.linalg.norm(R21 - R0) * r)
+        return float(np.linalg.norm((R21 - R0) @ c + p21 - p0)
+                     + math.sqrt(np.sum((R21 - R0) ** 2)) * r)
+
+    def _bound(self, E, i, st):
+        """The travel bound of far pair i at the evaluation E, computed when a witness or an
+        output asks for it (derivative evaluations do not need it)."""
+        if math.isnan(E.bound[i]):
+            E.bound[i] = self._travel_bound(i, E.poses, st)
+        return E.bound[i]
 
     def eval(self, context) -> _Eval:
         return self._cache.Eval(context)
@@ -465,7 +471,7 @@ class RigidContactSystem(LeafSystem):
             u = context.get_continuous_state_vector().CopyToVector()[
                 self.nq + self.nv + self._uoff[i]:self.nq + self.nv + self._uoff[i + 1]]
             n1 = p.patch1.dim
-            y[S["gap"]] = st.distance - E.bound[i]
+            y[S["gap"]] = st.distance - self._bound(E, i, st)
             y[S["u"]][:len(u)] = u
             y[S["p1"]] = posed(p.patch1, *E.poses[a]).position(u[:n1])
             y[S["p2"]] = posed(p.patch2, *E.poses[b]).position(u[n1:])
@@ -566,7 +572,7 @@ class RigidContactSystem(LeafSystem):
         st = self._status(context, i)
         if st.status != FAR:
             return 1.0
-        return float(st.clearance - self._cache.Eval(context).bound[i])
+        return float(st.clearance - self._bound(self._cache.Eval(context), i, st))
 
     # ------------------------------------------------------------------ events
     def _on_event(self, context, event, state):

@@ -7,8 +7,8 @@ isolation window w of it; reaching that takes many steps, each bisecting down fr
 length (about 900 derivative evaluations per event in the docking example at w = 1e-8 s).
 
 `WitnessApproach` is a simulator monitor that shortens the next step instead: after each step it
-predicts every witness's zero by the secant through its last two values (same epoch, see
-below) and caps the integrator's step so that the step ends w/2 before the earliest predicted
+predicts every witness's zero by the secant through its last two values and the parabola
+through its last three (same epoch, see below; the earlier of the two) and caps the integrator's step so that the step ends w/2 before the earliest predicted
 zero; once within w, the step is capped at 2 w, so that it crosses the zero and a single
 bisection isolates it. The secant converges superlinearly, so a zero is reached in a few
 steps. Events, their times and the integration's error control are Drake's own; only the
@@ -20,6 +20,36 @@ optionally ``witness_epoch(context)``, which changes whenever an event changes t
 modes (values from different epochs are not joined by a secant).
 """
 import math
+
+
+def _lead(pts) -> float:
+    """Time from the last of ``pts`` [(t, w), ...] (up to three, w > 0 at the last) to the
+    predicted zero of w: the earlier of the secant through the last two and of the parabola
+    through the last three (a witness falling ever faster, such as the gap of a couple
+    accelerating towards contact, is reached earlier than its secant says). inf if neither
+    predicts a zero ahead."""
+    lead = math.inf
+    if len(pts) < 2:
+        return lead
+    (t1, w1), (t2, w2) = pts[-2], pts[-1]
+    s12 = (w2 - w1) / (t2 - t1)
+    if s12 < 0.0:
+        lead = w2 / -s12
+    if len(pts) == 3:
+        t0, w0 = pts[0]
+        s01 = (w1 - w0) / (t1 - t0)
+        c = (s12 - s01) / (t2 - t0)            # w(t2 + h) = w2 + b h + c h^2
+        b = s12 + c * (t2 - t1)
+        if c != 0.0:
+            disc = b * b - 4.0 * c * w2
+            if disc >= 0.0:
+                r = math.sqrt(disc)
+                # roots h = (-b -+ r) / (2c), written without cancellation
+                q = -0.5 * (b + math.copysign(r, b))
+                roots = [h for h in (q / c, w2 / q if q != 0.0 else math.inf) if h > 0.0]
+                if roots:
+                    lead = min(lead, min(roots))
+    return lead
 
 
 class WitnessApproach:
@@ -53,13 +83,15 @@ class WitnessApproach:
         t = root.get_time()
         best = math.inf
         values = self._values(root)
+        hist = {}
         for key, (epoch, w) in values.items():
             h = self._hist.get(key)
-            if h is not None and h[0] == epoch and h[1] < t and w > 0.0:
-                rate = (w - h[2]) / (t - h[1])
-                if rate < 0.0:
-                    best = min(best, t + w / -rate)
-        self._hist = {k: (e, t, w) for k, (e, w) in values.items()}
+            pts = [p for p in h[1] if p[0] < t] if h is not None and h[0] == epoch else []
+            pts = (pts + [(t, w)])[-3:]
+            hist[key] = (epoch, pts)
+            if w > 0.0:
+                best = min(best, t + _lead(pts))
+        self._hist = hist
         return best
 
     def __call__(self, root):

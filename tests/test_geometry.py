@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
+from drake_dock.core.patches import Circle, Cone, PlaneRect, Reparametrized, Segment, posed
 from drake_dock.docking.apds import apds_patches, guide_side, guide_surface, ring_circle
 from drake_dock.docking.scene import rot_x, rot_z
 
@@ -104,6 +104,35 @@ def test_derivatives_match_central_differences(geom):
                 scale2 = max(np.abs(S).max(), scale1)
                 assert np.abs(fd1 - T[..., a]).max() <= 1e-7 * scale1, name
                 assert np.abs(fd2 - S[..., a]).max() <= 1e-7 * scale2, name
+
+
+def test_point_jets_equal_the_vectorised_evaluation(geom):
+    """`Patch.jet` (plain floats, used by the couple evaluation) against the vectorised
+    position/first/second, including a curve through a reparametrisation."""
+    patches = _all_patches(geom)
+    patches["reparam_curve"] = Reparametrized(Circle(0.5, 0.1), _Square())
+    for name, patch in patches.items():
+        for u in _interior_samples(patch, 6):
+            r, T, K = patch.jet(u)
+            assert np.allclose(r, patch.position(u), rtol=0, atol=1e-14), name
+            assert np.allclose(np.array(T).T, patch.first(u), rtol=0, atol=1e-13), name
+            assert np.allclose(np.transpose(np.array(K), (2, 0, 1)), patch.second(u), rtol=0,
+                               atol=1e-12), name
+
+
+class _Square:
+    """u = s^2 on s in [0.5, 2]: a parameter map without a ``jet`` of its own."""
+
+    lower, upper = np.array([0.5]), np.array([2.0])
+
+    def value(self, s):
+        return np.asarray(s, dtype=float) ** 2
+
+    def jac(self, s):
+        return 2 * np.asarray(s, dtype=float)[..., None]
+
+    def hess(self, s):
+        return np.full(np.shape(s) + (1, 1), 2.0)
 
 
 def test_turning_by_120_deg_maps_patches_onto_each_other(geom):

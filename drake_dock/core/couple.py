@@ -41,21 +41,82 @@ import numpy as np
 
 
 def cross(a, b):
-    """3-vector cross product (np.cross costs ~10 us per call on small vectors)."""
+    """3-vector cross product of numpy arrays (np.cross costs ~10 us per call on small
+    vectors)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
                      a[0] * b[1] - a[1] * b[0]])
 
 
+# One couple is evaluated in plain floats (3-tuples): a few hundred operations on 3-vectors,
+# each several times cheaper than the same numpy call.
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _cr(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def _sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _mul(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+def _axpy(s, a, b):
+    """s a + b."""
+    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
+
+
+def _rot(R, a):
+    r0, r1, r2 = R
+    return (r0[0] * a[0] + r0[1] * a[1] + r0[2] * a[2], r1[0] * a[0] + r1[1] * a[1]
+            + r1[2] * a[2], r2[0] * a[0] + r2[1] * a[1] + r2[2] * a[2])
+
+
 def _unit(a):
-    na = math.sqrt(a @ a)
+    na = math.sqrt(_dot(a, a))
     if na == 0.0:     # degenerate (parallel curves): reported by `conditioning`, no NaN
         return a, 1.0
-    return a / na, na
+    return _mul(a, 1.0 / na), na
 
 
 def _perp_rate(unit, rate, norm):
     """d/dt (a/|a|) = (I - u u^T) a' / |a|."""
-    return (rate - unit * (unit @ rate)) / norm
+    return _mul(_axpy(-_dot(unit, rate), unit, rate), 1.0 / norm)
+
+
+def _solve(A, b):
+    """A x = b for n = 2, 3 by Gaussian elimination with partial pivoting (lists of floats)."""
+    n = len(b)
+    M = [list(A[i]) + [b[i]] for i in range(n)]
+    for k in range(n):
+        piv = max(range(k, n), key=lambda i: abs(M[i][k]))
+        if piv != k:
+            M[k], M[piv] = M[piv], M[k]
+        pk = M[k][k]
+        for i in range(k + 1, n):
+            f = M[i][k] / pk
+            if f != 0.0:
+                Mi, Mk = M[i], M[k]
+                for j in range(k, n + 1):
+                    Mi[j] -= f * Mk[j]
+    x = [0.0] * n
+    for i in range(n - 1, -1, -1):
+        x[i] = (M[i][n] - sum(M[i][j] * x[j] for j in range(i + 1, n))) / M[i][i]
+    return x
+
+
+def _det(A):
+    if len(A) == 2:
+        return A[0][0] * A[1][1] - A[0][1] * A[1][0]
+    return _dot(A[0], _cr(A[1], A[2]))
 
 
 @dataclasses.dataclass
@@ -86,56 +147,61 @@ class CoupleEval:
 
 
 def _geometry(patch, R, u):
-    r = patch.position(u)
-    T = R @ patch.first(u)
-    K = (R @ patch.second(u).reshape(3, -1)).reshape(3, patch.dim, patch.dim)
-    return R @ r, T, K
+    """World-oriented jet (R r, R T, R K) of a patch at u (R as nested lists)."""
+    r, T, K = patch.jet(u)
+    return (_rot(R, r), [_rot(R, t) for t in T],
+            [[_rot(R, k) for k in row] for row in K])
 
 
 def _residual(kind, d, T1, K1, T2, K2):
-    t1, k1 = T1[:, 0], K1[:, 0, 0]
+    t1, k1 = T1[0], K1[0][0]
     if kind == "CC":
-        t2, k2 = T2[:, 0], K2[:, 0, 0]
-        F = np.array([t1 @ d, t2 @ d])
-        Fu = np.array([[k1 @ d + t1 @ t1, -(t1 @ t2)],
-                       [t2 @ t1, k2 @ d - t2 @ t2]])
-        return F, Fu
-    su, sv = T2[:, 0], T2[:, 1]
-    suu, suv, svv = K2[:, 0, 0], K2[:, 0, 1], K2[:, 1, 1]
-    N = cross(su, sv)
-    F = np.array([su @ d, sv @ d, t1 @ N])
-    Fu = np.array([
-        [su @ t1, suu @ d - su @ su, suv @ d - su @ sv],
-        [sv @ t1, suv @ d - sv @ su, svv @ d - sv @ sv],
-        [k1 @ N, t1 @ (cross(suu, sv) + cross(su, suv)), t1 @ (cross(suv, sv) + cross(su, svv))]])
-    return F, Fu
+        t2, k2 = T2[0], K2[0][0]
+        t12 = _dot(t1, t2)
+        return ([_dot(t1, d), _dot(t2, d)],
+                [[_dot(k1, d) + _dot(t1, t1), -t12], [t12, _dot(k2, d) - _dot(t2, t2)]])
+    su, sv = T2
+    (suu, suv), (_, svv) = K2
+    N = _cr(su, sv)
+    susv = _dot(su, sv)
+    return ([_dot(su, d), _dot(sv, d), _dot(t1, N)],
+            [[_dot(su, t1), _dot(suu, d) - _dot(su, su), _dot(suv, d) - susv],
+             [_dot(sv, t1), _dot(suv, d) - susv, _dot(svv, d) - _dot(sv, sv)],
+             [_dot(k1, N), _dot(t1, _add(_cr(suu, sv), _cr(su, suv))),
+              _dot(t1, _add(_cr(suv, sv), _cr(su, svv)))]])
 
 
-def _conditioning(Fu, T1=None, T2=None):
+def _conditioning(Fu, T1, T2):
     """|det| / product of row norms of Fu with its columns scaled by the parameters' tangent
     lengths (invariant to how the patches are parametrised): sin^2 / (1 + cos^2) of the angle
     between the curves of a C-C couple at contact; 0 when Eq. (39) fails."""
-    if T1 is not None:
-        scale = np.sqrt(np.concatenate([np.einsum("xi,xi->i", T1, T1),
-                                        np.einsum("xi,xi->i", T2, T2)]))
-        if np.all(scale > 0):
-            Fu = Fu / scale
-    rows = np.sqrt(np.einsum("ij,ij->i", Fu, Fu))
-    den = float(np.prod(rows))
-    return abs(float(np.linalg.det(Fu))) / den if den > 0 else 0.0
+    scale = [math.sqrt(_dot(t, t)) for t in list(T1) + list(T2)]
+    if all(s > 0.0 for s in scale):
+        Fu = [[f / s for f, s in zip(row, scale)] for row in Fu]
+    den = 1.0
+    for row in Fu:
+        den *= math.sqrt(sum(f * f for f in row))
+    return abs(_det(Fu)) / den if den > 0 else 0.0
+
+
+def _pose(X):
+    R, p = X
+    return R.tolist() if hasattr(R, "tolist") else R, tuple(float(a) for a in p)
 
 
 def closest_point_conditions(kind, patch1, X1, patch2, X2, u, *, conditioning=False):
     """F(u) and Fu of the contact form for body poses X_i = (R_i, p_i) (and the conditioning
     of Fu if asked)."""
     n1 = patch1.dim
-    r1, T1, K1 = _geometry(patch1, X1[0], u[:n1])
-    r2, T2, K2 = _geometry(patch2, X2[0], u[n1:])
-    d = (r1 + X1[1]) - (r2 + X2[1])
+    u = [float(a) for a in u]
+    (R1, p1), (R2, p2) = _pose(X1), _pose(X2)
+    r1, T1, K1 = _geometry(patch1, R1, u[:n1])
+    r2, T2, K2 = _geometry(patch2, R2, u[n1:])
+    d = _sub(_add(r1, p1), _add(r2, p2))
     F, Fu = _residual(kind, d, T1, K1, T2, K2)
     if conditioning:
-        return F, Fu, _conditioning(Fu, T1, T2)
-    return F, Fu
+        return np.array(F), np.array(Fu), _conditioning(Fu, T1, T2)
+    return np.array(F), np.array(Fu)
 
 
 def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
@@ -144,81 +210,83 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
     twists V_i = (w_i, v_i). With ``project`` one Newton step on F(u) = 0 corrects the drift of
     the integrated couple before anything else is computed (its size is returned)."""
     n1 = patch1.dim
-    R1, p1o = X1
-    R2, p2o = X2
-    w1, v1 = V1
-    w2, v2 = V2
-    u = np.asarray(u_state, dtype=float)
+    (R1, p1o), (R2, p2o) = _pose(X1), _pose(X2)
+    w1, v1 = (tuple(float(a) for a in x) for x in V1)
+    w2, v2 = (tuple(float(a) for a in x) for x in V2)
+    u0 = [float(a) for a in u_state]
+    u = u0
     r1, T1, K1 = _geometry(patch1, R1, u[:n1])
     r2, T2, K2 = _geometry(patch2, R2, u[n1:])
-    d = (r1 + p1o) - (r2 + p2o)
+    d = _sub(_add(r1, p1o), _add(r2, p2o))
     F, Fu = _residual(kind, d, T1, K1, T2, K2)
-    residual = float(np.sqrt(F @ F))
+    residual = math.sqrt(sum(f * f for f in F))
     cond = _conditioning(Fu, T1, T2)
-    du = np.zeros_like(u)
+    du = [0.0] * len(u)
     if project and residual > 0.0 and cond > 1e-14:
-        du = -np.linalg.solve(Fu, F)
-        u = u + du
-        if np.abs(du).max() > 1e-9 * (1.0 + np.abs(u).max()):
+        du = [-a for a in _solve(Fu, F)]
+        u = [a + b for a, b in zip(u, du)]
+        if max(abs(a) for a in du) > 1e-9 * (1.0 + max(abs(a) for a in u)):
             r1, T1, K1 = _geometry(patch1, R1, u[:n1])
             r2, T2, K2 = _geometry(patch2, R2, u[n1:])
-            d = (r1 + p1o) - (r2 + p2o)
+            d = _sub(_add(r1, p1o), _add(r2, p2o))
             F, Fu = _residual(kind, d, T1, K1, T2, K2)
             cond = _conditioning(Fu, T1, T2)
         else:
             # A round-off-sized correction: the points move along their tangents (exact to
             # O(du^2) < 1e-18); tangents and curvatures are kept.
-            r1 = r1 + T1 @ du[:n1]
-            r2 = r2 + T2 @ du[n1:]
-            d = (r1 + p1o) - (r2 + p2o)
-    P1, P2 = r1 + p1o, r2 + p2o
-    vm1 = v1 + cross(w1, r1)
-    vm2 = v2 + cross(w2, r2)
-    v_rel = vm1 - vm2
-    t1, k1 = T1[:, 0], K1[:, 0, 0]
-    w1t1 = cross(w1, t1)
+            for t, a in zip(T1, du[:n1]):
+                r1 = _axpy(a, t, r1)
+            for t, a in zip(T2, du[n1:]):
+                r2 = _axpy(a, t, r2)
+            d = _sub(_add(r1, p1o), _add(r2, p2o))
+    P1, P2 = _add(r1, p1o), _add(r2, p2o)
+    v_rel = _sub(_add(v1, _cr(w1, r1)), _add(v2, _cr(w2, r2)))
+    t1, k1 = T1[0], K1[0][0]
+    w1t1 = _cr(w1, t1)
     if kind == "CC":
-        t2, k2 = T2[:, 0], K2[:, 0, 0]
-        w2t2 = cross(w2, t2)
-        Ft = np.array([w1t1 @ d + t1 @ v_rel, w2t2 @ d + t2 @ v_rel])
+        t2, k2 = T2[0], K2[0][0]
+        w2t2 = _cr(w2, t2)
+        Ft = [_dot(w1t1, d) + _dot(t1, v_rel), _dot(w2t2, d) + _dot(t2, v_rel)]
     else:
-        su, sv = T2[:, 0], T2[:, 1]
-        N = cross(su, sv)
-        Ft = np.array([cross(w2, su) @ d + su @ v_rel, cross(w2, sv) @ d + sv @ v_rel,
-                       w1t1 @ N + t1 @ cross(w2, N)])
+        su, sv = T2
+        N = _cr(su, sv)
+        w2su, w2sv = _cr(w2, su), _cr(w2, sv)
+        Ft = [_dot(w2su, d) + _dot(su, v_rel), _dot(w2sv, d) + _dot(sv, v_rel),
+              _dot(w1t1, N) + _dot(t1, _cr(w2, N))]
     # Eq. (47): u' = -J^-1 dF/dt (J = Fu, Eq. 40). A singular J is reported by `conditioning`
     # and handled by the caller's rule; here it gives zeros, never a NaN.
-    udot = np.linalg.solve(Fu, -Ft) if cond > 1e-14 else np.zeros_like(u)
+    udot = _solve(Fu, [-f for f in Ft]) if cond > 1e-14 else [0.0] * len(u)
     u1d, u2d = udot[:n1], udot[n1:]
     # Rates of the world tangents along the couple: w x T + K u'.
-    t1dot = w1t1 + k1 * u1d[0]
+    t1dot = _axpy(u1d[0], k1, w1t1)
     if kind == "CC":
-        t2dot = w2t2 + k2 * u2d[0]
-        c = cross(t1, t2)
-        n_hat, c_norm = _unit(c)
-        n = sigma * n_hat
-        ndot = sigma * _perp_rate(n_hat, cross(t1dot, t2) + cross(t1, t2dot), c_norm)
+        t2dot = _axpy(u2d[0], k2, w2t2)
+        n_hat, c_norm = _unit(_cr(t1, t2))
+        n = _mul(n_hat, sigma)
+        ndot = _mul(_perp_rate(n_hat, _add(_cr(t1dot, t2), _cr(t1, t2dot)), c_norm), sigma)
         ta, t2_norm = _unit(t2)
         tadot = _perp_rate(ta, t2dot, t2_norm)
-        conv = cross(w1, t1 * u1d[0]) - cross(w2, t2 * u2d[0])
+        conv = _sub(_cr(w1, _mul(t1, u1d[0])), _cr(w2, _mul(t2, u2d[0])))
     else:
-        suu, suv, svv = K2[:, 0, 0], K2[:, 0, 1], K2[:, 1, 1]
-        sudot = cross(w2, su) + suu * u2d[0] + suv * u2d[1]
-        svdot = cross(w2, sv) + suv * u2d[0] + svv * u2d[1]
+        (suu, suv), (_, svv) = K2
+        sudot = _axpy(u2d[1], suv, _axpy(u2d[0], suu, w2su))
+        svdot = _axpy(u2d[1], svv, _axpy(u2d[0], suv, w2sv))
         N_hat, N_norm = _unit(N)
-        n = sigma * N_hat
-        ndot = sigma * _perp_rate(N_hat, cross(sudot, sv) + cross(su, svdot), N_norm)
+        n = _mul(N_hat, sigma)
+        ndot = _mul(_perp_rate(N_hat, _add(_cr(sudot, sv), _cr(su, svdot)), N_norm), sigma)
         ta, su_norm = _unit(su)
         tadot = _perp_rate(ta, sudot, su_norm)
-        conv = cross(w1, t1 * u1d[0]) - cross(w2, T2 @ u2d)
-    tb = cross(n, ta)
-    tbdot = cross(ndot, ta) + cross(n, tadot)
+        conv = _sub(_cr(w1, _mul(t1, u1d[0])),
+                    _cr(w2, _axpy(u2d[1], sv, _mul(su, u2d[0]))))
+    tb = _cr(n, ta)
+    tbdot = _add(_cr(ndot, ta), _cr(n, tadot))
+    A = np.array
     return CoupleEval(
-        u=u, drift=du, residual=residual, udot=udot, conditioning=cond, p1=P1, p2=P2, n=n,
-        ta=ta, tb=tb, gap=float(n @ d), v_rel=v_rel, vn=float(n @ v_rel),
-        vt=np.array([ta @ v_rel, tb @ v_rel]),
-        bias_n=float(n @ conv + ndot @ v_rel),
-        bias_t=np.array([ta @ conv + tadot @ v_rel, tb @ conv + tbdot @ v_rel]))
+        u=A(u), drift=A(du), residual=residual, udot=A(udot), conditioning=cond, p1=A(P1),
+        p2=A(P2), n=A(n), ta=A(ta), tb=A(tb), gap=_dot(n, d), v_rel=A(v_rel),
+        vn=_dot(n, v_rel), vt=A([_dot(ta, v_rel), _dot(tb, v_rel)]),
+        bias_n=_dot(n, conv) + _dot(ndot, v_rel),
+        bias_t=A([_dot(ta, conv) + _dot(tadot, v_rel), _dot(tb, conv) + _dot(tbdot, v_rel)]))
 
 
 def orientation_sign(kind, patch1, X1, patch2, X2, u) -> float:

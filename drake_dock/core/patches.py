@@ -7,13 +7,17 @@ R^3 in its body frame. Every patch provides, vectorised over leading axes:
 - ``first(u)``     -> (..., 3, dim)       d r / d u
 - ``second(u)``    -> (..., 3, dim, dim)  d^2 r / d u d u
 
-and a box domain ``lower <= u <= upper``; a parameter may be periodic (a full circle), in which
+and, for one parameter point, ``jet(u)`` -> (r, T, K): the same three as tuples of floats
+(r a 3-tuple, T[a] and K[a][b] 3-tuples), the form the couple evaluation works in (a patch
+evaluated at one point is cheaper in plain floats than in numpy); and a box domain
+``lower <= u <= upper``; a parameter may be periodic (a full circle), in which
 case it is wrapped instead of bounded. `posed` maps a patch to the world through a body pose,
 Eq. (20): r = p_WB + R_WB r'(u).
 """
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
@@ -35,6 +39,17 @@ class Patch:
 
     def second(self, u):
         raise NotImplementedError
+
+    def jet(self, u):
+        """(r, T, K) at one point u as tuples of floats (module docstring); this default goes
+        through the vectorised methods, subclasses write it out."""
+        u = np.asarray(u, dtype=float)
+        r = tuple(self.position(u).tolist())
+        T = tuple(tuple(c) for c in self.first(u).T.tolist())
+        K2 = self.second(u)
+        K = tuple(tuple(tuple(K2[:, a, b].tolist()) for b in range(self.dim))
+                  for a in range(self.dim))
+        return r, T, K
 
     # Domain helpers -------------------------------------------------------------------------
     def wrap(self, u):
@@ -111,6 +126,11 @@ class Circle(Patch):
                      axis=-1)
         return d[..., None, None]
 
+    def jet(self, u):
+        R = self.radius
+        c, s = math.cos(u[0]), math.sin(u[0])
+        return (R * c, R * s, self.height), ((-R * s, R * c, 0.0),), (((-R * c, -R * s, 0.0),),)
+
 
 class Segment(Patch):
     """Straight segment a + u (b - a), u in [0, 1]."""
@@ -135,6 +155,12 @@ class Segment(Patch):
     def second(self, u):
         s = np.asarray(u, dtype=float)[..., 0]
         return np.zeros(s.shape + (3, 1, 1))
+
+    def jet(self, u):
+        a, b, s = self.a, self.b, float(u[0])
+        e = (b[0] - a[0], b[1] - a[1], b[2] - a[2])
+        return ((a[0] + s * e[0], a[1] + s * e[1], a[2] + s * e[2]), (e,),
+                (((0.0, 0.0, 0.0),),))
 
 
 class PlaneRect(Patch):
@@ -162,6 +188,13 @@ class PlaneRect(Patch):
     def second(self, u):
         u = np.asarray(u, dtype=float)
         return np.zeros(u.shape[:-1] + (3, 2, 2))
+
+    def jet(self, u):
+        o, e0, e1 = self.o, self.e0, self.e1
+        a, b = float(u[0]), float(u[1])
+        z = (0.0, 0.0, 0.0)
+        return (tuple((o + a * e0 + b * e1).tolist()), (tuple(e0.tolist()), tuple(e1.tolist())),
+                ((z, z), (z, z)))
 
 
 class Cone(Patch):
@@ -208,6 +241,15 @@ class Cone(Patch):
         out[..., 1, 1] = r_zz
         return out
 
+    def jet(self, u):
+        th, z = float(u[0]), float(u[1])
+        cot = self.cot
+        rho = self.R0 - z * cot
+        c, s = math.cos(th), math.sin(th)
+        r_thz = (cot * s, -cot * c, 0.0)
+        return ((rho * c, rho * s, z), ((-rho * s, rho * c, 0.0), (-cot * c, -cot * s, 1.0)),
+                (((-rho * c, -rho * s, 0.0), r_thz), (r_thz, (0.0, 0.0, 0.0))))
+
 
 class Reparametrized(Patch):
     """A patch composed with a parameter map phi: s -> u = phi(s), so that r(s) = base(phi(s)).
@@ -239,6 +281,40 @@ class Reparametrized(Patch):
         J = self.phi.jac(s)
         return (np.einsum("...xij,...ia,...jb->...xab", self.base.second(u), J, J)
                 + np.einsum("...xi,...iab->...xab", self.base.first(u), self.phi.hess(s)))
+
+    def jet(self, s):
+        """The chain rule of the class docstring on floats; ``phi.jet(s)`` -> (u, J, Hs) as
+        nested tuples if the map has it."""
+        if hasattr(self.phi, "jet"):
+            u, J, Hs = self.phi.jet(s)
+        else:
+            s = np.asarray(s, dtype=float)
+            u, J, Hs = (self.phi.value(s).tolist(), self.phi.jac(s).tolist(),
+                        self.phi.hess(s).tolist())
+        rb, Tb, Kb = self.base.jet(u)
+        if self.dim == 1:
+            (j,), = J
+            (h,), = Hs[0]
+            (t,), ((k,),) = Tb, Kb
+            return rb, ((j * t[0], j * t[1], j * t[2]),), \
+                (((j * j * k[0] + h * t[0], j * j * k[1] + h * t[1], j * j * k[2] + h * t[2]),),)
+        (j00, j01), (j10, j11) = J
+        B0, B1 = Tb
+        (B00, B01), (_, B11) = Kb
+        T = (tuple(B0[x] * j00 + B1[x] * j10 for x in range(3)),
+             tuple(B0[x] * j01 + B1[x] * j11 for x in range(3)))
+        jj = ((j00, j10), (j01, j11))              # jj[a] = (u_0,a, u_1,a)
+
+        def second(a, b):
+            (ua0, ua1), (ub0, ub1) = jj[a], jj[b]
+            h0, h1 = Hs[0][a][b], Hs[1][a][b]
+            c00, c01, c10, c11 = ua0 * ub0, ua0 * ub1, ua1 * ub0, ua1 * ub1
+            return tuple(B00[x] * c00 + B01[x] * (c01 + c10) + B11[x] * c11 + B0[x] * h0
+                         + B1[x] * h1 for x in range(3))
+
+        K01 = second(0, 1)
+        K = ((second(0, 0), K01), (K01, second(1, 1)))
+        return rb, T, K
 
 
 @dataclasses.dataclass(frozen=True)
@@ -295,3 +371,11 @@ class PolarCurve(Patch):
         th, (r, r1, r2), (z, z1, z2), c, s = self._parts(u)
         return np.stack([r2 * c - 2 * r1 * s - r * c, r2 * s + 2 * r1 * c - r * s, z2],
                         axis=-1)[..., None, None]
+
+    def jet(self, u):
+        th = float(u[0])
+        r, r1, r2 = (float(a) for a in self.radial(th))
+        z, z1, z2 = (float(a) for a in self.axial(th))
+        c, s = math.cos(th), math.sin(th)
+        return ((r * c, r * s, z), ((r1 * c - r * s, r1 * s + r * c, z1),),
+                (((r2 * c - 2 * r1 * s - r * c, r2 * s + 2 * r1 * c - r * s, z2),),))

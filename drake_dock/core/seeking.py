@@ -103,18 +103,24 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50):
     periodic = np.array(P1.patch.periodic + P2.patch.periodic)
     scale = np.maximum(np.concatenate([P1.patch.span, P2.patch.span]), 1e-300)
 
-    def parts(u):
-        a, b = u[:n1], u[n1:]
-        d = P1.position(a) - P2.position(b)
-        J = np.concatenate([P1.first(a), -P2.first(b)], axis=1)
-        return d, J
+    def world(P, u):
+        r, T, K = P.patch.jet(u)
+        R = P.R
+        return (R @ r + P.p, R @ np.array(T).T,
+                np.einsum("xy,aby->xab", R, np.array(K)) if K is not None else None)
+
+    def parts(u, second=False):
+        r1, T1, K1 = world(P1, u[:n1])
+        r2, T2, K2 = world(P2, u[n1:])
+        d = r1 - r2
+        J = np.concatenate([T1, -T2], axis=1)
+        return (d, J, K1, K2) if second else (d, J)
 
     for it in range(1, max_iter + 1):
-        d, J = parts(u)
+        d, J, K1, K2 = parts(u, second=True)
         g = J.T @ d
-        a, b = u[:n1], u[n1:]
-        S1 = np.einsum("x,xab->ab", d, P1.second(a))
-        S2 = np.einsum("x,xab->ab", d, P2.second(b))
+        S1 = np.einsum("x,xab->ab", d, K1)
+        S2 = np.einsum("x,xab->ab", d, K2)
         H = J.T @ J
         H[:n1, :n1] += S1
         H[n1:, n1:] -= S2

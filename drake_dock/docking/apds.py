@@ -103,7 +103,7 @@ def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
 
     def radial(th):
         w = g.alpha2 + sigma * (th - phi)
-        sw, cw = np.sin(w), np.cos(w)
+        sw, cw = (math.sin(w), math.cos(w)) if isinstance(w, float) else (np.sin(w), np.cos(w))
         rho = A / sw
         return rho, -sigma * A * cw / sw**2, A * (1.0 + cw**2) / sw**3
 
@@ -133,6 +133,21 @@ class _PetalMap:
         q = np.sqrt(1.0 - x**2)
         t1 = np.arcsin(x) - self.g.alpha2
         return t1, x1 / q, x2 / q + x * x1**2 / q**3
+
+    def jet(self, s):
+        """(value, jac, hess) at one point, as nested tuples of floats."""
+        a, z = float(s[0]), float(s[1])
+        cot = self.cot1
+        rho = self.g.R - z * cot
+        x = self.A / rho
+        x1 = x * cot / rho
+        x2 = 2.0 * x * cot**2 / rho**2
+        q = math.sqrt(1.0 - x * x)
+        t1 = math.asin(x) - self.g.alpha2
+        d1, d2 = x1 / q, x2 / q + x * x1**2 / q**3
+        w = math.pi / 3 - 2 * t1
+        return ((self.phi0 + t1 + a * w, z), ((w, d1 * (1 - 2 * a)), (0.0, 1.0)),
+                (((0.0, -2 * d1), (-2 * d1, d2 * (1 - 2 * a))), ((0.0, 0.0), (0.0, 0.0))))
 
     def value(self, s):
         s = np.asarray(s, dtype=float)
