@@ -22,6 +22,7 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/lzb_chains.py
 	$(BIN)/python bench/contact_eval.py
 	$(BIN)/python bench/paper_example.py
+	$(BIN)/python bench/time_shares.py
 
 clean:
 	rm -rf $(VENV) out

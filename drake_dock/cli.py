@@ -58,13 +58,14 @@ def main(argv=None) -> int:
                        help="override simulation.duration (s)")
     run_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     study_p = sub.add_parser("study", help="run a study")
-    study_p.add_argument("which", choices=["speed-accuracy"],
-                         help="speed-accuracy: drake_dock against Drake's compliant contact")
+    study_p.add_argument("which", choices=["speed-accuracy", "stability"],
+                         help="speed-accuracy: drake_dock against Drake's compliant contact; "
+                              "stability: the five cases where methods fail")
     study_p.add_argument("scenario", nargs="?", default=str(PAPER_EXAMPLE),
                          help="scenario YAML (default: the paper's example)")
     study_p.add_argument("--out", required=True, help="output directory (replaced atomically)")
     study_p.add_argument("--quick", action="store_true",
-                         help="a few points only (for CI): 2 drake_dock accuracies, 3 compliant")
+                         help="a few points only (for CI)")
     args = parser.parse_args(argv)
     if args.command == "study":
         return _study(args)
@@ -105,14 +106,23 @@ def _guarded(work, out) -> int:
 
 def _study(args) -> int:
     from drake_dock.scenario import load_scenario
-    from drake_dock.study import StudyPlan, run_study, speedup_lines, write_study
+    if args.which == "stability":
+        from drake_dock.stability import StabilityPlan as Plan
+        from drake_dock.stability import run_stability as run_plan
+        from drake_dock.stability import summary_lines as lines
+        from drake_dock.stability import write_stability as write
+    else:
+        from drake_dock.study import StudyPlan as Plan
+        from drake_dock.study import run_study as run_plan
+        from drake_dock.study import speedup_lines as lines
+        from drake_dock.study import write_study as write
 
     def work():
         scenario = load_scenario(args.scenario)
-        plan = StudyPlan.quick() if args.quick else StudyPlan.full()
-        result = run_study(scenario, plan, log=lambda s: print(s, flush=True))
-        write_study(result, args.out)
-        return speedup_lines(result)
+        result = run_plan(scenario, Plan.quick() if args.quick else Plan.full(),
+                          log=lambda s: print(s, flush=True))
+        write(result, args.out)
+        return lines(result)
     return _guarded(work, args.out)
 
 

@@ -43,6 +43,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+from time import perf_counter as _perf
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -148,6 +149,34 @@ class ContactModes:
     impacts: list = dataclasses.field(default_factory=list)   # dicts: t, couples, impulses
     impact_loss: float = 0.0
     mode_changes: int = 0
+
+
+@dataclasses.dataclass
+class Timing:
+    """Where a run's wall time goes (cumulative, seconds; reset with `reset`): seeking (Sect. 5.1,
+    the hierarchical grid and Newton, per pair with the number of seeks), contact dynamics
+    (every derivative evaluation: couple tracking, Eq. 47, the constraint forces) and impacts
+    (LZB and the mode selection at events). Only the declared pairs are ever searched."""
+
+    pairs: list
+    seeking: float = 0.0
+    contact_dynamics: float = 0.0
+    impacts: float = 0.0
+    seeks: dict = dataclasses.field(default_factory=dict)
+
+    def reset(self):
+        self.seeking = self.contact_dynamics = self.impacts = 0.0
+        self.seeks = {}
+
+    def shares(self, wall_time: float) -> dict:
+        """The three parts and the rest (Drake's integrator, witnesses, logging) as fractions of
+        ``wall_time``, with the pairs declared and the seeks per pair."""
+        parts = {"seeking": self.seeking, "contact_dynamics": self.contact_dynamics,
+                 "impacts": self.impacts}
+        out = {k: v / wall_time for k, v in parts.items()}
+        out["other"] = max(0.0, 1.0 - sum(out.values()))
+        return {"wall_time": wall_time, "shares": out, "pairs_declared": len(self.pairs),
+                "seeks_per_pair": {n: self.seeks.get(n, 0) for n in self.pairs}}
 
 
 @dataclasses.dataclass
@@ -273,6 +302,7 @@ class RigidContactSystem(LeafSystem):
                                                   lambda c, i=i: self._w_clear(c, i), ev)})
         self._memo = None
         self.evaluations = 0
+        self.timing = Timing([p.name for p in pairs])
 
     # ------------------------------------------------------------------ user helpers
     def SetPositionsAndVelocities(self, context, q, v):
@@ -366,6 +396,13 @@ class RigidContactSystem(LeafSystem):
         return M, Minv, Minv @ (tau_el + tau_in - bias), float(tau_el @ v), float(tau_in @ v)
 
     def _calc_eval(self, context, value):
+        t0 = _perf()
+        try:
+            self._calc_eval_timed(context, value)
+        finally:
+            self.timing.contact_dynamics += _perf() - t0
+
+    def _calc_eval_timed(self, context, value):
         self.evaluations += 1
         t = context.get_time()
         x = context.get_continuous_state_vector().CopyToVector()
@@ -587,6 +624,15 @@ class RigidContactSystem(LeafSystem):
 
     def _seek(self, i, poses, modes, u, time, was_contact):
         """Sect. 5.1 for pair i, and the status that follows (module docstring)."""
+        t0 = _perf()
+        try:
+            self._seek_timed(i, poses, modes, u, time, was_contact)
+        finally:
+            self.timing.seeking += _perf() - t0
+            name = self.pairs[i].name
+            self.timing.seeks[name] = self.timing.seeks.get(name, 0) + 1
+
+    def _seek_timed(self, i, poses, modes, u, time, was_contact):
         p = self.pairs[i]
         a, b = self._fidx[i]
         st = modes.pairs[i]
@@ -689,7 +735,14 @@ class RigidContactSystem(LeafSystem):
                                      impact_loss_plus=modes.impact_loss)
         return x_new, modes
 
-    def _impacts_and_modes(self, context, t, modes, ctx, poses, twists, q, v, u):
+    def _impacts_and_modes(self, *args):
+        t0 = _perf()
+        try:
+            return self._impacts_and_modes_timed(*args)
+        finally:
+            self.timing.impacts += _perf() - t0
+
+    def _impacts_and_modes_timed(self, context, t, modes, ctx, poses, twists, q, v, u):
         opt = self.options
         evs = {}
 

@@ -68,4 +68,16 @@ def format_summary(s) -> str:
         f"impacts {led['dissipated_impacts_J']:.6g} J; ledger closure "
         f"{led['closure_error_relative']:.2e}",
         f"wall time {s['wall_time_s']:.2f} s for {s['end_time_s']:.4f} s simulated "
-        f"({s['derivative_evaluations']} derivative evaluations)"])
+        f"({s['derivative_evaluations']} derivative evaluations)",
+        time_shares_line(s["time_shares"])])
+
+
+def time_shares_line(ts) -> str:
+    """One line: the share of wall time spent seeking, in contact dynamics, in impacts and
+    elsewhere, and the pairs searched (declared pairs and seeks)."""
+    sh = ts["shares"]
+    seeks = ts["seeks_per_pair"]
+    return (f"time shares: seeking {sh['seeking']:.0%}, contact dynamics "
+            f"{sh['contact_dynamics']:.0%}, impacts {sh['impacts']:.0%}, other {sh['other']:.0%};"
+            f" pairs searched {sum(1 for n in seeks.values() if n)}/{ts['pairs_declared']} "
+            f"declared, {sum(seeks.values())} seeks")

@@ -8,7 +8,8 @@ length (about 900 derivative evaluations per event in the docking example at w =
 
 `WitnessApproach` is a simulator monitor that shortens the next step instead: after each step it
 predicts every witness's zero by the secant through its last two values and the parabola
-through its last three (same epoch, see below; the earlier of the two) and caps the integrator's step so that the step ends w/2 before the earliest predicted
+through its last three (same epoch, see below; the earlier of the two) and caps the
+integrator's step so that the step ends w/2 before the earliest predicted
 zero; once within w, the step is capped at 2 w, so that it crosses the zero and a single
 bisection isolates it. The secant converges superlinearly, so a zero is reached in a few
 steps. Events, their times and the integration's error control are Drake's own; only the

@@ -69,6 +69,20 @@ class StudyPlan:
         return StudyPlan((1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8), 1e-10, c, wall_limit=90.0)
 
 
+def rigid_chaser_force(result):
+    """(t, F): the net contact force on the chaser [N, 3] at the samples of a drake_dock
+    `RunResult`, from the couples' lambda_n, lambda_t and frames."""
+    rec = result.record
+    sign = np.array([1.0 if p.body1 == CHASER_APDS else -1.0
+                     for p in apds_pairs(result.scenario.geometry)])
+    t = np.asarray(rec.t)
+    C = np.asarray(rec.couples)
+    frames = C[:, :, COUPLE_SLICES["frame"]].reshape(len(t), -1, 3, 3)
+    lam = np.concatenate([C[:, :, COUPLE_SLICES["lambda_t"]],
+                          C[:, :, COUPLE_SLICES["lambda_n"]]], axis=2)
+    return t, np.einsum("c,kcxy,kcy->kx", sign, frames, lam)
+
+
 def rigid_metrics(result, e3) -> dict:
     """The four metrics of a drake_dock `RunResult` (module docstring)."""
     if not result.captured:
@@ -80,14 +94,7 @@ def rigid_metrics(result, e3) -> dict:
     b = result.dd.dp.bodies
     v_c = plant.EvalBodySpatialVelocityInWorld(pc, b["chaser"]).translational()
     w_a = plant.EvalBodySpatialVelocityInWorld(pc, b["target_apds"]).rotational()
-    sign = np.array([1.0 if p.body1 == CHASER_APDS else -1.0
-                     for p in apds_pairs(result.scenario.geometry)])
-    t = np.asarray(rec.t)
-    C = np.asarray(rec.couples)
-    frames = C[:, :, COUPLE_SLICES["frame"]].reshape(len(t), -1, 3, 3)
-    lam = np.concatenate([C[:, :, COUPLE_SLICES["lambda_t"]],
-                          C[:, :, COUPLE_SLICES["lambda_n"]]], axis=2)
-    F = np.einsum("c,kcxy,kcy->kx", sign, frames, lam)        # net force on the chaser
+    t, F = rigid_chaser_force(result)
     t_c = result.capture_time
     # The window's start falls between samples: the force there is interpolated linearly
     # (a sample-dependent start would make the peak depend on the step sequence).

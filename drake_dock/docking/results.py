@@ -140,5 +140,6 @@ def summary(result, ts: dict) -> dict:
         "mode_changes": result.mode_changes,
         "derivative_evaluations": result.evaluations,
         "wall_time_s": result.wall_time,
+        "time_shares": result.timing,
     }
 

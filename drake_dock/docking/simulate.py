@@ -53,6 +53,7 @@ class RunResult:
     end_time: float
     wall_time: float           # seconds in Simulator.Initialize + AdvanceTo (build excluded)
     evaluations: int
+    timing: dict | None = None  # `Timing.shares`: seeking / contact dynamics / impacts / other
 
 
 def make_simulator(dd: DockingDiagram, scenario, state: InitialState) -> Simulator:
@@ -144,6 +145,7 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
         return EventStatus.Succeeded()
 
     evals0 = dd.contact.evaluations
+    dd.contact.timing.reset()
     wall0 = _time.perf_counter()
     sim.Initialize()
     root = sim.get_context()
@@ -156,7 +158,7 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
     modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
     return RunResult(scenario, dd, state, rec.record, list(modes.impacts), modes.mode_changes,
                      captured, root.get_time() if captured else None, root.get_time(), wall,
-                     dd.contact.evaluations - evals0)
+                     dd.contact.evaluations - evals0, dd.contact.timing.shares(wall))
 
 
 __all__ = ["simulate", "make_simulator", "RunResult", "Record", "STEP", "PRE_IMPACT",
