@@ -127,6 +127,8 @@ class ContactOptions:
     zeno_speed: float = 1e-3         # m/s: the Zeno guard (see the module docstring)
     impact_gap_tol: float = 1e-8     # m: couples this near join an impact
     impact_rtol: float = 1e-10
+    seek_rtol: float = 1e-7          # a seek's Newton ends when its next step would shorten the
+                                     # distance by less than this fraction (`seek_couple`)
     max_impacts: int = 10000
 
 
@@ -149,6 +151,14 @@ class ContactModes:
     impacts: list = dataclasses.field(default_factory=list)   # dicts: t, couples, impulses
     impact_loss: float = 0.0
     mode_changes: int = 0
+
+    def __deepcopy__(self, memo):
+        """Copies that events may change: the pair states are copied (their arrays are
+        replaced, never written in place); the impact log's entries are never changed once
+        logged, so the log is copied as a list of the same entries (Drake clones the abstract
+        state at every event; a deep copy of the growing log dominated event handling)."""
+        return ContactModes([dataclasses.replace(st) for st in self.pairs], list(self.impacts),
+                            self.impact_loss, self.mode_changes)
 
 
 @dataclasses.dataclass
@@ -301,6 +311,7 @@ class RigidContactSystem(LeafSystem):
                 "clear": self.MakeWitnessFunction(f"{p.name} clearance", down,
                                                   lambda c, i=i: self._w_clear(c, i), ev)})
         self._memo = None
+        self._eval_memo = {}
         self.evaluations = 0
         self.timing = Timing([p.name for p in pairs])
 
@@ -395,10 +406,40 @@ class RigidContactSystem(LeafSystem):
         Minv = np.linalg.inv(M)
         return M, Minv, Minv @ (tau_el + tau_in - bias), float(tau_el @ v), float(tau_in @ v)
 
+    #: evaluations kept for reuse (see `_calc_eval`)
+    eval_memo_size = 4
+
+    def _eval_key(self, context):
+        """Everything an evaluation depends on: time, continuous state, the modes object (its
+        identity, held by the memo so that it cannot be reused, and its version) and the
+        inputs."""
+        modes = self.get_modes(context)
+        key = [context.get_time(), context.get_continuous_state_vector().CopyToVector().tobytes(),
+               id(modes), modes.mode_changes]
+        if self._gf_port.HasValue(context):
+            key.append(self._gf_port.Eval(context).tobytes())
+        for _, port in self._wrench_ports.values():
+            if port.HasValue(context):
+                key.append(port.Eval(context).tobytes())
+        return tuple(key), modes
+
     def _calc_eval(self, context, value):
+        """Drake's cache recomputes an evaluation whenever the context's state is written, even
+        with the same values (the integrator restores a step's initial state before the step,
+        and the witness isolation restores it before each re-integration): about a quarter of
+        the requests in the docking example. The last few evaluations are kept by their full
+        dependencies (`_eval_key`) and reused."""
         t0 = _perf()
         try:
+            key, modes = self._eval_key(context)
+            hit = self._eval_memo.get(key)
+            if hit is not None:
+                value.set_value(hit[0])
+                return
             self._calc_eval_timed(context, value)
+            if len(self._eval_memo) >= self.eval_memo_size:
+                self._eval_memo.pop(next(iter(self._eval_memo)))
+            self._eval_memo[key] = (value.get_value(), modes)
         finally:
             self.timing.contact_dynamics += _perf() - t0
 
@@ -497,8 +538,18 @@ class RigidContactSystem(LeafSystem):
                                           x[self.ie + 3:]]))
 
     def _out_couple(self, context, out, i):
+        out.SetFromVector(self._couple_row(context, self._cache.Eval(context),
+                                           self.get_modes(context).pairs[i], i))
+
+    def couple_table(self, context) -> np.ndarray:
+        """All couples' outputs at once, row i the value of port ``couple_<pairs[i].name>``
+        (for loggers: one call instead of one port evaluation per couple)."""
         E = self._cache.Eval(context)
-        st = self.get_modes(context).pairs[i]
+        modes = self.get_modes(context)
+        return np.stack([self._couple_row(context, E, st, i)
+                         for i, st in enumerate(modes.pairs)])
+
+    def _couple_row(self, context, E, st, i):
         y = np.zeros(COUPLE_OUTPUT_SIZE)
         ev = E.evals[i]
         S = COUPLE_SLICES
@@ -510,8 +561,9 @@ class RigidContactSystem(LeafSystem):
             n1 = p.patch1.dim
             y[S["gap"]] = st.distance - self._bound(E, i, st)
             y[S["u"]][:len(u)] = u
-            y[S["p1"]] = posed(p.patch1, *E.poses[a]).position(u[:n1])
-            y[S["p2"]] = posed(p.patch2, *E.poses[b]).position(u[n1:])
+            for sl, patch, (R, o), uk in ((S["p1"], p.patch1, E.poses[a], u[:n1]),
+                                          (S["p2"], p.patch2, E.poses[b], u[n1:])):
+                y[sl] = R @ np.array(patch.jet([float(c) for c in uk])[0]) + o
             y[S["frame"]] = np.eye(3).ravel()
         else:
             y[S["status"]] = st.status + (1 if st.status == CONTACT and st.stick else 0)
@@ -521,7 +573,7 @@ class RigidContactSystem(LeafSystem):
             y[S["u"]][:len(ev.u)] = ev.u
             y[S["p1"]], y[S["p2"]] = ev.p1, ev.p2
             y[S["frame"]] = ev.frame.ravel()
-        out.SetFromVector(y)
+        return y
 
     # ------------------------------------------------------------------ witnesses
     def DoGetWitnessFunctions(self, context):
@@ -638,7 +690,7 @@ class RigidContactSystem(LeafSystem):
         st = modes.pairs[i]
         P1, P2 = posed(p.patch1, *poses[a]), posed(p.patch2, *poses[b])
         try:
-            c = seek_couple(P1, P2)
+            c = seek_couple(P1, P2, distance_rtol=self.options.seek_rtol)
         except SeekingError as e:
             raise SeekingError(str(e), time=time, couples=[p.name]) from None
         R1, p1 = poses[a]

@@ -161,6 +161,7 @@ class _Problem:
         self.rate = np.ones(s)           # dx/dtau = -rate * u_n
         self.x_end = np.zeros(s)         # expansion ends at x = x_end
         self.stuck = np.zeros(s, dtype=bool)
+        self.v_tiny = 1e-12              # |u_t| (scaled velocity) below which a couple is at rest
         self.slip_dir = np.zeros((s, 2))
         self.wc = np.zeros(s)            # compression work, summed over episodes
         # State: x (s), u (nu: normal then tangential pairs), P (nu), W_comp (s), W_exp (s),
@@ -194,9 +195,11 @@ class _Problem:
             slip = loaded & ~self.stuck
             if slip.any():
                 nt = np.linalg.norm(ut[slip], axis=1)
-                # At |u_t| = 0 (slip just started from rest) the slip direction is the one set
-                # by the stick-to-slip transition.
-                d = np.where(nt[:, None] > 0, ut[slip] / np.where(nt > 0, nt, 1.0)[:, None],
+                # Near |u_t| = 0 (slip just started from rest) the slip direction is the one
+                # set by the stick-to-slip transition: the direction of a round-off-sized u_t
+                # is noise, and following it makes the force chatter.
+                big = nt > self.v_tiny
+                d = np.where(big[:, None], ut[slip] / np.where(big, nt, 1.0)[:, None],
                              self.slip_dir[slip])
                 lam_t[slip] = -self.mu[slip, None] * lam_n[slip, None] * d
             stick = loaded & self.stuck
@@ -271,34 +274,67 @@ class _Problem:
             g[1][st] = self.mu_s[st] * lam_n[st] - np.linalg.norm(lam_t[st], axis=1)
         return g
 
-    def set_friction_mode(self, y, j, events, impulse):
-        """At the start of loading of couple j or when its slip stops: stick if the sticking
-        force lies in the static cone, else slip along -(sticking force)."""
+    def _probe_loads(self, y):
+        """Normal forces for the friction-mode test: the current ones, or, when no couple is
+        loaded yet (the instant of loading), their ratio as loading starts: couples closing at
+        rates -u_n load as lambda = kappa (-u_n tau)^eta (Eq. 28)."""
         s = self.s
-        ut = y[self.iu][s:].reshape(s, 2)[j]
-        nrm = np.linalg.norm(ut)
-        scale = np.abs(y[self.iu]).max()
-        if nrm > 1e-12 * max(scale, 1e-300):
+        x, un = y[self.ix], y[self.iun]
+        lam_n = np.where(x > 0, self.kappa * np.maximum(x, 0.0) ** self.eta, 0.0)
+        if not (lam_n > 0).any():
+            loading = (x >= 0) & (un < 0) & (self.phase == _COMP)
+            lam_n = np.where(loading, self.kappa * np.maximum(-un, 0.0) ** self.eta, 0.0)
+        return lam_n
+
+    def select_friction_modes(self, y, js, events, impulse):
+        """Stick or slip for the couples ``js`` (loaded or loading, Eq. 27), decided jointly
+        with the couples that stick now, since their sticking forces depend on each other: a
+        couple that moves tangentially slips along its motion; the couples at rest all stick
+        if the tangential forces that keep them at rest lie in their static cones; otherwise
+        the one furthest outside its cone slips, along minus its sticking force, and the rest
+        are tested again (at most s rounds). Testing one couple at a time, with the others'
+        loads not yet counted, made three feet landing together slip and stick in turn without
+        end."""
+        s = self.s
+        ut = y[self.iu][s:].reshape(s, 2)
+        scale = max(np.abs(y[self.iu]).max(), 1e-300)
+        lam_n = self._probe_loads(y)
+        was = self.stuck.copy()
+        rest = []
+        for j in js:
+            if np.linalg.norm(ut[j]) > 1e-12 * scale:
+                self.stuck[j] = False
+                self.slip_dir[j] = ut[j] / np.linalg.norm(ut[j])
+            else:
+                rest.append(j)
+        cand = sorted(set(rest) | {j for j in np.flatnonzero(self.stuck) if lam_n[j] > 0
+                                   or j in js})
+        for j in cand:
+            y[self.iu][s + 2 * j: s + 2 * j + 2] = 0.0
+            self.stuck[j] = True
+        while cand:
+            mask = np.zeros(s, dtype=bool)
+            mask[cand] = True
+            lam_t = np.zeros((s, 2))
+            slip = (lam_n > 0) & ~mask
+            lam_t[slip] = -self.mu[slip, None] * lam_n[slip, None] * self.slip_dir[slip]
+            lt = self._stick_forces(lam_n, lam_t, mask)
+            norm = np.linalg.norm(lt, axis=1)
+            cone = self.mu_s[cand] * lam_n[cand]
+            excess = norm - cone * (1 + 1e-12)
+            # A couple at zero load sticks only with zero force (to round-off of the loads).
+            excess = np.where(cone > 0, excess, norm - 1e-12 * max(lam_n.max(), 1e-300))
+            k = int(np.argmax(excess / np.maximum(cone, 1e-300)))
+            if excess[k] <= 0:
+                break
+            j = cand.pop(k)
             self.stuck[j] = False
-            self.slip_dir[j] = ut / nrm
-            return
-        y[self.iu][s + 2 * j: s + 2 * j + 2] = 0.0
-        lam_n, lam_t = self.forces(y)
-        probe = lam_n.copy()
-        if probe[j] <= 0:   # at the instant of loading: the ratio at a unit load
-            probe[j] = self.kappa[j]
-        mask = np.zeros(s, dtype=bool)
-        mask[j] = True
-        was = self.stuck[j]
-        self.stuck[j] = True
-        lt = self._stick_forces(probe, lam_t, mask)[0]
-        if np.linalg.norm(lt) <= self.mu_s[j] * probe[j] * (1 + 1e-12):
-            if not was:
+            self.slip_dir[j] = -lt[k] / norm[k]
+        for j in sorted(set(js) | set(np.flatnonzero(was != self.stuck))):
+            if self.stuck[j] and not was[j]:
                 events.append(ImpactEvent(impulse, "stick", j))
-            return
-        self.stuck[j] = False
-        self.slip_dir[j] = -lt / np.linalg.norm(lt)
-        events.append(ImpactEvent(impulse, "slip" if was else "slip_reversal", j))
+            elif not self.stuck[j] and np.linalg.norm(ut[j]) <= 1e-12 * scale:
+                events.append(ImpactEvent(impulse, "slip" if was[j] else "slip_reversal", j))
 
     def apply_event(self, y, kind, j, events, impulse):
         s = self.s
@@ -326,22 +362,31 @@ class _Problem:
                 x[j] = 0.0
                 events.append(ImpactEvent(impulse, "re_impact", j))
                 if self.friction:
-                    self.set_friction_mode(y, j, events, impulse)
+                    self.select_friction_modes(y, [j], events, impulse)
             else:
                 self._end(y, j, events, impulse)
         else:
             if self.stuck[j]:
+                # The sticking force reached the static cone: slip along minus it (the others
+                # that stick are decided again with it).
+                lam_n = self._probe_loads(y)
+                mask = self.stuck & ((lam_n > 0) | (np.arange(s) == j))
+                lam_t = np.zeros((s, 2))
+                slip = (lam_n > 0) & ~mask
+                lam_t[slip] = -self.mu[slip, None] * lam_n[slip, None] * self.slip_dir[slip]
+                lt = self._stick_forces(lam_n, lam_t, mask)[list(np.flatnonzero(mask)).index(j)]
                 self.stuck[j] = False
-                lam_n, lam_t = self.forces(y)
-                self.stuck[j] = True
-                self.set_friction_mode(y, j, events, impulse)
-                if self.stuck[j]:   # numerically on the cone: slip along the cone boundary
-                    self.stuck[j] = False
+                if np.linalg.norm(lt) > 0:
+                    self.slip_dir[j] = -lt / np.linalg.norm(lt)
+                events.append(ImpactEvent(impulse, "slip", j))
+                others = [k for k in np.flatnonzero(self.stuck) if k != j]
+                if others:
+                    self.select_friction_modes(y, others, events, impulse)
             else:
                 ut = y[self.iu][s:].reshape(s, 2)[j]
                 scale = np.abs(y[self.iu]).max()
                 if np.linalg.norm(ut) <= 1e-9 * scale:
-                    self.set_friction_mode(y, j, events, impulse)
+                    self.select_friction_modes(y, [j], events, impulse)
                 else:  # the slip direction turned by more than 90 deg: follow it
                     self.slip_dir[j] = ut / np.linalg.norm(ut)
 
@@ -432,9 +477,8 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     events = []
     y = prob.y0.copy()
     if friction:
-        for j in range(s):
-            if x0[j] > 0 or un0[j] < 0:
-                prob.set_friction_mode(y, j, events, 0.0)
+        prob.select_friction_modes(y, [j for j in range(s) if x0[j] > 0 or un0[j] < 0],
+                                   events, 0.0)
     steps = 0
     primary = []
     history = []

@@ -389,3 +389,41 @@ def test_symmetric_couples_ending_together_stay_symmetric(e, mu):
         np.testing.assert_allclose(P, P.mean(), rtol=1e-9)
         np.testing.assert_allclose(r.v_plus[[0, 1, 3, 4]], 0.0, atol=1e-9)
     np.testing.assert_allclose(res[0].normal_impulse, res[1].normal_impulse, rtol=1e-6)
+
+
+def _stool(r=0.25, h=0.25):
+    """A three-footed stool (generalized velocity [w, v]) standing on a plane z = 0: feet at
+    radius r, 120 deg apart, h below the mass centre; normals +z, tangents x and y."""
+    M = np.diag([0.1, 0.1, 0.15, 3.0, 3.0, 3.0])
+    Wn, Wt = [], []
+    ez = np.array([0.0, 0.0, 1.0])
+    for k in range(3):
+        th = 2 * np.pi * k / 3
+        p = np.array([r * np.cos(th), r * np.sin(th), -h])
+        Wn.append(np.concatenate([np.cross(p, ez), ez]))
+        for t in (np.array([1.0, 0, 0]), np.array([0, 1.0, 0])):
+            Wt.append(np.concatenate([np.cross(p, t), t]))
+    return M, np.array(Wn).T, np.array(Wt).T
+
+
+@pytest.mark.parametrize("e", [0.0, 0.5])
+@pytest.mark.parametrize("mu", [0.3, 1.0])
+def test_three_feet_landing_together_with_friction(e, mu):
+    """A stool dropped flat lands on three feet at once. With friction the feet must be decided
+    together: each foot alone would need a tangential force (its load tips the stool), but with
+    the three loads together none is needed, so all stick. Deciding one foot at a time made the
+    feet slip and stick in turn without end (the impact never finished). Closed form: the stool
+    only translates, P_j = (1 + e) m |v| / 3, v+ = -e v, no tangential impulse; the result does
+    not depend on the order of the couples."""
+    M, Wn, Wt = _stool()
+    v = np.array([0, 0, 0, 0, 0, -0.14])
+    res = solve_lzb(M, Wn, v, 1e9, 1.5, e, Wt=Wt, mu=mu, rtol=1e-10, max_steps=5000)
+    np.testing.assert_allclose(res.normal_impulse, (1 + e) * 3.0 * 0.14 / 3, rtol=1e-8)
+    np.testing.assert_allclose(res.tangential_impulse, 0.0, atol=1e-10)
+    np.testing.assert_allclose(res.v_plus, -e * v, atol=1e-10)
+    assert [ev.kind for ev in res.events[:3]] == ["stick"] * 3
+    perm = [2, 0, 1]
+    tperm = np.ravel([[2 * j, 2 * j + 1] for j in perm])
+    res2 = solve_lzb(M, Wn[:, perm], v, 1e9, 1.5, e, Wt=Wt[:, tperm], mu=mu, rtol=1e-10,
+                     max_steps=5000)
+    np.testing.assert_allclose(res2.normal_impulse, res.normal_impulse[perm], rtol=1e-10)

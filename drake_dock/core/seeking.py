@@ -91,11 +91,15 @@ def hierarchical_seek(P1, P2, *, n_coarse=12, levels=2, n_fine=21, candidates=3)
     return out
 
 
-def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50):
+def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None):
     """Bounded Newton on f(u) = 0.5 |r1(u1) - r2(u2)|^2 from (u1, u2).
 
     Returns (u1, u2, iterations). Parameters at a domain end with the gradient pushing outwards
-    are held (active set); periodic parameters are wrapped."""
+    are held (active set); periodic parameters are wrapped. With ``distance_rtol`` the
+    iteration also ends when the next step would shorten the distance by less than that
+    fraction of it: a caller that needs the distance, not the couple, stops early in a flat
+    valley (a ring nearly coaxial with a cone), where the couple walks along the valley for
+    many iterations while the distance changes in its seventh digit."""
     n1 = P1.patch.dim
     u = np.concatenate([u1, u2]).astype(float)
     lower = np.concatenate([P1.patch.lower, P2.patch.lower])
@@ -169,6 +173,9 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50):
         f0 = 0.5 * d @ d
         if -(g @ step) <= 1e-15 * f0:
             break
+        # df = |d| d|d|: the predicted shortening of the distance by this step.
+        if distance_rtol is not None and on_bounds and -(g @ step) <= distance_rtol * 2.0 * f0:
+            break
         t = 1.0
         while True:
             un = u + t * step
@@ -199,11 +206,13 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50):
     return u[:n1], u[n1:], it
 
 
-def seek_couple(P1, P2, **grid_options) -> Couple:
-    """The couple of minimal distance between posed patches P1 and P2 (Sect. 5.1)."""
+def seek_couple(P1, P2, *, distance_rtol=None, **grid_options) -> Couple:
+    """The couple of minimal distance between posed patches P1 and P2 (Sect. 5.1); with
+    ``distance_rtol`` the Newton finish ends once the distance has converged to that fraction
+    (see `newton_closest`)."""
     best = None
     for u1, u2 in hierarchical_seek(P1, P2, **grid_options):
-        u1, u2, it = newton_closest(P1, P2, u1, u2)
+        u1, u2, it = newton_closest(P1, P2, u1, u2, distance_rtol=distance_rtol)
         p1, p2 = P1.position(u1), P2.position(u2)
         dist = float(np.linalg.norm(p1 - p2))
         if best is None or dist < best.distance:

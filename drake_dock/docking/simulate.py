@@ -77,7 +77,6 @@ class _Recorder:
         self.n_impacts = 0
         self._scratch = dd.diagram.CreateDefaultContext()
         d = dd.diagram
-        self._ports = [d.GetOutputPort(f"couple_{p.name}") for p in dd.contact.pairs]
         self._state = d.GetOutputPort("state")
         self._energy = d.GetOutputPort("energy")
         self._ring = d.GetOutputPort("ring_distance")
@@ -86,7 +85,8 @@ class _Recorder:
         r = self.record
         r.t.append(context.get_time())
         r.x.append(self._state.Eval(context).copy())
-        r.couples.append(np.stack([p.Eval(context) for p in self._ports]))
+        contact = self.dd.contact
+        r.couples.append(contact.couple_table(contact.GetMyContextFromRoot(context)))
         r.energy.append(self._energy.Eval(context).copy())
         r.ring_distance.append(float(self._ring.Eval(context)[0]))
         r.kind.append(kind)
