@@ -122,13 +122,17 @@ class ContactOptions:
     drift_tol: float = 1e-3          # largest projection step, relative to the domain span
     track_distance: float = 0.02     # m: nearer interior isolated couples are tracked
     reseek_floor: float = 1e-4       # m: smallest relative travel between two re-seeks
+    reseek_early: float = 0.75       # far pairs are sought again at the first step start where
+                                     # this fraction of their clearance is used (0: never)
     conditioning_min: float = 1e-6   # |det J| / prod(row norms) below which J is singular
     v_slip: float = 1e-6             # m/s: a couple slower than this may stick
     zeno_speed: float = 1e-3         # m/s: the Zeno guard (see the module docstring)
     impact_gap_tol: float = 1e-8     # m: couples this near join an impact
     impact_rtol: float = 1e-10
-    seek_rtol: float = 1e-7          # a seek's Newton ends when its next step would shorten the
-                                     # distance by less than this fraction (`seek_couple`)
+    seek_rtol: float = 1e-7          # a seek's Newton ends when a step shortens the distance
+                                     # by less than this fraction, for pairs farther than
+                                     # track_distance (`seek_couple`): their distance only sets
+                                     # the clearance, which keeps track_distance / 2 in hand
     max_impacts: int = 10000
 
 
@@ -290,6 +294,8 @@ class RigidContactSystem(LeafSystem):
         self.DeclareInitializationUnrestrictedUpdateEvent(
             lambda context, state: self._on_event(context, None, state))
         ev = UnrestrictedUpdateEvent(self._on_event)
+        if options.reseek_early > 0:
+            self.DeclarePerStepUnrestrictedUpdateEvent(self._on_step)
         down = WitnessFunctionDirection.kPositiveThenNonPositive
         self._w = []
         for i, p in enumerate(pairs):
@@ -407,7 +413,7 @@ class RigidContactSystem(LeafSystem):
         return M, Minv, Minv @ (tau_el + tau_in - bias), float(tau_el @ v), float(tau_in @ v)
 
     #: evaluations kept for reuse (see `_calc_eval`)
-    eval_memo_size = 4
+    eval_memo_size = 16
 
     def _eval_key(self, context):
         """Everything an evaluation depends on: time, continuous state, the modes object (its
@@ -621,11 +627,16 @@ class RigidContactSystem(LeafSystem):
         return 1.0 if ev is None else ev.gap
 
     def _w_apex(self, context, i):
-        """The gap rate: a couple that separates and closes again within one integration step
-        would leave the gap's sign unchanged at the step's ends (a missed impact); stopping at
-        the gap's maximum (the apex) prevents that."""
+        """The gap rate while the gap is not positive, else 1. Just after an impact the gap is
+        at or below zero (the impact is isolated to within Drake's window), so the gap witness
+        cannot trigger; a couple that closes again before its gap has become positive would be
+        missed. This witness triggers if it turns back (v_n reaches zero) while the gap is still
+        not positive. Once the gap is positive the gap witness takes over: the value jumps from
+        v_n > 0 to 1 (no trigger) on the way out, and from 1 to v_n < 0 on the way back, at the
+        gap's zero, together with the gap witness. (Stopping at every bounce's apex cost an
+        isolated event each.)"""
         ev = self._cache.Eval(context).evals[i]
-        return 1.0 if ev is None else ev.vn
+        return 1.0 if ev is None or ev.gap > 0.0 else ev.vn
 
     def _w_end(self, context, i):
         ev = self._cache.Eval(context).evals[i]
@@ -664,11 +675,25 @@ class RigidContactSystem(LeafSystem):
         return float(st.clearance - self._bound(self._cache.Eval(context), i, st))
 
     # ------------------------------------------------------------------ events
-    def _on_event(self, context, event, state):
+    def _on_step(self, context, state):
+        """Per-step event: far pairs whose travel bound has used ``reseek_early`` of their
+        clearance are sought again at the start of this step (with every other transition due,
+        as at a witness event). The clearance witness stays the guarantee; sought a little
+        early, a pair needs no isolated event (each cost about 30 derivative evaluations)."""
+        modes = self.get_modes(context)
+        E = self._cache.Eval(context)
+        early = self.options.reseek_early
+        if not any(st.status == FAR and st.ref_X21 is not None
+                   and self._bound(E, i, st) >= early * st.clearance
+                   for i, st in enumerate(modes.pairs)):
+            return EventStatus.DidNothing()
+        return self._on_event(context, None, state, early=early)
+
+    def _on_event(self, context, event, state, early=1.0):
         x = context.get_continuous_state_vector().CopyToVector()
         key = (context.get_time(), x.tobytes(), self.get_modes(context).mode_changes)
         if self._memo is None or self._memo[0] != key:
-            self._memo = (key,) + self._resolve(context, x)
+            self._memo = (key,) + self._resolve(context, x, early)
         _, x_new, modes_new = self._memo
         state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(x_new)
         state.get_mutable_abstract_state(self._mode_index).set_value(copy.deepcopy(modes_new))
@@ -690,7 +715,8 @@ class RigidContactSystem(LeafSystem):
         st = modes.pairs[i]
         P1, P2 = posed(p.patch1, *poses[a]), posed(p.patch2, *poses[b])
         try:
-            c = seek_couple(P1, P2, distance_rtol=self.options.seek_rtol)
+            c = seek_couple(P1, P2, distance_rtol=self.options.seek_rtol,
+                            rtol_beyond=self.options.track_distance)
         except SeekingError as e:
             raise SeekingError(str(e), time=time, couples=[p.name]) from None
         R1, p1 = poses[a]
@@ -737,8 +763,9 @@ class RigidContactSystem(LeafSystem):
                 st.clearance = max(0.5 * c.distance, opt.reseek_floor)
         st.stick, st.slide_dir = False, None
 
-    def _resolve(self, context, x):
-        """All the transitions due at this state (module docstring); returns (x, modes)."""
+    def _resolve(self, context, x, early=1.0):
+        """All the transitions due at this state (module docstring); returns (x, modes). Far
+        pairs are sought again when their travel bound reaches ``early`` x their clearance."""
         t = context.get_time()
         opt = self.options
         modes = copy.deepcopy(self.get_modes(context))
@@ -754,7 +781,7 @@ class RigidContactSystem(LeafSystem):
         for i, st in enumerate(modes.pairs):
             sl = slice(self._uoff[i], self._uoff[i + 1])
             if initial or (st.status == FAR and self._travel_bound(i, poses, st)
-                           >= st.clearance):
+                           >= early * st.clearance):
                 self._seek(i, poses, modes, u, t, False)
                 continue
             if st.status == FAR:

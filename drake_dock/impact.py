@@ -162,6 +162,7 @@ class _Problem:
         self.x_end = np.zeros(s)         # expansion ends at x = x_end
         self.stuck = np.zeros(s, dtype=bool)
         self.v_tiny = 1e-12              # |u_t| (scaled velocity) below which a couple is at rest
+        self._stick_cache = {}
         self.slip_dir = np.zeros((s, 2))
         self.wc = np.zeros(s)            # compression work, summed over episodes
         # State: x (s), u (nu: normal then tangential pairs), P (nu), W_comp (s), W_exp (s),
@@ -211,12 +212,17 @@ class _Problem:
         """Tangential force rates that keep u_t = 0 on the sticking couples (Eq. 27, second
         line): G_SS lam_S = -(G_Sn lam_n + G_S,slip lam_slip)."""
         s = self.s
-        idx = np.concatenate([[s + 2 * j, s + 2 * j + 1] for j in np.flatnonzero(stick)])
-        lam = np.concatenate([lam_n, lam_t.ravel()])
-        lam[idx] = 0.0
-        rhs = -self.G[idx] @ lam
-        sol = np.linalg.lstsq(self.G[np.ix_(idx, idx)], rhs, rcond=1e-12)[0]
-        return sol.reshape(-1, 2)
+        key = stick.tobytes()
+        hit = self._stick_cache.get(key)
+        if hit is None:
+            # Per set of sticking couples: the rows and the pseudo-inverse of G_SS (the
+            # least-squares solution, as lstsq with rcond 1e-12), factored once.
+            idx = np.concatenate([[s + 2 * j, s + 2 * j + 1] for j in np.flatnonzero(stick)])
+            GS = self.G[idx].copy()
+            GS[:, idx] = 0.0
+            hit = self._stick_cache[key] = (-np.linalg.pinv(self.G[np.ix_(idx, idx)],
+                                                           rcond=1e-12) @ GS)
+        return (hit @ np.concatenate([lam_n, lam_t.ravel()])).reshape(-1, 2)
 
     def rhs(self, t, y):
         s = self.s

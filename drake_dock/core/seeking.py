@@ -91,15 +91,18 @@ def hierarchical_seek(P1, P2, *, n_coarse=12, levels=2, n_fine=21, candidates=3)
     return out
 
 
-def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None):
+def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None,
+                   rtol_beyond=0.0):
     """Bounded Newton on f(u) = 0.5 |r1(u1) - r2(u2)|^2 from (u1, u2).
 
     Returns (u1, u2, iterations). Parameters at a domain end with the gradient pushing outwards
     are held (active set); periodic parameters are wrapped. With ``distance_rtol`` the
-    iteration also ends when the next step would shorten the distance by less than that
+    iteration also ends when a step shortens (or would shorten) the distance by less than that
     fraction of it: a caller that needs the distance, not the couple, stops early in a flat
     valley (a ring nearly coaxial with a cone), where the couple walks along the valley for
-    many iterations while the distance changes in its seventh digit."""
+    many iterations while the distance changes in its seventh digit. This applies only while
+    the distance exceeds ``rtol_beyond``; the distance is then converged to about 1e2
+    distance_rtol (the valley's many small steps add up), not the couple."""
     n1 = P1.patch.dim
     u = np.concatenate([u1, u2]).astype(float)
     lower = np.concatenate([P1.patch.lower, P2.patch.lower])
@@ -174,7 +177,8 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None
         if -(g @ step) <= 1e-15 * f0:
             break
         # df = |d| d|d|: the predicted shortening of the distance by this step.
-        if distance_rtol is not None and on_bounds and -(g @ step) <= distance_rtol * 2.0 * f0:
+        far = distance_rtol is not None and on_bounds and 2.0 * f0 > rtol_beyond ** 2
+        if far and -(g @ step) <= distance_rtol * 2.0 * f0:
             break
         t = 1.0
         while True:
@@ -194,6 +198,9 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None
         u = un
         if moved.max() < tol:
             break
+        # The step just taken shortened the distance by less than distance_rtol of it.
+        if far and f0 - fn <= distance_rtol * 2.0 * f0:
+            break
     else:
         # A nearly flat valley (a ring almost coaxial with a cone) can keep the iteration
         # creeping at a gradient of 1e-13: a point whose projected gradient is 1e-10 of
@@ -206,13 +213,14 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None
     return u[:n1], u[n1:], it
 
 
-def seek_couple(P1, P2, *, distance_rtol=None, **grid_options) -> Couple:
+def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, **grid_options) -> Couple:
     """The couple of minimal distance between posed patches P1 and P2 (Sect. 5.1); with
-    ``distance_rtol`` the Newton finish ends once the distance has converged to that fraction
-    (see `newton_closest`)."""
+    ``distance_rtol`` the Newton finish ends once the distance has converged to that fraction,
+    where it is beyond ``rtol_beyond`` (see `newton_closest`)."""
     best = None
     for u1, u2 in hierarchical_seek(P1, P2, **grid_options):
-        u1, u2, it = newton_closest(P1, P2, u1, u2, distance_rtol=distance_rtol)
+        u1, u2, it = newton_closest(P1, P2, u1, u2, distance_rtol=distance_rtol,
+                                    rtol_beyond=rtol_beyond)
         p1, p2 = P1.position(u1), P2.position(u2)
         dist = float(np.linalg.norm(p1 - p2))
         if best is None or dist < best.distance:
