@@ -51,6 +51,9 @@ class StudyPlan:
     tolerance: float = 1e-3
     wall_limit: float = 120.0        # per compliant run: stopped beyond it (reported)
     t_max_factor: float = 2.0        # compliant runs end at this x the reference capture time
+    # drake_dock's step cap is the output spacing (scenario.simulation.max_step); each accuracy
+    # is also run with these caps (error control then sets the steps; the samples are sparser)
+    rigid_max_steps: tuple = ()
 
     @staticmethod
     def quick():
@@ -66,7 +69,8 @@ class StudyPlan:
                 c += [CompliantConfig(model, k, h) for h in (1e-3, 3e-4, 1e-4, 3e-5)]
         c += [CompliantConfig("point", 1e7, 0.0, accuracy=a) for a in (1e-2, 1e-3)]
         c += [CompliantConfig("hydroelastic", 1e8, 0.0, accuracy=1e-2)]
-        return StudyPlan((1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8), 1e-10, c, wall_limit=90.0)
+        return StudyPlan((1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8), 1e-10, c, wall_limit=90.0,
+                         rigid_max_steps=(0.01,))
 
 
 def rigid_chaser_force(result):
@@ -119,7 +123,7 @@ class Point:
     label: str
     model: str
     stiffness: float
-    step: float          # compliant time step (0 = continuous), or NaN
+    step: float          # compliant time step (0 = continuous), or drake_dock's step cap
     accuracy: float      # drake_dock or continuous compliant accuracy, or NaN
     wall_time: float
     captured: bool
@@ -133,9 +137,11 @@ def run_study(scenario, plan: StudyPlan, log=print) -> dict:
     state = initial_state(scenario)
     e3 = state.X_WB["target_apds"][0][:, 2].copy()
 
-    def rigid(acc):
+    def rigid(acc, max_step=None):
         sc = copy.deepcopy(scenario)
         sc.simulation.accuracy = acc
+        if max_step is not None:
+            sc.simulation.max_step = max_step
         try:
             r = simulate(sc, state=state)
         except DrakeDockError as exc:
@@ -146,15 +152,18 @@ def run_study(scenario, plan: StudyPlan, log=print) -> dict:
     ref, note, wall = rigid(plan.reference_accuracy)
     if ref is None or ref["capture_time"] is None:
         raise DrakeDockError(f"the reference run failed: {note or 'no capture'}")
+    cap = scenario.simulation.max_step
     points = [Point("drake_dock", "reference", f"drake_dock acc={plan.reference_accuracy:.0e}",
-                    "rigid", math.nan, math.nan, plan.reference_accuracy, wall, True, ref,
+                    "rigid", math.nan, cap, plan.reference_accuracy, wall, True, ref,
                     _errors(ref, ref))]
-    accs = [10 * plan.reference_accuracy] + list(plan.rigid_accuracies)
-    for i, acc in enumerate(accs):
-        m, note, wall = rigid(acc)
+    runs = [(10 * plan.reference_accuracy, None)] + [(a, None) for a in plan.rigid_accuracies]
+    runs += [(a, h) for h in plan.rigid_max_steps for a in plan.rigid_accuracies]
+    for i, (acc, h) in enumerate(runs):
+        m, note, wall = rigid(acc, h)
         m = m or {k: None for k in METRICS}
         role = "self-convergence" if i == 0 else "point"
-        p = Point("drake_dock", role, f"drake_dock acc={acc:.0e}", "rigid", math.nan, math.nan,
+        label = f"drake_dock acc={acc:.0e}" + (f" step<={h:g}" if h is not None else "")
+        p = Point("drake_dock", role, label, "rigid", math.nan, cap if h is None else h,
                   acc, wall, m["capture_time"] is not None, m, _errors(m, ref), note)
         points.append(p)
         log(_fmt(p))
@@ -253,7 +262,7 @@ def work_precision_figure(result, path):
             if p.role == "reference" or p.errors[k] is None:
                 continue
             if p.method == "drake_dock":
-                key = "drake_dock (rigid, LZB)"
+                key = f"drake_dock (rigid, LZB), step <= {p.step:g} s"
             elif p.step > 0:
                 key = f"SAP {p.model} k={p.stiffness:.0e}"
             else:

@@ -298,6 +298,29 @@ def test_stool_three_couples_share_weight():
     np.testing.assert_allclose(lam, sc.params["mass"] * G / 3, rtol=1e-8)
 
 
+@pytest.mark.parametrize("mu", [0.0, 0.3])
+def test_stool_dropped_flat_lands_on_three_feet(mu):
+    """Dropped flat from 1 mm, the stool hits on its three feet at once at the free-fall time
+    sqrt(2 h / g); with a plastic impact it stays, each foot carrying m g / 3, without sliding.
+    With friction this used to stall the LZB solver (the feet's stick/slip were decided one
+    at a time)."""
+    h = 1e-3
+    sc = stool(mu=mu)
+    sim, root, ctx = start(sc.system, lambda c: sc.set_state(
+        c, (np.eye(3), np.array([0, 0, 0.2 + sc.params["foot_radius"] + h])),
+        (np.zeros(3), np.zeros(3))))
+    sim.AdvanceTo(0.05)
+    imp = sc.system.get_modes(ctx).impacts
+    assert len(imp) == 1 and len(imp[0]["couples"]) == 3
+    np.testing.assert_allclose(imp[0]["t"], math.sqrt(2 * h / G), rtol=1e-7)
+    np.testing.assert_allclose(imp[0]["normal_impulse"],
+                               sc.params["mass"] * math.sqrt(2 * G * h) / 3, rtol=1e-7)
+    lam = [couple(sc.system, ctx, f"foot{k}_plane")["lambda_n"] for k in range(3)]
+    np.testing.assert_allclose(lam, sc.params["mass"] * G / 3, rtol=1e-8)
+    x = ctx.get_continuous_state_vector().CopyToVector()
+    np.testing.assert_allclose(x[sc.system.nq:sc.system.nq + 6], 0.0, atol=1e-9)
+
+
 # --------------------------------------------------------------------------- transitions
 def test_contact_ends_at_the_patch_end():
     """A disk sliding (frictionless) off the end of the plane patch at x = 0.5: at the domain
