@@ -271,8 +271,14 @@ def work_precision_figure(result, path):
         for key, xy in groups.items():
             xy.sort()
             x, y = zip(*xy)
-            style = dict(lw=2.2, marker="o", color="k") if key.startswith("drake_dock") else \
-                dict(lw=1, marker="s" if "SAP" in key else "^", ms=4)
+            if key.startswith("drake_dock"):
+                coarse = len([g for g in groups if g.startswith("drake_dock")]) > 1 and \
+                    key != min((g for g in groups if g.startswith("drake_dock")),
+                               key=lambda g: float(g.split("<= ")[1].split()[0]))
+                style = dict(lw=2.2, marker="o", color="0.55" if coarse else "k",
+                             ls="--" if coarse else "-")
+            else:
+                style = dict(lw=1, marker="s" if "SAP" in key else "^", ms=4)
             ax.loglog(x, y, label=key, **style)
         ax.axhline(tol, color="r", ls="--", lw=0.8)
         ax.set_title(k.replace("_", " "))
