@@ -13,7 +13,8 @@ SceneGraph by MultibodyPositionToGeometryPose.
 Each declared pair is in one of three states:
 - ``far``: not tracked. Its last sought distance d_c and the relative pose then are kept; a
   witness compares a conservative bound of the relative travel of patch 1 since then
-  (|delta(X21 c1)| + |delta R21|_F r1, c1 and r1 a bounding sphere of patch 1) with a clearance;
+  (|delta(X21 c1)| + |delta R21|_2 r1, c1 and r1 a bounding sphere of patch 1, |delta R21|_2 =
+  2 sin(theta / 2) for the rotation angle theta since then) with a clearance;
   when it is reached the pair is sought again (Sect. 5.1).
 - ``tracked`` (a potential contact): its couple is interior to both domains, isolated (the
   Jacobian of Eq. 40 is regular) and nearer than ``track_distance``; u* is continuous state
@@ -128,7 +129,8 @@ class ContactOptions:
     v_slip: float = 1e-6             # m/s: a couple slower than this may stick
     zeno_speed: float = 1e-3         # m/s: the Zeno guard (see the module docstring)
     impact_gap_tol: float = 1e-8     # m: couples this near join an impact
-    impact_rtol: float = 1e-10
+    impact_rtol: float = 1e-10       # LZB's impulse-domain integration (`solve_lzb`); the
+                                     # docking diagram sets 1e-3 x the simulation accuracy
     seek_rtol: float = 1e-7          # a seek's Newton ends when a step shortens the distance
                                      # by less than this fraction, for pairs farther than
                                      # track_distance (`seek_couple`): their distance only sets
@@ -208,6 +210,7 @@ class _Eval:
     applied_power: float
     external_power: float
     bound: np.ndarray      # relative travel bound per far pair (NaN until asked: `_bound`)
+    witness: dict          # witness values computed at this evaluation (`_witness`)
     poses: list
     extra_power: np.ndarray
 
@@ -301,23 +304,24 @@ class RigidContactSystem(LeafSystem):
         for i, p in enumerate(pairs):
             self._w.append({
                 "gap": self.MakeWitnessFunction(f"{p.name} gap", down,
-                                                lambda c, i=i: self._w_gap(c, i), ev),
+                                                lambda c, i=i: self._witness(c, i, 'gap'), ev),
                 "end": self.MakeWitnessFunction(f"{p.name} domain end", down,
-                                                lambda c, i=i: self._w_end(c, i), ev),
+                                                lambda c, i=i: self._witness(c, i, 'end'), ev),
                 "cond": self.MakeWitnessFunction(f"{p.name} Eq. 39", down,
-                                                 lambda c, i=i: self._w_cond(c, i), ev),
+                                                 lambda c, i=i: self._witness(c, i, 'cond'), ev),
                 "lambda": self.MakeWitnessFunction(f"{p.name} lambda_n", down,
-                                                   lambda c, i=i: self._w_lambda(c, i), ev),
+                                                   lambda c, i=i: self._witness(c, i, 'lambda'), ev),
                 "slip": self.MakeWitnessFunction(f"{p.name} slip", down,
-                                                 lambda c, i=i: self._w_slip(c, i), ev),
+                                                 lambda c, i=i: self._witness(c, i, 'slip'), ev),
                 "cone": self.MakeWitnessFunction(f"{p.name} friction cone", down,
-                                                 lambda c, i=i: self._w_cone(c, i), ev),
+                                                 lambda c, i=i: self._witness(c, i, 'cone'), ev),
                 "apex": self.MakeWitnessFunction(f"{p.name} gap rate", down,
-                                                 lambda c, i=i: self._w_apex(c, i), ev),
+                                                 lambda c, i=i: self._witness(c, i, 'apex'), ev),
                 "clear": self.MakeWitnessFunction(f"{p.name} clearance", down,
-                                                  lambda c, i=i: self._w_clear(c, i), ev)})
+                                                  lambda c, i=i: self._witness(c, i, 'clear'), ev)})
         self._memo = None
         self._eval_memo = {}
+        self._far_cache = {}
         self.evaluations = 0
         self.timing = Timing([p.name for p in pairs])
 
@@ -367,19 +371,19 @@ class RigidContactSystem(LeafSystem):
         world = self.plant.world_frame()
         R1, o1 = poses[a]
         R2, o2 = poses[b]
-        r1 = R1.T @ (ev.p1 - o1)
-        r2 = R2.T @ (ev.p2 - o2)
-        J = (self.plant.CalcJacobianTranslationalVelocity(ctx, _KV, p.frame1, r1, world, world)
-             - self.plant.CalcJacobianTranslationalVelocity(ctx, _KV, p.frame2, r2, world,
-                                                              world))
-        ab = (self.plant.CalcBiasTranslationalAcceleration(ctx, _KV, p.frame1, r1, world, world)
-              - self.plant.CalcBiasTranslationalAcceleration(ctx, _KV, p.frame2, r2, world,
-                                                               world)).ravel()
-        Wn = J.T @ ev.n
-        Wt = J.T @ np.column_stack([ev.ta, ev.tb])
-        return ContactRow(p.name, Wn, Wt, ev.bias_n + ev.n @ ab,
-                          ev.bias_t + np.array([ev.ta @ ab, ev.tb @ ab]), ev.gap, ev.vn, ev.vt,
-                          self.law.mu, self._mu_s)
+        J = (self.plant.CalcJacobianTranslationalVelocity(ctx, _KV, p.frame1, R1.T @ (ev.p1 - o1),
+                                                          world, world)
+             - self.plant.CalcJacobianTranslationalVelocity(ctx, _KV, p.frame2,
+                                                            R2.T @ (ev.p2 - o2), world, world))
+        ab = (self.plant.CalcBiasTranslationalAcceleration(ctx, _KV, p.frame1,
+                                                           R1.T @ (ev.p1 - o1), world, world)
+              - self.plant.CalcBiasTranslationalAcceleration(ctx, _KV, p.frame2,
+                                                             R2.T @ (ev.p2 - o2), world, world))
+        D = np.array([ev.n, ev.ta, ev.tb]).T          # columns n, ta, tb
+        W = J.T @ D
+        b = D.T @ ab.ravel()
+        return ContactRow(p.name, W[:, 0], W[:, 1:], ev.bias_n + b[0], ev.bias_t + b[1:],
+                          ev.gap, ev.vn, ev.vt, self.law.mu, self._mu_s)
 
     def _set_scratch(self, q, v):
         self.plant.SetPositions(self._ctx, q)
@@ -489,7 +493,7 @@ class RigidContactSystem(LeafSystem):
         qdot = self.plant.MapVelocityToQDot(ctx, v)
         value.set_value(_Eval(q, v, qdot, sol.vdot, udot, evals, lam_n, lam_t,
                               sol.generalized_force, sol.power_lost_to_friction(rows), p_plant,
-                              p_in, bound, poses,
+                              p_in, bound, {}, poses,
                               np.array([f(q, v) for _, f in self.extra_powers], dtype=float)))
 
     def _travel_bound(self, i, poses, st):
@@ -501,8 +505,9 @@ class RigidContactSystem(LeafSystem):
         R21, p21 = R2.T @ R1, R2.T @ (p1 - p2)
         R0, p0 = st.ref_X21
         c, r = self._spheres[i]
+        # |R21 - R0|_2 = |R0^T R21 - I|_2 = 2 sin(theta / 2) = sqrt(3 - tr(R0^T R21)).
         return float(np.linalg.norm((R21 - R0) @ c + p21 - p0)
-                     + math.sqrt(np.sum((R21 - R0) ** 2)) * r)
+                     + math.sqrt(max(3.0 - float(np.sum(R0 * R21)), 0.0)) * r)
 
     def _bound(self, E, i, st):
         """The travel bound of far pair i at the evaluation E, computed when a witness or an
@@ -564,12 +569,11 @@ class RigidContactSystem(LeafSystem):
             a, b = self._fidx[i]
             u = context.get_continuous_state_vector().CopyToVector()[
                 self.nq + self.nv + self._uoff[i]:self.nq + self.nv + self._uoff[i + 1]]
-            n1 = p.patch1.dim
             y[S["gap"]] = st.distance - self._bound(E, i, st)
             y[S["u"]][:len(u)] = u
-            for sl, patch, (R, o), uk in ((S["p1"], p.patch1, E.poses[a], u[:n1]),
-                                          (S["p2"], p.patch2, E.poses[b], u[n1:])):
-                y[sl] = R @ np.array(patch.jet([float(c) for c in uk])[0]) + o
+            r1, r2 = self._far_points(i, u)
+            y[S["p1"]] = E.poses[a][0] @ r1 + E.poses[a][1]
+            y[S["p2"]] = E.poses[b][0] @ r2 + E.poses[b][1]
             y[S["frame"]] = np.eye(3).ravel()
         else:
             y[S["status"]] = st.status + (1 if st.status == CONTACT and st.stick else 0)
@@ -580,6 +584,19 @@ class RigidContactSystem(LeafSystem):
             y[S["p1"]], y[S["p2"]] = ev.p1, ev.p2
             y[S["frame"]] = ev.frame.ravel()
         return y
+
+    def _far_points(self, i, u):
+        """The points of far pair i's last sought couple in the two body frames (they change
+        only when the pair is sought again)."""
+        key = u.tobytes()
+        hit = self._far_cache.get(i)
+        if hit is None or hit[0] != key:
+            p = self.pairs[i]
+            n1 = p.patch1.dim
+            hit = self._far_cache[i] = (
+                key, np.array(p.patch1.jet([float(c) for c in u[:n1]])[0]),
+                np.array(p.patch2.jet([float(c) for c in u[n1:]])[0]))
+        return hit[1], hit[2]
 
     # ------------------------------------------------------------------ witnesses
     def DoGetWitnessFunctions(self, context):
@@ -611,7 +628,7 @@ class RigidContactSystem(LeafSystem):
             else:
                 kinds = ("end", "cond", "lambda", "cone" if st.stick else "slip")
             for k in kinds:
-                out[f"{self.pairs[i].name} {k}"] = getattr(self, self._W_FUNCS[k])(context, i)
+                out[f"{self.pairs[i].name} {k}"] = self._witness(context, i, k)
         return out
 
     def witness_epoch(self, context) -> int:
@@ -619,14 +636,23 @@ class RigidContactSystem(LeafSystem):
         from before it is not continued by its values after it)."""
         return self.get_modes(context).mode_changes
 
-    def _status(self, context, i):
-        return self.get_modes(context).pairs[i]
+    def _witness(self, context, i, kind):
+        """The value of witness ``kind`` of pair i, kept on the evaluation (Drake evaluates
+        every witness at both ends of every step, and `WitnessApproach` asks for them again:
+        each is computed once per evaluation)."""
+        E = self._cache.Eval(context)
+        key = (i, kind)
+        w = E.witness.get(key)
+        if w is None:
+            w = E.witness[key] = float(getattr(self, self._W_FUNCS[kind])(
+                E, self.get_modes(context).pairs[i], i))
+        return w
 
-    def _w_gap(self, context, i):
-        ev = self._cache.Eval(context).evals[i]
+    def _w_gap(self, E, st, i):
+        ev = E.evals[i]
         return 1.0 if ev is None else ev.gap
 
-    def _w_apex(self, context, i):
+    def _w_apex(self, E, st, i):
         """The gap rate while the gap is not positive, else 1. Just after an impact the gap is
         at or below zero (the impact is isolated to within Drake's window), so the gap witness
         cannot trigger; a couple that closes again before its gap has become positive would be
@@ -635,44 +661,40 @@ class RigidContactSystem(LeafSystem):
         v_n > 0 to 1 (no trigger) on the way out, and from 1 to v_n < 0 on the way back, at the
         gap's zero, together with the gap witness. (Stopping at every bounce's apex cost an
         isolated event each.)"""
-        ev = self._cache.Eval(context).evals[i]
+        ev = E.evals[i]
         return 1.0 if ev is None or ev.gap > 0.0 else ev.vn
 
-    def _w_end(self, context, i):
-        ev = self._cache.Eval(context).evals[i]
+    def _w_end(self, E, st, i):
+        ev = E.evals[i]
         if ev is None:
             return 1.0
-        m = np.concatenate([self.pairs[i].patch1.margin(ev.u[:self.pairs[i].patch1.dim]),
-                            self.pairs[i].patch2.margin(ev.u[self.pairs[i].patch1.dim:])])
-        return float(np.min(m / self._spans[i]))
+        p = self.pairs[i]
+        n1 = p.patch1.dim
+        return min(float(np.min(p.patch1.margin(ev.u[:n1]) / self._spans[i][:n1])),
+                   float(np.min(p.patch2.margin(ev.u[n1:]) / self._spans[i][n1:])))
 
-    def _w_cond(self, context, i):
-        ev = self._cache.Eval(context).evals[i]
+    def _w_cond(self, E, st, i):
+        ev = E.evals[i]
         return 1.0 if ev is None else ev.conditioning - self.options.conditioning_min
 
-    def _w_lambda(self, context, i):
-        return float(self._cache.Eval(context).lam_n[i]) if \
-            self._status(context, i).status == CONTACT else 1.0
+    def _w_lambda(self, E, st, i):
+        return E.lam_n[i] if st.status == CONTACT else 1.0
 
-    def _w_slip(self, context, i):
-        st = self._status(context, i)
-        ev = self._cache.Eval(context).evals[i]
+    def _w_slip(self, E, st, i):
+        ev = E.evals[i]
         if st.status != CONTACT or st.stick or ev is None or st.slide_dir is None:
             return 1.0
-        return float(ev.vt @ st.slide_dir)
+        return ev.vt @ st.slide_dir
 
-    def _w_cone(self, context, i):
-        st = self._status(context, i)
-        E = self._cache.Eval(context)
+    def _w_cone(self, E, st, i):
         if st.status != CONTACT or not st.stick:
             return 1.0
-        return float(self._mu_s * E.lam_n[i] - math.hypot(*E.lam_t[i]))
+        return self._mu_s * E.lam_n[i] - math.hypot(*E.lam_t[i])
 
-    def _w_clear(self, context, i):
-        st = self._status(context, i)
+    def _w_clear(self, E, st, i):
         if st.status != FAR:
             return 1.0
-        return float(st.clearance - self._bound(self._cache.Eval(context), i, st))
+        return st.clearance - self._bound(E, i, st)
 
     # ------------------------------------------------------------------ events
     def _on_step(self, context, state):

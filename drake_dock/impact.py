@@ -188,7 +188,14 @@ class _Problem:
         s = self.s
         x = y[self.ix]
         u = y[self.iu]
-        lam_n = np.where(x > 0, self.kappa * np.maximum(x, 0.0) ** self.eta, 0.0)
+        lam_n = self.kappa * np.maximum(x, 0.0) ** self.eta_pow     # 0 where x <= 0
+        if self.friction and not self.stuck.any():
+            # Fast path (every couple slips or is unloaded): unloaded couples get zero.
+            ut = u[s:].reshape(s, 2)
+            nt = np.sqrt(ut[:, 0] ** 2 + ut[:, 1] ** 2)
+            big = nt > self.v_tiny
+            d = np.where(big[:, None], ut / np.where(big, nt, 1.0)[:, None], self.slip_dir)
+            return lam_n, (-self.mu * lam_n)[:, None] * d
         lam_t = np.zeros((s, 2))
         if self.friction:
             ut = u[s:].reshape(s, 2)
@@ -251,11 +258,10 @@ class _Problem:
         dy[self.ix] = -self.rate * un
         dy[self.iu] = du
         dy[self.iP] = lam
-        comp = self.phase == _COMP
-        dy[self.iwc] = np.where(comp, power, 0.0)
-        dy[self.iwe] = np.where(comp, 0.0, power)
+        dy[self.iwc] = power * self.comp_f
+        dy[self.iwe] = power * (1.0 - self.comp_f)
         ut = y[self.iu][s:].reshape(s, 2)
-        dy[self.iwf] = -np.einsum("ij,ij->i", lam_t, ut)
+        dy[self.iwf] = -(lam_t * ut).sum(axis=1)
         return dy
 
     # Events ---------------------------------------------------------------------------------

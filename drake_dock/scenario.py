@@ -81,6 +81,14 @@ class SimulationParams:
     accuracy: float = 1e-6           # integrator error control and witness isolation
     max_step: float = 0.002          # largest integration step (s); also the sample spacing
     capture_distance: float = 0.005  # axial ring-centre distance ending the capture phase (m)
+    # Drake's error-controlled explicit integrator (SimulatorConfig.integration_scheme). The
+    # third-order Bogacki-Shampine reuses its last stage (3 evaluations a step against RK5's
+    # 6): where the step cap, not the accuracy, sets the step, it does the same work for half
+    # the evaluations (bench/paper_example.py, README "Speed").
+    integration_scheme: str = "bogacki_shampine3"
+
+
+INTEGRATION_SCHEMES = ("bogacki_shampine3", "runge_kutta3", "runge_kutta5")
 
 
 @dataclasses.dataclass
@@ -119,6 +127,9 @@ def _check_raw(node, schema, path):
                 ok = False
         if not ok:
             raise InputError(where, node, "a number")
+    elif schema is str:
+        if not isinstance(node, str):
+            raise InputError(where, node, "a string")
     elif typing.get_origin(schema) is list:
         if not isinstance(node, list):
             raise InputError(where, node, "a list of numbers")
@@ -188,6 +199,9 @@ def validate(s: Scenario) -> Scenario:
         raise InputError("simulation.accuracy", s.simulation.accuracy, "0 < accuracy < 1")
     _positive("simulation.max_step", s.simulation.max_step)
     _positive("simulation.capture_distance", s.simulation.capture_distance)
+    if s.simulation.integration_scheme not in INTEGRATION_SCHEMES:
+        raise InputError("simulation.integration_scheme", s.simulation.integration_scheme,
+                         f"one of {', '.join(INTEGRATION_SCHEMES)}")
     return s
 
 

@@ -10,8 +10,8 @@ length (about 900 derivative evaluations per event in the docking example at w =
 predicts every witness's zero by the secant through its last two values and the parabola
 through its last three (same epoch, see below; the earlier of the two) and caps the
 integrator's step so that the step ends w/2 before the earliest predicted
-zero; once within w, the step is capped at 2 w, so that it crosses the zero and a single
-bisection isolates it. The secant converges superlinearly, so a zero is reached in a few
+zero; once within w, the step is capped at 1.9 w, so that it crosses the zero and a single
+bisection (to 0.95 w, inside the window) isolates it. The secant converges superlinearly, so a zero is reached in a few
 steps. Events, their times and the integration's error control are Drake's own; only the
 maximum step size changes, and it returns to its configured value after each event.
 
@@ -57,6 +57,12 @@ class WitnessApproach:
     """Simulator monitor. ``window`` is Drake's witness isolation window (0.01 x the context's
     accuracy, in s, for error-controlled integration); ``max_step`` the configured maximum."""
 
+    #: length of the step that crosses a zero, in isolation windows: below 2, so that Drake's
+    #: one bisection leaves an interval shorter than the window (at exactly 2 the interval
+    #: (a + b) / 2 - a is the window give or take a rounding, and a second bisection, which
+    #: misses the zero half the time, ends the step with no event)
+    cross = 1.9
+
     #: consecutive shortened steps after which one step of the configured maximum is allowed
     #: (a witness that hovers just above zero must not stall the run)
     max_shortened = 40
@@ -101,8 +107,9 @@ class WitnessApproach:
         lead = t_zero - t
         step = self.max_step
         if lead < self.max_step + self.window and self._shortened < self.max_shortened:
-            step = lead - 0.5 * self.window if lead > self.window else 2.0 * self.window
-            step = max(step, 2.0 * self.window)
+            cross = self.cross * self.window
+            step = lead - 0.5 * self.window if lead > self.window else cross
+            step = max(step, cross)
         if step < self.max_step:
             self._shortened += 1
             self.shortened_steps += 1

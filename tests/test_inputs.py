@@ -73,6 +73,13 @@ def test_wrong_type():
     _fails("initial: {chaser_speed: fast}", "initial.chaser_speed")
 
 
+@pytest.mark.parametrize("value, allowed", [("euler", "one of bogacki_shampine3"),
+                                            ("3", "a string")])
+def test_unknown_integration_scheme(value, allowed):
+    e = _fails(f"simulation: {{integration_scheme: {value}}}", "simulation.integration_scheme")
+    assert e.allowed.startswith(allowed)
+
+
 def test_initial_interpenetration():
     _fails("initial: {approach_travel: -0.02}", "initial.approach_travel")
 

@@ -10,6 +10,7 @@ import pytest
 
 from drake_dock import stability as S
 from drake_dock.contact_system import ZenoError
+from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.small_scenes import G, painleve_rod, stool
 
 
@@ -140,7 +141,10 @@ def test_step_size_drake_dock_smooth_at_every_output_step(quick):
     a = quick[2]["step_size"]
     fine, coarse = a["rigid"]
     assert fine["step"] < coarse["step"]
-    assert coarse["capture_time"] == pytest.approx(fine["capture_time"], abs=1e-9)
+    # Both locate capture by Drake's witness isolation, to within its window (1e-2 of the
+    # accuracy, in seconds) after the zero.
+    window = 1e-2 * load_scenario(PAPER_EXAMPLE).simulation.accuracy
+    assert coarse["capture_time"] == pytest.approx(fine["capture_time"], abs=window)
     for r in a["rigid"]:
         assert r["index"] < 1e-3
     tf, Ff = np.array(fine["t"]), np.array(fine["F"])

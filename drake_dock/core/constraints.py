@@ -25,6 +25,7 @@ and the couples. Several consistent choices that differ only in stick against st
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import math
 
@@ -68,9 +69,19 @@ class ContactSolution:
     vdot: np.ndarray
     lam_n: np.ndarray     # (k,)
     lam_t: np.ndarray     # (k, 2)
-    gddot: np.ndarray     # (k,) g'' (without the stabilisation terms)
-    at: np.ndarray        # (k, 2) tangential relative accelerations
     generalized_force: np.ndarray  # sum Wn lam_n + Wt lam_t
+    rows: list
+
+    @functools.cached_property
+    def gddot(self) -> np.ndarray:
+        """(k,) g'' (without the stabilisation terms); computed when asked (the mode selection
+        needs it, a derivative evaluation does not)."""
+        return np.array([r.Wn @ self.vdot + r.bn for r in self.rows])
+
+    @functools.cached_property
+    def at(self) -> np.ndarray:
+        """(k, 2) tangential relative accelerations."""
+        return np.array([r.Wt.T @ self.vdot + r.bt for r in self.rows]).reshape(-1, 2)
 
     def power_lost_to_friction(self, rows):
         """sum -lam_t . v_t over the couples (>= 0 for sliding, 0 for sticking)."""
@@ -95,15 +106,21 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None) -> C
     lam = np.zeros(0)
     Cf = None
     if cols:
-        C = np.column_stack(cols)
-        D = np.column_stack(cons)
+        C = np.array(cols).T
+        D = np.array(cons).T
         MinvC = Minv @ C
         A = D.T @ MinvC
         b = -(np.asarray(rhs) + D.T @ a0)
-        cond = np.linalg.cond(A)
-        if np.isfinite(cond) and cond <= 1e10:
+        # Singular (redundant or degenerate rows) when the Hadamard ratio |det A| / prod of
+        # its row norms, a scale-free measure in [0, 1] that vanishes with the smallest
+        # singular value of the row-scaled matrix, is below 1e-12 (an SVD per evaluation
+        # cost more than the rest of the solve).
+        rn = np.sqrt(np.einsum("ij,ij->i", A, A))
+        ratio = abs(np.linalg.det(A)) / np.prod(rn) if np.all(rn > 0) else 0.0
+        if np.isfinite(ratio) and ratio > 1e-12:
             lam = np.linalg.solve(A, b)
         else:
+            cond = np.linalg.cond(A)
             # Redundant constraints (a body resting on several sticking couples is statically
             # indeterminate): the minimum-norm forces, if the equations are consistent.
             lam = np.linalg.lstsq(A, b, rcond=1e-10)[0] if np.all(np.isfinite(A)) else None
@@ -125,10 +142,8 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None) -> C
             lam_n[i] = lam[j]
             lam_t[i] = -r.mu * lam[j] * np.asarray(s)
             j += 1
-    gddot = np.array([r.Wn @ vdot + r.bn for r in rows])
-    at = np.array([r.Wt.T @ vdot + r.bt for r in rows]).reshape(k, 2)
-    return ContactSolution(tuple(modes), list(dirs), vdot, lam_n, lam_t, gddot, at,
-                           Cf if Cf is not None else np.zeros_like(a0))
+    return ContactSolution(tuple(modes), list(dirs), vdot, lam_n, lam_t,
+                           Cf if Cf is not None else np.zeros_like(a0), list(rows))
 
 
 def _slide_start(Minv, a0, rows, modes, dirs, i_start, omega, time, max_iter=200):

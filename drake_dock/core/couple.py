@@ -93,24 +93,20 @@ def _perp_rate(unit, rate, norm):
 
 
 def _solve(A, b):
-    """A x = b for n = 2, 3 by Gaussian elimination with partial pivoting (lists of floats)."""
-    n = len(b)
-    M = [list(A[i]) + [b[i]] for i in range(n)]
-    for k in range(n):
-        piv = max(range(k, n), key=lambda i: abs(M[i][k]))
-        if piv != k:
-            M[k], M[piv] = M[piv], M[k]
-        pk = M[k][k]
-        for i in range(k + 1, n):
-            f = M[i][k] / pk
-            if f != 0.0:
-                Mi, Mk = M[i], M[k]
-                for j in range(k, n + 1):
-                    Mi[j] -= f * Mk[j]
-    x = [0.0] * n
-    for i in range(n - 1, -1, -1):
-        x[i] = (M[i][n] - sum(M[i][j] * x[j] for j in range(i + 1, n))) / M[i][i]
-    return x
+    """A x = b for n = 2, 3 by Cramer's rule (lists of floats; the callers have checked the
+    conditioning of A, `_conditioning`, so that no pivoting is needed at these sizes)."""
+    if len(b) == 2:
+        (a, c), (d, e) = A
+        det = a * e - c * d
+        return [(b[0] * e - c * b[1]) / det, (a * b[1] - b[0] * d) / det]
+    r0, r1, r2 = A
+    c0 = _cr(r1, r2)
+    det = _dot(r0, c0)
+    c1, c2 = _cr(r2, r0), _cr(r0, r1)
+    # x = adj(A) b / det, the columns of adj(A) being the cross products of the rows.
+    return [(c0[0] * b[0] + c1[0] * b[1] + c2[0] * b[2]) / det,
+            (c0[1] * b[0] + c1[1] * b[1] + c2[1] * b[2]) / det,
+            (c0[2] * b[0] + c1[2] * b[1] + c2[2] * b[2]) / det]
 
 
 def _det(A):

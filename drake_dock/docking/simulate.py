@@ -5,7 +5,8 @@ impact's witness gives the state just before it) and, for each impact, one sampl
 just after it at the same time (from the impact log; no step end sees that state). The
 simulation ends at ``simulation.duration`` or at capture (`CaptureMonitor`'s witness).
 
-Integration: Runge-Kutta 5 with error control at ``simulation.accuracy``; the context's
+Integration: ``simulation.integration_scheme`` (default Bogacki-Shampine 3) with error control
+at ``simulation.accuracy``; the context's
 accuracy, which sets Drake's witness isolation window (1e-2 of it, in seconds), is the same
 value; the step is capped at ``simulation.max_step``.
 """
@@ -63,7 +64,7 @@ def make_simulator(dd: DockingDiagram, scenario, state: InitialState) -> Simulat
     set_initial_state(dd.dp, pc, state)
     dd.contact.set_from_plant_context(dd.contact.GetMyMutableContextFromRoot(root), pc)
     sp = scenario.simulation
-    ApplySimulatorConfig(SimulatorConfig(integration_scheme="runge_kutta5",
+    ApplySimulatorConfig(SimulatorConfig(integration_scheme=sp.integration_scheme,
                                          accuracy=sp.accuracy, max_step_size=sp.max_step,
                                          use_error_control=True), sim)
     root.SetAccuracy(sp.accuracy)
