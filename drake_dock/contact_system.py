@@ -228,12 +228,19 @@ class RigidContactSystem(LeafSystem):
     names bodies that get an input port ``<body>_wrench`` (6-vector [torque, force], world
     frame, applied at the body origin). ``extra_powers`` is a sequence of (name, f) with
     f(q, v) -> power (W); each is integrated as continuous state and appended to the
-    ``energy`` output (e.g. the power of a damper, for an energy ledger)."""
+    ``energy`` output (e.g. the power of a damper, for an energy ledger). The energy integrals
+    are state in units of ``energy_scale`` (J): Drake's error control compares every state's
+    absolute error with the accuracy, so that integrals in joules of a run with kJ of kinetic
+    energy, not its motion, would set the step (the docking diagram passes the chaser's
+    kinetic energy; the ``energy`` output is in joules)."""
 
     def __init__(self, plant, pairs, law: ContactLaw = ContactLaw(),
                  options: ContactOptions = ContactOptions(), wrench_bodies=(),
-                 extra_powers=()):
+                 extra_powers=(), energy_scale: float = 1.0):
         super().__init__()
+        if not (math.isfinite(energy_scale) and energy_scale > 0):
+            raise ValueError(f"energy_scale: must be finite and > 0, got {energy_scale}")
+        self.energy_scale = float(energy_scale)
         if not plant.is_finalized():
             raise ValueError("plant: must be finalized")
         if plant.time_step() != 0.0:
@@ -522,8 +529,9 @@ class RigidContactSystem(LeafSystem):
     def DoCalcTimeDerivatives(self, context, derivatives):
         E = self._cache.Eval(context)
         derivatives.get_mutable_vector().SetFromVector(np.concatenate(
-            [E.qdot, E.vdot, E.udot, [E.friction_power, E.applied_power, E.external_power],
-             E.extra_power]))
+            [E.qdot, E.vdot, E.udot,
+             np.array([E.friction_power, E.applied_power, E.external_power,
+                       *E.extra_power]) / self.energy_scale]))
 
     # ------------------------------------------------------------------ outputs
     def _out_state(self, context, out):
@@ -544,9 +552,9 @@ class RigidContactSystem(LeafSystem):
             pe = self.plant.CalcPotentialEnergy(ctx)
         except RuntimeError:
             pe = math.nan
-        out.SetFromVector(np.concatenate([[ke, pe, x[self.ie], x[self.ie + 1], x[self.ie + 2],
-                                           self.get_modes(context).impact_loss],
-                                          x[self.ie + 3:]]))
+        w = x[self.ie:] * self.energy_scale
+        out.SetFromVector(np.concatenate([[ke, pe, w[0], w[1], w[2],
+                                           self.get_modes(context).impact_loss], w[3:]]))
 
     def _out_couple(self, context, out, i):
         out.SetFromVector(self._couple_row(context, self._cache.Eval(context),

@@ -92,7 +92,9 @@ def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagra
     contact = builder.AddSystem(RigidContactSystem(
         dp.plant, pairs, contact_law(scenario), options,
         wrench_bodies=("chaser",),
-        extra_powers=[("stewart_damper_work", StewartDamperPower(dp))]))
+        extra_powers=[("stewart_damper_work", StewartDamperPower(dp))],
+        energy_scale=0.5 * scenario.bodies.chaser.mass * scenario.initial.chaser_speed ** 2
+        or 1.0))
     contact.set_name("rigid_contact")
     to_pose = builder.AddSystem(MultibodyPositionToGeometryPose(dp.plant,
                                                                 input_multibody_state=True))
