@@ -69,8 +69,8 @@ class StudyPlan:
                 c += [CompliantConfig(model, k, h) for h in (1e-3, 3e-4, 1e-4, 3e-5)]
         c += [CompliantConfig("point", 1e7, 0.0, accuracy=a) for a in (1e-2, 1e-3)]
         c += [CompliantConfig("hydroelastic", 1e8, 0.0, accuracy=1e-2)]
-        return StudyPlan((1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8), 1e-10, c, wall_limit=90.0,
-                         rigid_max_steps=(0.01,))
+        return StudyPlan((1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8), 1e-10, c, wall_limit=90.0,
+                         rigid_max_steps=(0.01, 0.02))
 
 
 def rigid_chaser_force(result):
@@ -272,11 +272,12 @@ def work_precision_figure(result, path):
             xy.sort()
             x, y = zip(*xy)
             if key.startswith("drake_dock"):
-                coarse = len([g for g in groups if g.startswith("drake_dock")]) > 1 and \
-                    key != min((g for g in groups if g.startswith("drake_dock")),
-                               key=lambda g: float(g.split("<= ")[1].split()[0]))
-                style = dict(lw=2.2, marker="o", color="0.55" if coarse else "k",
-                             ls="--" if coarse else "-")
+                # The finest step cap solid black, coarser caps dashed in lighter greys.
+                dd = sorted((g for g in groups if g.startswith("drake_dock")),
+                            key=lambda g: float(g.split("<= ")[1].split()[0]))
+                rank = dd.index(key)
+                style = dict(lw=2.2, marker="o", color=("k", "0.4", "0.65", "0.8")[min(rank, 3)],
+                             ls="--" if rank else "-")
             else:
                 style = dict(lw=1, marker="s" if "SAP" in key else "^", ms=4)
             ax.loglog(x, y, label=key, **style)
