@@ -123,7 +123,7 @@ class ContactOptions:
     drift_tol: float = 1e-3          # largest projection step, relative to the domain span
     track_distance: float = 0.02     # m: nearer interior isolated couples are tracked
     reseek_floor: float = 1e-4       # m: smallest relative travel between two re-seeks
-    reseek_early: float = 0.75       # far pairs are sought again at the first step start where
+    reseek_early: float = 0.9        # far pairs are sought again at the first step start where
                                      # this fraction of their clearance is used (0: never)
     conditioning_min: float = 1e-6   # |det J| / prod(row norms) below which J is singular
     v_slip: float = 1e-6             # m/s: a couple slower than this may stick
