@@ -12,10 +12,11 @@ SceneGraph by MultibodyPositionToGeometryPose.
 
 Each declared pair is in one of three states:
 - ``far``: not tracked. Its last sought distance d_c and the relative pose then are kept; a
-  witness compares a conservative bound of the relative travel of patch 1 since then
-  (|delta(X21 c1)| + |delta R21|_2 r1, c1 and r1 a bounding sphere of patch 1, |delta R21|_2 =
-  2 sin(theta / 2) for the rotation angle theta since then) with a clearance;
-  when it is reached the pair is sought again (Sect. 5.1).
+  conservative bound of the relative travel of patch 1 since then (|delta(X21 c1)| +
+  |delta R21|_2 r1, c1 and r1 a bounding sphere of patch 1, |delta R21|_2 = 2 sin(theta / 2)
+  for the rotation angle theta since then) is compared with a clearance; when it is reached
+  the pair is sought again (Sect. 5.1). One witness serves all far pairs: the smallest
+  clearance left.
 - ``tracked`` (a potential contact): its couple is interior to both domains, isolated (the
   Jacobian of Eq. 40 is regular) and nearer than ``track_distance``; u* is continuous state
   integrated with Eq. (47), projected on the closest-point conditions at each evaluation (one
@@ -63,6 +64,7 @@ from drake_dock.errors import NumericalError, SeekingError
 from drake_dock.impact import solve_lzb
 
 FAR, TRACKED, CONTACT = 0, 1, 2
+FAR_WITNESS = "far pairs clearance"   # the one witness of all far pairs (`_w_clear`)
 STATUS_NAMES = {FAR: "far", TRACKED: "tracked", CONTACT: "contact"}
 _KV = JacobianWrtVariable.kV
 
@@ -213,6 +215,7 @@ class _Eval:
     witness: dict          # witness values computed at this evaluation (`_witness`)
     poses: list
     extra_power: np.ndarray
+    modes: object = None   # the ContactModes this evaluation was made with
 
 
 def _bounding_sphere(patch, n=41):
@@ -265,6 +268,8 @@ class RigidContactSystem(LeafSystem):
         self._spans = [np.concatenate([p.patch1.span, p.patch2.span]) for p in pairs]
         self._periodic = [np.array(p.patch1.periodic + p.patch2.periodic) for p in pairs]
         self._spheres = [_bounding_sphere(p.patch1) for p in pairs]
+        self._sphere_c = np.array([c for c, _ in self._spheres]).reshape(-1, 3)
+        self._sphere_r = np.array([r for _, r in self._spheres])
         frames = []
         for p in pairs:
             for f in (p.frame1, p.frame2):
@@ -323,9 +328,10 @@ class RigidContactSystem(LeafSystem):
                 "cone": self.MakeWitnessFunction(f"{p.name} friction cone", down,
                                                  lambda c, i=i: self._witness(c, i, 'cone'), ev),
                 "apex": self.MakeWitnessFunction(f"{p.name} gap rate", down,
-                                                 lambda c, i=i: self._witness(c, i, 'apex'), ev),
-                "clear": self.MakeWitnessFunction(f"{p.name} clearance", down,
-                                                  lambda c, i=i: self._witness(c, i, 'clear'), ev)})
+                                                 lambda c, i=i: self._witness(c, i, 'apex'), ev)})
+        # One witness for all far pairs: the smallest clearance left (`_w_clear`).
+        self._w_far = self.MakeWitnessFunction(FAR_WITNESS, down,
+                                               lambda c: self._witness(c, None, 'clear'), ev)
         self._memo = None
         self._eval_memo = {}
         self._far_cache = {}
@@ -501,26 +507,48 @@ class RigidContactSystem(LeafSystem):
         value.set_value(_Eval(q, v, qdot, sol.vdot, udot, evals, lam_n, lam_t,
                               sol.generalized_force, sol.power_lost_to_friction(rows), p_plant,
                               p_in, bound, {}, poses,
-                              np.array([f(q, v) for _, f in self.extra_powers], dtype=float)))
+                              np.array([f(q, v) for _, f in self.extra_powers], dtype=float),
+                              modes))
+
+    def _travel_bounds(self, idx, poses, pairs):
+        """Travel bounds of the far pairs ``idx`` (their states in ``pairs``) at ``poses``, at
+        once: |delta(X21 c1)| + |delta R21|_2 r1 (module docstring), inf for a pair never
+        sought."""
+        out = np.full(len(idx), math.inf)
+        known = [k for k, i in enumerate(idx) if pairs[i].ref_X21 is not None]
+        if not known:
+            return out
+        ids = [idx[k] for k in known]
+        rel = {}
+        for i in ids:
+            ab = self._fidx[i]
+            if ab not in rel:
+                (R1, p1), (R2, p2) = poses[ab[0]], poses[ab[1]]
+                rel[ab] = (R2.T @ R1, R2.T @ (p1 - p2))
+        R21 = np.array([rel[self._fidx[i]][0] for i in ids])
+        p21 = np.array([rel[self._fidx[i]][1] for i in ids])
+        R0 = np.array([pairs[i].ref_X21[0] for i in ids])
+        p0 = np.array([pairs[i].ref_X21[1] for i in ids])
+        lin = np.einsum("kij,kj->ki", R21 - R0, self._sphere_c[ids]) + p21 - p0
+        # |R21 - R0|_2 = |R0^T R21 - I|_2 = 2 sin(theta / 2) = sqrt(3 - tr(R0^T R21)).
+        rot = np.sqrt(np.maximum(3.0 - np.einsum("kij,kij->k", R0, R21), 0.0))
+        out[known] = np.sqrt(np.einsum("ki,ki->k", lin, lin)) + rot * self._sphere_r[ids]
+        return out
 
     def _travel_bound(self, i, poses, st):
-        if st.ref_X21 is None:
-            return math.inf
-        a, b = self._fidx[i]
-        R1, p1 = poses[a]
-        R2, p2 = poses[b]
-        R21, p21 = R2.T @ R1, R2.T @ (p1 - p2)
-        R0, p0 = st.ref_X21
-        c, r = self._spheres[i]
-        # |R21 - R0|_2 = |R0^T R21 - I|_2 = 2 sin(theta / 2) = sqrt(3 - tr(R0^T R21)).
-        return float(np.linalg.norm((R21 - R0) @ c + p21 - p0)
-                     + math.sqrt(max(3.0 - float(np.sum(R0 * R21)), 0.0)) * r)
+        pairs = [None] * len(self.pairs)
+        pairs[i] = st
+        return float(self._travel_bounds([i], poses, pairs)[0])
 
     def _bound(self, E, i, st):
         """The travel bound of far pair i at the evaluation E, computed when a witness or an
-        output asks for it (derivative evaluations do not need it)."""
+        output asks for it (derivative evaluations do not need it): all far pairs' at once."""
         if math.isnan(E.bound[i]):
-            E.bound[i] = self._travel_bound(i, E.poses, st)
+            pairs = E.modes.pairs
+            idx = [k for k, sk in enumerate(pairs) if sk.status == FAR and math.isnan(E.bound[k])]
+            if pairs[i] is not st:      # not E's own state of pair i
+                return self._travel_bound(i, E.poses, st)
+            E.bound[idx] = self._travel_bounds(idx, E.poses, pairs)
         return E.bound[i]
 
     def eval(self, context) -> _Eval:
@@ -609,10 +637,12 @@ class RigidContactSystem(LeafSystem):
     # ------------------------------------------------------------------ witnesses
     def DoGetWitnessFunctions(self, context):
         out = []
-        for i, st in enumerate(self.get_modes(context).pairs):
+        pairs = self.get_modes(context).pairs
+        if any(st.status == FAR for st in pairs):
+            out.append(self._w_far)
+        for i, st in enumerate(pairs):
             w = self._w[i]
             if st.status == FAR:
-                out.append(w["clear"])
                 continue
             out += [w["end"], w["cond"]]
             if st.status == TRACKED:
@@ -628,9 +658,12 @@ class RigidContactSystem(LeafSystem):
         """The values of the witnesses `DoGetWitnessFunctions` returns now, by description
         (used by `drake_dock.stepping.WitnessApproach` to predict their zeros)."""
         out = {}
-        for i, st in enumerate(self.get_modes(context).pairs):
+        pairs = self.get_modes(context).pairs
+        if any(st.status == FAR for st in pairs):
+            out[FAR_WITNESS] = self._witness(context, None, "clear")
+        for i, st in enumerate(pairs):
             if st.status == FAR:
-                kinds = ("clear",)
+                continue
             elif st.status == TRACKED:
                 kinds = ("end", "cond", "gap", "apex")
             else:
@@ -653,7 +686,7 @@ class RigidContactSystem(LeafSystem):
         w = E.witness.get(key)
         if w is None:
             w = E.witness[key] = float(getattr(self, self._W_FUNCS[kind])(
-                E, self.get_modes(context).pairs[i], i))
+                E, None if i is None else self.get_modes(context).pairs[i], i))
         return w
 
     def _w_gap(self, E, st, i):
@@ -700,9 +733,14 @@ class RigidContactSystem(LeafSystem):
         return self._mu_s * E.lam_n[i] - math.hypot(*E.lam_t[i])
 
     def _w_clear(self, E, st, i):
-        if st.status != FAR:
-            return 1.0
-        return st.clearance - self._bound(E, i, st)
+        """All far pairs' witness: the smallest clearance left, min (clearance - travel bound)
+        (1 if no pair is far). Its event seeks again every far pair whose clearance is used up
+        (`_resolve`)."""
+        w = math.inf
+        for k, sk in enumerate(E.modes.pairs):
+            if sk.status == FAR:
+                w = min(w, sk.clearance - self._bound(E, k, sk))
+        return 1.0 if w == math.inf else w
 
     # ------------------------------------------------------------------ events
     def _on_step(self, context, state):

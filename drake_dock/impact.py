@@ -237,16 +237,9 @@ class _Problem:
         un = y[self.iun]
         if not self.friction:
             # Fast path (most impacts): a handful of numpy operations.
-            lam = self.kappa * np.maximum(x, 0.0) ** self.eta_pow
-            dy = np.empty_like(y)
-            dy[:s] = -self.rate * un
-            dy[s:2 * s] = self.G @ lam
-            dy[2 * s:3 * s] = lam
-            power = lam * un
-            dy[3 * s:4 * s] = -power * self.comp_f
-            dy[4 * s:5 * s] = power * (self.comp_f - 1.0)
-            dy[5 * s:] = 0.0
-            return dy
+            return self._assemble(y, self.kappa * np.maximum(x, 0.0) ** self.eta_pow, un, 0.0)
+        if not self.stuck.any():
+            return self._rhs_sliding(y)
         lam_n, lam_t = self.forces(y)
         lam = np.concatenate([lam_n, lam_t.ravel()])
         du = self.G @ lam
@@ -264,6 +257,42 @@ class _Problem:
         dy[self.iwf] = -(lam_t * ut).sum(axis=1)
         return dy
 
+    def _rhs_sliding(self, y):
+        """`rhs` with friction when no couple sticks (most frictional impacts): the loaded
+        couples slide, lambda_t = -mu lambda_n u_t/|u_t|, and their friction power is
+        mu lambda_n |u_t|; the same equations in fewer numpy operations."""
+        s = self.s
+        x, un = y[:s], y[s:2 * s]
+        lam = np.empty(3 * s)
+        lam_n = lam[:s]
+        np.power(np.maximum(x, 0.0), self.eta_pow, out=lam_n)
+        lam_n *= self.kappa
+        ut = y[2 * s:4 * s].reshape(s, 2)
+        nt = np.sqrt(np.einsum("ij,ij->i", ut, ut))
+        big = nt > self.v_tiny
+        if big.all():
+            d = ut / nt[:, None]
+        else:
+            d = np.where(big[:, None], ut / np.where(big, nt, 1.0)[:, None], self.slip_dir)
+        lam_t = lam[s:].reshape(s, 2)
+        mu_lam = self.mu * lam_n
+        np.multiply(d, -mu_lam[:, None], out=lam_t)
+        return self._assemble(y, lam, un, mu_lam * np.einsum("ij,ij->i", d, ut))
+
+    def _assemble(self, y, lam, un, friction_power):
+        """dy/dtau from the force rates lam (normal, then tangential pairs if any): x, u, P,
+        compression and expansion works, friction dissipation (Eq. 30-31, 35)."""
+        s, nu = self.s, len(lam)
+        dy = np.empty_like(y)
+        dy[:s] = -self.rate * un
+        dy[s:s + nu] = self.G @ lam
+        dy[s + nu:s + 2 * nu] = lam
+        power = lam[:s] * un
+        dy[s + 2 * nu:2 * s + 2 * nu] = -power * self.comp_f
+        dy[2 * s + 2 * nu:3 * s + 2 * nu] = power * (self.comp_f - 1.0)
+        dy[3 * s + 2 * nu:] = friction_power
+        return dy
+
     # Events ---------------------------------------------------------------------------------
     def event_values(self, y):
         """Per couple, functions whose crossing from > 0 to <= 0 is a phase event:
@@ -276,7 +305,12 @@ class _Problem:
         # x <= 0 (a gap): x crosses zero upwards (re-impact), written as -x.
         g[0] = np.where(self.phase == _COMP, np.where(x > 0, -un, -x), x - self.x_end)
         g[1] = np.inf
-        if self.friction:
+        if self.friction and not self.stuck.any():
+            # No couple sticks: the loaded ones (x > 0) slide.
+            ut = y[2 * s:4 * s].reshape(s, 2)
+            loaded = x > 0
+            g[1][loaded] = np.einsum("ij,ij->i", ut, self.slip_dir)[loaded]
+        elif self.friction:
             lam_n, lam_t = self.forces(y)
             ut = y[self.iu][s:].reshape(s, 2)
             loaded = lam_n > 0

@@ -39,45 +39,16 @@ import math
 
 import numpy as np
 
+# One couple is evaluated in plain floats (3-tuples).
+from drake_dock.core.vec3 import add as _add, axpy as _axpy, cross as _cr, dot as _dot, \
+    mul as _mul, rot as _rot, sub as _sub
+
 
 def cross(a, b):
     """3-vector cross product of numpy arrays (np.cross costs ~10 us per call on small
     vectors)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
                      a[0] * b[1] - a[1] * b[0]])
-
-
-# One couple is evaluated in plain floats (3-tuples): a few hundred operations on 3-vectors,
-# each several times cheaper than the same numpy call.
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def _cr(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-def _mul(a, s):
-    return (a[0] * s, a[1] * s, a[2] * s)
-
-
-def _axpy(s, a, b):
-    """s a + b."""
-    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
-
-
-def _rot(R, a):
-    r0, r1, r2 = R
-    return (r0[0] * a[0] + r0[1] * a[1] + r0[2] * a[2], r1[0] * a[0] + r1[1] * a[1]
-            + r1[2] * a[2], r2[0] * a[0] + r2[1] * a[1] + r2[2] * a[2])
 
 
 def _unit(a):

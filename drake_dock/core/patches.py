@@ -91,6 +91,19 @@ class Patch:
         mesh = np.meshgrid(*axes, indexing="ij")
         return np.stack([m.ravel() for m in mesh], axis=-1)
 
+    def grid_points(self, n):
+        """(`grid` (n), positions there), computed once per patch and n (read-only arrays):
+        the coarse grid every seek of the patch starts from."""
+        cache = self.__dict__.setdefault("_grid_points", {})
+        hit = cache.get(n)
+        if hit is None:
+            U = self.grid(n)
+            r = self.position(U)
+            U.flags.writeable = False
+            r.flags.writeable = False
+            hit = cache[n] = (U, r)
+        return hit
+
     @property
     def span(self):
         return self.upper - self.lower

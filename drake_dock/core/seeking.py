@@ -8,8 +8,11 @@ Everything is vectorised over the grid; only the pair asked for is searched.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
+
+from drake_dock.core import vec3 as v3
 
 from drake_dock.errors import SeekingError
 
@@ -31,18 +34,12 @@ class Couple:
         return np.concatenate([self.u1, self.u2])
 
 
-def _pairwise_d2(P1, P2, U1, U2):
-    X1 = P1.position(U1)
-    X2 = P2.position(U2)
-    # |x1 - x2|^2 on the product grid without forming the full difference tensor.
-    return (np.einsum("ix,ix->i", X1, X1)[:, None] + np.einsum("jx,jx->j", X2, X2)[None, :]
-            - 2.0 * X1 @ X2.T)
-
-
-def _pairwise_min(P1, P2, U1, U2):
-    d2 = _pairwise_d2(P1, P2, U1, U2)
-    i, j = np.unravel_index(np.argmin(d2), d2.shape)
-    return U1[i], U2[j]
+def _pairwise_d2(X1, X2):
+    """|x1 - x2|^2 for every pair of rows of X1 (..., m1, 3) and X2 (..., m2, 3), without
+    forming the difference tensor; leading axes are batched."""
+    return (np.einsum("...ix,...ix->...i", X1, X1)[..., :, None]
+            + np.einsum("...jx,...jx->...j", X2, X2)[..., None, :]
+            - 2.0 * X1 @ np.swapaxes(X2, -1, -2))
 
 
 def _distinct_best(d2, U1, U2, h1, h2, k):
@@ -56,18 +53,27 @@ def _distinct_best(d2, U1, U2, h1, h2, k):
             chosen.append((i, j))
             if len(chosen) == k:
                 break
-    return [(U1[i], U2[j]) for i, j in chosen]
+    return [U1[i] for i, _ in chosen], [U2[j] for _, j in chosen]
 
 
-def _local_grid(patch, centre, half_width, n):
-    axes = []
-    for k in range(patch.dim):
-        lo, hi = centre[k] - half_width[k], centre[k] + half_width[k]
-        if not patch.periodic[k]:
-            lo, hi = max(lo, patch.lower[k]), min(hi, patch.upper[k])
-        axes.append(np.linspace(lo, hi, n))
-    mesh = np.meshgrid(*axes, indexing="ij")
-    return patch.wrap(np.stack([m.ravel() for m in mesh], axis=-1))
+def _local_grids(patch, centres, half_width, n):
+    """Around each row c of ``centres`` (C, dim), the tensor grid of n points per parameter
+    spanning c +- half_width (clipped to the domain for bounded parameters, wrapped for
+    periodic ones), in the order of ``meshgrid(..., indexing="ij")``: shape (C, n**dim, dim)."""
+    lo, hi = centres - half_width, centres + half_width
+    bounded = ~np.array(patch.periodic)
+    lo = np.where(bounded, np.maximum(lo, patch.lower), lo)
+    hi = np.where(bounded, np.minimum(hi, patch.upper), hi)
+    axes = lo[:, :, None] + (hi - lo)[:, :, None] * np.linspace(0.0, 1.0, n)   # (C, dim, n)
+    if patch.dim == 1:
+        U = axes[:, 0, :, None]
+    else:
+        mesh = [np.broadcast_to(axes[:, k].reshape((-1,) + (1,) * k + (n,)
+                                                   + (1,) * (patch.dim - 1 - k)),
+                                (len(centres),) + (n,) * patch.dim).reshape(len(centres), -1)
+                for k in range(patch.dim)]
+        U = np.stack(mesh, axis=-1)
+    return patch.wrap(U)
 
 
 def hierarchical_seek(P1, P2, *, n_coarse=12, levels=2, n_fine=21, candidates=3):
@@ -75,20 +81,71 @@ def hierarchical_seek(P1, P2, *, n_coarse=12, levels=2, n_fine=21, candidates=3)
     the previous level around its best point. The ``candidates`` best coarse couples that are
     distinct (more than two cells apart) are refined, since a nearly flat distance (a ring
     almost coaxial with a cone) can put the best coarse cell in the wrong valley. Returns a list
-    of (u1, u2), best first."""
-    U1, U2 = P1.patch.grid(n_coarse), P2.patch.grid(n_coarse)
+    of (u1, u2), best first. The candidates are refined together (one batch per level), and
+    the coarse grid's points are the patches' cached ones (`Patch.grid_points`) posed."""
+    U1, r1 = P1.patch.grid_points(n_coarse)
+    U2, r2 = P2.patch.grid_points(n_coarse)
     h1 = P1.patch.span / (n_coarse - 1)
     h2 = P2.patch.span / (n_coarse - 1)
-    d2 = _pairwise_d2(P1, P2, U1, U2)
-    out = []
-    for u1, u2 in _distinct_best(d2, U1, U2, h1, h2, candidates):
-        g1, g2 = h1, h2
-        for _ in range(levels):
-            u1, u2 = _pairwise_min(P1, P2, _local_grid(P1.patch, u1, 2 * g1, n_fine),
-                                   _local_grid(P2.patch, u2, 2 * g2, n_fine))
-            g1, g2 = 4 * g1 / (n_fine - 1), 4 * g2 / (n_fine - 1)
-        out.append((u1, u2))
-    return out
+    d2 = _pairwise_d2(r1 @ P1.R.T + P1.p, r2 @ P2.R.T + P2.p)
+    c1, c2 = _distinct_best(d2, U1, U2, h1, h2, candidates)
+    c1, c2 = np.array(c1), np.array(c2)
+    C = len(c1)
+    g1, g2 = h1, h2
+    for _ in range(levels):
+        G1 = _local_grids(P1.patch, c1, 2 * g1, n_fine)
+        G2 = _local_grids(P2.patch, c2, 2 * g2, n_fine)
+        m1, m2 = G1.shape[1], G2.shape[1]
+        X1 = P1.position(G1.reshape(C * m1, -1)).reshape(C, m1, 3)
+        X2 = P2.position(G2.reshape(C * m2, -1)).reshape(C, m2, 3)
+        i, j = np.divmod(_pairwise_d2(X1, X2).reshape(C, -1).argmin(axis=1), m2)
+        c1, c2 = G1[np.arange(C), i], G2[np.arange(C), j]
+        g1, g2 = 4 * g1 / (n_fine - 1), 4 * g2 / (n_fine - 1)
+    return list(zip(c1, c2))
+
+
+def _chol_solve(A, b):
+    """x = A^-1 b by Cholesky for a small symmetric matrix in floats, with det(A); None when
+    A is not positive definite."""
+    n = len(b)
+    L = [[0.0] * n for _ in range(n)]
+    det = 1.0
+    for i in range(n):
+        for j in range(i + 1):
+            s = A[i][j] - sum(L[i][k] * L[j][k] for k in range(j))
+            if i == j:
+                if not s > 0.0:
+                    return None
+                L[i][i] = math.sqrt(s)
+                det *= s
+            else:
+                L[i][j] = s / L[j][j]
+    y = [0.0] * n
+    for i in range(n):
+        y[i] = (b[i] - sum(L[i][k] * y[k] for k in range(i))) / L[i][i]
+    x = [0.0] * n
+    for i in reversed(range(n)):
+        x[i] = (y[i] - sum(L[k][i] * x[k] for k in range(i + 1, n))) / L[i][i]
+    return x, det
+
+
+def _descent_step(H, g):
+    """-|H|^-1 g with the eigenvalues of H made positive and floored at 1e-10 max(1, |w|max):
+    the Newton step where H is safely positive definite, always a descent direction. A
+    Cholesky solve when the floor cannot bind (lambda_min >= det / tr^(n-1) is above it), the
+    eigen-decomposition otherwise."""
+    n = len(g)
+    if n == 1:
+        return [-g[0] / max(abs(H[0][0]), 1e-10 * max(1.0, abs(H[0][0])))]
+    fact = _chol_solve(H, g)
+    if fact is not None:
+        x, det = fact
+        tr = sum(H[i][i] for i in range(n))
+        if det / tr ** (n - 1) >= 1e-10 * max(1.0, tr):
+            return [-a for a in x]
+    w, V = np.linalg.eigh(np.array(H))
+    w = np.maximum(np.abs(w), 1e-10 * max(1.0, np.abs(w).max()))
+    return (-V @ ((V.T @ np.array(g)) / w)).tolist()
 
 
 def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None,
@@ -102,91 +159,108 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None
     valley (a ring nearly coaxial with a cone), where the couple walks along the valley for
     many iterations while the distance changes in its seventh digit. This applies only while
     the distance exceeds ``rtol_beyond``; the distance is then converged to about 1e2
-    distance_rtol (the valley's many small steps add up), not the couple."""
-    n1 = P1.patch.dim
-    u = np.concatenate([u1, u2]).astype(float)
-    lower = np.concatenate([P1.patch.lower, P2.patch.lower])
-    upper = np.concatenate([P1.patch.upper, P2.patch.upper])
-    periodic = np.array(P1.patch.periodic + P2.patch.periodic)
-    scale = np.maximum(np.concatenate([P1.patch.span, P2.patch.span]), 1e-300)
+    distance_rtol (the valley's many small steps add up), not the couple.
 
-    def world(P, u):
-        r, T, K = P.patch.jet(u)
-        R = P.R
-        return (R @ r + P.p, R @ np.array(T).T,
-                np.einsum("xy,aby->xab", R, np.array(K)) if K is not None else None)
+    One point at a time in plain floats (the patches' jets, `drake_dock.core.vec3`)."""
+    pa, pb = P1.patch, P2.patch
+    n1 = pa.dim
+    n = n1 + pb.dim
+    u = [float(a) for a in u1] + [float(a) for a in u2]
+    lower = [float(a) for a in pa.lower] + [float(a) for a in pb.lower]
+    upper = [float(a) for a in pa.upper] + [float(a) for a in pb.upper]
+    periodic = tuple(pa.periodic) + tuple(pb.periodic)
+    scale = [max(float(a), 1e-300) for a in list(pa.span) + list(pb.span)]
+    R1, o1 = P1.R.tolist(), tuple(P1.p.tolist())
+    R2, o2 = P2.R.tolist(), tuple(P2.p.tolist())
+    eps8 = 8 * np.finfo(float).eps
+    idx = range(n)
 
-    def parts(u, second=False):
-        r1, T1, K1 = world(P1, u[:n1])
-        r2, T2, K2 = world(P2, u[n1:])
-        d = r1 - r2
-        J = np.concatenate([T1, -T2], axis=1)
-        if second:
-            # Round-off of d = r1 - r2 is about eps (|r1| + |r2|): far from the world origin
-            # it, not |d|, sets how small the gradient J^T d can get.
-            return d, J, K1, K2, 8 * np.finfo(float).eps * (np.abs(r1).max() + np.abs(r2).max())
-        return d, J
+    def gap_vector(u):
+        return v3.sub(v3.add(v3.rot(R1, pa.jet(u[:n1])[0]), o1),
+                      v3.add(v3.rot(R2, pb.jet(u[n1:])[0]), o2))
 
+    gfree = [0.0] * n
+    norm_J = norm_d = 0.0
     for it in range(1, max_iter + 1):
-        d, J, K1, K2, d_roundoff = parts(u, second=True)
-        g = J.T @ d
-        S1 = np.einsum("x,xab->ab", d, K1)
-        S2 = np.einsum("x,xab->ab", d, K2)
-        H = J.T @ J
-        H[:n1, :n1] += S1
-        H[n1:, n1:] -= S2
+        r1, T1, K1 = pa.jet(u[:n1])
+        r2, T2, K2 = pb.jet(u[n1:])
+        x1, x2 = v3.add(v3.rot(R1, r1), o1), v3.add(v3.rot(R2, r2), o2)
+        d = v3.sub(x1, x2)
+        # J = [T1, -T2] (world tangents); g = J^T d; H = J^T J + diag(d.K1, -d.K2).
+        cols = [v3.rot(R1, t) for t in T1] + [v3.mul(v3.rot(R2, t), -1.0) for t in T2]
+        g = [v3.dot(c, d) for c in cols]
+        H = [[v3.dot(cols[a], cols[b]) for b in idx] for a in idx]
+        d1, d2 = v3.rot_t(R1, d), v3.rot_t(R2, d)     # d.(R K) = (R^T d).K
+        for a in range(n1):
+            for b in range(n1):
+                H[a][b] += v3.dot(d1, K1[a][b])
+        for a in range(n - n1):
+            for b in range(n - n1):
+                H[n1 + a][n1 + b] -= v3.dot(d2, K2[a][b])
+        norm_J = math.sqrt(sum(v3.dot(c, c) for c in cols))     # Frobenius
+        norm_d = math.sqrt(v3.dot(d, d))
+        # Round-off of d = r1 - r2 is about eps (|r1| + |r2|): far from the world origin it,
+        # not |d|, sets how small the gradient J^T d can get.
+        d_roundoff = eps8 * (max(abs(a) for a in x1) + max(abs(a) for a in x2))
         # Active set with a band (Bertsekas' projected Newton): a parameter within a band
         # (at most 1e-3 of its span) from a bound that the gradient pushes outwards is moved
-        # onto the bound and
-        # held; approaching the bound by clipped, backtracked steps converges only linearly.
-        # The band shrinks with the coordinate's own Newton distance |g_i| / H_ii, so that it
-        # vanishes at a minimum that lies inside the domain close to a bound.
-        band = np.minimum(1e-3 * scale, np.abs(g) / np.maximum(np.abs(np.diag(H)), 1e-300))
-        at_lo = (~periodic) & (u <= lower + band) & (g > 0)
-        at_hi = (~periodic) & (u >= upper - band) & (g < 0)
-        free = ~(at_lo | at_hi)
-        step = np.zeros_like(u)
-        step[at_lo] = (lower - u)[at_lo]
-        step[at_hi] = (upper - u)[at_hi]
-        gfree = np.where(free, g, 0.0)
+        # onto the bound and held; approaching the bound by clipped, backtracked steps
+        # converges only linearly. The band shrinks with the coordinate's own Newton distance
+        # |g_i| / H_ii, so that it vanishes at a minimum that lies inside the domain close to
+        # a bound.
+        step = [0.0] * n
+        free = []
+        on_bounds = True
+        for i in idx:
+            gi = g[i]
+            band = min(1e-3 * scale[i], abs(gi) / max(abs(H[i][i]), 1e-300))
+            if not periodic[i] and u[i] <= lower[i] + band and gi > 0:
+                step[i] = lower[i] - u[i]
+            elif not periodic[i] and u[i] >= upper[i] - band and gi < 0:
+                step[i] = upper[i] - u[i]
+            else:
+                free.append(i)
+                continue
+            on_bounds = on_bounds and step[i] == 0.0
+        gfree = [g[i] if i in free else 0.0 for i in idx]
+        norm_gfree = math.sqrt(sum(a * a for a in gfree))
         # Converged when the projected gradient vanishes to round-off (this also ends a flat
         # valley, e.g. two coaxial arcs of equal radius where every couple is minimal).
-        on_bounds = np.all(step[~free] == 0.0)
-        if on_bounds and np.linalg.norm(gfree) <= np.linalg.norm(J) * max(
-                1e-13 * np.linalg.norm(d), d_roundoff):
+        if on_bounds and norm_gfree <= norm_J * max(1e-13 * norm_d, d_roundoff):
             break
         # Touching to round-off (a tangent touch makes |d|^2 flat to fourth order, where
         # Newton on it only converges linearly): the contact form finishes it (couple.py).
-        if on_bounds and np.linalg.norm(gfree) <= 1e-15 * np.linalg.norm(J) ** 2:
+        if on_bounds and norm_gfree <= 1e-15 * norm_J ** 2:
             break
-        if free.any():
+        if free:
             # Newton step with the Hessian's eigenvalues made positive (|lambda|, floored), so
             # that the step always descends; unchanged near a strict minimum.
-            w, V = np.linalg.eigh(H[np.ix_(free, free)])
-            w = np.maximum(np.abs(w), 1e-10 * max(1.0, np.abs(w).max()))
-            step[free] = -V @ ((V.T @ g[free]) / w)
+            sf = _descent_step([[H[a][b] for b in free] for a in free], [g[a] for a in free])
+            for a, s in zip(free, sf):
+                step[a] = s
             # A nearly flat direction (a coaxial circle along a surface of revolution) gives a
             # huge step that backtracking would shrink by many trials: cap it at a quarter
             # of the domain instead.
-            reach = np.max(np.abs(step) / scale)
+            reach = max(abs(s) / c for s, c in zip(step, scale))
             if reach > 0.25:
-                step *= 0.25 / reach
+                step = [s * (0.25 / reach) for s in step]
         # Backtracking on f keeps the iteration a descent method far from the minimum; a step
         # that cannot decrease f at all means f is at its minimum to round-off.
-        f0 = 0.5 * d @ d
-        if -(g @ step) <= 1e-15 * f0:
+        f0 = 0.5 * norm_d * norm_d
+        slope = sum(a * b for a, b in zip(g, step))
+        if -slope <= 1e-15 * f0:
             break
         # df = |d| d|d|: the predicted shortening of the distance by this step.
         far = distance_rtol is not None and on_bounds and 2.0 * f0 > rtol_beyond ** 2
-        if far and -(g @ step) <= distance_rtol * 2.0 * f0:
+        if far and -slope <= distance_rtol * 2.0 * f0:
             break
         t = 1.0
         while True:
-            un = u + t * step
-            un = np.where(periodic, un, np.clip(un, lower, upper))
-            dn, _ = parts(un)
-            fn = 0.5 * dn @ dn
-            if fn <= f0 + 1e-4 * (g @ (un - u)):
+            un = [a + t * s if periodic[i] else min(max(a + t * s, lower[i]), upper[i])
+                  for i, (a, s) in enumerate(zip(u, step))]
+            dn = gap_vector(un)
+            fn = 0.5 * v3.dot(dn, dn)
+            if fn <= f0 + 1e-4 * sum(gi * (b - a) for gi, a, b in zip(g, u, un)):
                 break
             t *= 0.25
             if t < 1e-12:
@@ -194,9 +268,9 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None
                 break
         if un is None:
             break
-        moved = np.abs(un - u) / scale
+        moved = max(abs(b - a) / c for a, b, c in zip(u, un, scale))
         u = un
-        if moved.max() < tol:
+        if moved < tol:
             break
         # The step just taken shortened the distance by less than distance_rtol of it.
         if far and f0 - fn <= distance_rtol * 2.0 * f0:
@@ -206,11 +280,12 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None
         # creeping at a gradient of 1e-13: a point whose projected gradient is 1e-10 of
         # |J| |d| is accepted (the distance is stationary there to second order). Otherwise
         # report with the residual so that the caller can name the couple.
-        if np.linalg.norm(gfree) > 1e-10 * np.linalg.norm(J) * np.linalg.norm(d):
+        norm_gfree = math.sqrt(sum(a * a for a in gfree))
+        if norm_gfree > 1e-10 * norm_J * norm_d:
             raise SeekingError(f"closest-couple Newton did not converge in {max_iter} iterations "
-                               f"(projected gradient {np.linalg.norm(gfree):.3e})")
-    u = np.concatenate([P1.patch.wrap(u[:n1]), P2.patch.wrap(u[n1:])])
-    return u[:n1], u[n1:], it
+                               f"(projected gradient {norm_gfree:.3e})")
+    u = np.array(u)
+    return pa.wrap(u[:n1]), pb.wrap(u[n1:]), it
 
 
 def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, **grid_options) -> Couple:

@@ -1,0 +1,102 @@
+"""The seek's building blocks against independent constructions: the batched local grids
+against numpy's meshgrid, the Newton step against the floored eigen-decomposition, and the far
+pairs' travel bound against the actual displacement of every point of the patch."""
+import math
+
+import numpy as np
+import pytest
+
+from drake_dock.contact_system import FAR, PairState
+from drake_dock.core.patches import Circle, Cone
+from drake_dock.core.seeking import _descent_step, _local_grids
+from drake_dock.small_scenes import stool
+
+
+@pytest.mark.parametrize("patch", [Cone(0.6, math.radians(45), (0.1, 1.0), (0.0, 0.2)),
+                                   Circle(0.5, 0.1)], ids=["cone", "circle"])
+def test_local_grids_match_meshgrid(patch):
+    rng = np.random.default_rng(1)
+    centres = rng.uniform(patch.lower, patch.upper, size=(4, patch.dim))
+    centres[0] = patch.lower            # clipped at the lower ends (or wrapped)
+    half = 0.3 * patch.span
+    got = _local_grids(patch, centres, half, 7)
+    for c, g in zip(centres, got):
+        axes = []
+        for k in range(patch.dim):
+            lo, hi = c[k] - half[k], c[k] + half[k]
+            if not patch.periodic[k]:
+                lo, hi = max(lo, patch.lower[k]), min(hi, patch.upper[k])
+            axes.append(np.linspace(lo, hi, 7))
+        mesh = np.meshgrid(*axes, indexing="ij")
+        want = patch.wrap(np.stack([m.ravel() for m in mesh], axis=-1))
+        np.testing.assert_allclose(g, want, rtol=0, atol=1e-15)
+
+
+def _floored_eigen_step(H, g):
+    w, V = np.linalg.eigh(H)
+    w = np.maximum(np.abs(w), 1e-10 * max(1.0, np.abs(w).max()))
+    return -V @ ((V.T @ g) / w)
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4])
+def test_descent_step_is_the_floored_eigen_step(n):
+    rng = np.random.default_rng(n)
+    for case in range(30):
+        A = rng.normal(size=(n, n))
+        if case % 3 == 0:        # positive definite
+            H = A @ A.T + 0.1 * np.eye(n)
+        elif case % 3 == 1:      # indefinite
+            H = A + A.T
+        else:                    # nearly singular: eigenvalues 1 .. 1e-13
+            Q, _ = np.linalg.qr(A)
+            H = Q @ np.diag(np.logspace(0, -13, n)) @ Q.T
+        g = rng.normal(size=n)
+        want = _floored_eigen_step(H, g)
+        got = np.array(_descent_step(H.tolist(), g.tolist()))
+        np.testing.assert_allclose(got, want, rtol=1e-7, atol=1e-12 * np.abs(want).max())
+        assert got @ g < 0.0     # a descent direction
+
+
+def _random_rotation(rng, angle=None):
+    q = rng.normal(size=4)
+    if angle is not None:
+        axis = q[1:] / np.linalg.norm(q[1:])
+        q = np.concatenate([[math.cos(angle / 2)], math.sin(angle / 2) * axis])
+    w, x, y, z = q / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def test_far_pair_travel_bound_covers_every_point_of_the_patch():
+    """The bound of each far pair (all pairs at once) is at least the largest displacement,
+    relative to frame 2, of the points of patch 1 since the reference pose; a pair never
+    sought has an infinite bound."""
+    system = stool().system
+    rng = np.random.default_rng(7)
+    k = len(system.pairs)
+    for trial in range(20):
+        poses0 = [(_random_rotation(rng), rng.normal(size=3)) for _ in system._frames]
+        scale = 10.0 ** rng.uniform(-4, 0)
+        poses1 = [(_random_rotation(rng, scale * rng.uniform(0, 1)) @ R, p + scale
+                   * rng.normal(size=3)) for R, p in poses0]
+        states = []
+        for i in range(k):
+            a, b = system._fidx[i]
+            (R1, p1), (R2, p2) = poses0[a], poses0[b]
+            states.append(PairState(FAR, ref_X21=(R2.T @ R1, R2.T @ (p1 - p2))))
+        bounds = system._travel_bounds(list(range(k)), poses1, states)
+        for i, pair in enumerate(system.pairs):
+            r = pair.patch1.position(pair.patch1.grid(61))
+            a, b = system._fidx[i]
+            moved = []
+            for poses in (poses0, poses1):
+                (R1, p1), (R2, p2) = poses[a], poses[b]
+                moved.append((r @ R1.T + p1 - p2) @ R2)      # points in frame 2
+            actual = np.linalg.norm(moved[1] - moved[0], axis=1).max()
+            assert actual <= bounds[i]
+            assert bounds[i] <= 3.0 * actual + 1e-12     # and not vacuous
+            assert bounds[i] == pytest.approx(system._travel_bound(i, poses1, states[i]),
+                                              rel=1e-14)
+    states[1] = PairState(FAR)
+    assert math.isinf(system._travel_bounds([0, 1, 2], poses1, states)[1])
