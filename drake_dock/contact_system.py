@@ -56,7 +56,8 @@ from pydrake.systems.framework import (EventStatus, LeafSystem, UnrestrictedUpda
 
 from drake_dock.core.constraints import (DETACH, SLIDE, STICK, ContactRow, select_modes,
                                          solve_given_modes)
-from drake_dock.core.couple import closest_point_conditions, evaluate_couple
+from drake_dock.core.couple import (closest_point_conditions, evaluate_couple, float_pose,
+                                    float_vec)
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.core.tracking import SingularCoupleError
@@ -132,7 +133,7 @@ class ContactOptions:
     zeno_speed: float = 1e-3         # m/s: the Zeno guard (see the module docstring)
     impact_gap_tol: float = 1e-8     # m: couples this near join an impact
     impact_rtol: float = 1e-10       # LZB's impulse-domain integration (`solve_lzb`); the
-                                     # docking diagram sets 1e-3 x the simulation accuracy
+                                     # docking diagram sets 1e-2 x the simulation accuracy
     seek_rtol: float = 1e-7          # a seek's Newton ends when a step shortens the distance
                                      # by less than this fraction, for pairs farther than
                                      # track_distance (`seek_couple`): their distance only sets
@@ -216,6 +217,7 @@ class _Eval:
     poses: list
     extra_power: np.ndarray
     modes: object = None   # the ContactModes this evaluation was made with
+    xdot: np.ndarray = None  # the state's time derivative
 
 
 def _bounding_sphere(patch, n=41):
@@ -334,6 +336,11 @@ class RigidContactSystem(LeafSystem):
                                                lambda c: self._witness(c, None, 'clear'), ev)
         self._memo = None
         self._eval_memo = {}
+        # Reused by `_free_acceleration` (never written: the first two).
+        self._zero_v = np.zeros(self.nv)
+        self._no_forces = MultibodyForces(plant)
+        self._forces_fe = MultibodyForces(plant)
+        self._forces_in = MultibodyForces(plant)
         self._far_cache = {}
         self.evaluations = 0
         self.timing = Timing([p.name for p in pairs])
@@ -384,14 +391,12 @@ class RigidContactSystem(LeafSystem):
         world = self.plant.world_frame()
         R1, o1 = poses[a]
         R2, o2 = poses[b]
-        J = (self.plant.CalcJacobianTranslationalVelocity(ctx, _KV, p.frame1, R1.T @ (ev.p1 - o1),
-                                                          world, world)
-             - self.plant.CalcJacobianTranslationalVelocity(ctx, _KV, p.frame2,
-                                                            R2.T @ (ev.p2 - o2), world, world))
-        ab = (self.plant.CalcBiasTranslationalAcceleration(ctx, _KV, p.frame1,
-                                                           R1.T @ (ev.p1 - o1), world, world)
-              - self.plant.CalcBiasTranslationalAcceleration(ctx, _KV, p.frame2,
-                                                             R2.T @ (ev.p2 - o2), world, world))
+        s1, s2 = (ev.p1 - o1) @ R1, (ev.p2 - o2) @ R2     # the points in their frames
+        plant = self.plant
+        J = (plant.CalcJacobianTranslationalVelocity(ctx, _KV, p.frame1, s1, world, world)
+             - plant.CalcJacobianTranslationalVelocity(ctx, _KV, p.frame2, s2, world, world))
+        ab = (plant.CalcBiasTranslationalAcceleration(ctx, _KV, p.frame1, s1, world, world)
+              - plant.CalcBiasTranslationalAcceleration(ctx, _KV, p.frame2, s2, world, world))
         D = np.array([ev.n, ev.ta, ev.tb]).T          # columns n, ta, tb
         W = J.T @ D
         b = D.T @ ab.ravel()
@@ -407,19 +412,21 @@ class RigidContactSystem(LeafSystem):
         """M, M^-1, a0 = M^-1 tau (every force but contact), and the power of the plant's
         force elements and of the inputs. Drake's inverse dynamics at zero acceleration gives
         C(q, v) v - tau for any set of forces."""
-        zero = np.zeros(self.nv)
+        zero = self._zero_v
         ID = self.plant.CalcInverseDynamics
-        bias = ID(ctx, zero, MultibodyForces(self.plant))
-        fe = MultibodyForces(self.plant)
+        bias = ID(ctx, zero, self._no_forces)
+        fe = self._forces_fe     # set, not added, by CalcForceElementsContribution
         self.plant.CalcForceElementsContribution(ctx, fe)
         tau_el = bias - ID(ctx, zero, fe)
         tau_in = np.zeros(self.nv)
         if self._gf_port.HasValue(context):
             tau_in += self._gf_port.Eval(context)
-        wf, any_in = MultibodyForces(self.plant), False
+        wf, any_in = self._forces_in, False
         for body, port in self._wrench_ports.values():
             if port.HasValue(context):
                 w = port.Eval(context)
+                if not any_in:
+                    wf.SetZero()
                 body.AddInForce(ctx, np.zeros(3), SpatialForce(w[:3], w[3:]),
                                 self.plant.world_frame(), wf)
                 any_in = True
@@ -474,6 +481,9 @@ class RigidContactSystem(LeafSystem):
         modes = self.get_modes(context)
         ctx = self._set_scratch(q, v)
         poses, twists = self._frame_kinematics(ctx)
+        # The couples work in plain floats: the frames' poses and twists converted once.
+        fposes = [float_pose(X) for X in poses]
+        ftwists = [(float_vec(w), float_vec(v)) for w, v in twists]
         k = len(self.pairs)
         evals = [None] * k
         udot = np.zeros(self.nu)
@@ -483,7 +493,7 @@ class RigidContactSystem(LeafSystem):
             sl = slice(self._uoff[i], self._uoff[i + 1])
             if st.status == FAR:
                 continue
-            ev = self._couple(i, u[sl], poses, twists, st.sigma, t)
+            ev = self._couple(i, u[sl], fposes, ftwists, st.sigma, t)
             evals[i] = ev
             udot[sl] = ev.udot + self.options.drift_feedback * ev.drift
             if st.status == CONTACT:
@@ -504,11 +514,13 @@ class RigidContactSystem(LeafSystem):
         for j, i in enumerate(row_pairs):
             lam_n[i], lam_t[i] = sol.lam_n[j], sol.lam_t[j]
         qdot = self.plant.MapVelocityToQDot(ctx, v)
-        value.set_value(_Eval(q, v, qdot, sol.vdot, udot, evals, lam_n, lam_t,
-                              sol.generalized_force, sol.power_lost_to_friction(rows), p_plant,
-                              p_in, bound, {}, poses,
-                              np.array([f(q, v) for _, f in self.extra_powers], dtype=float),
-                              modes))
+        E = _Eval(q, v, qdot, sol.vdot, udot, evals, lam_n, lam_t, sol.generalized_force,
+                  sol.power_lost_to_friction(rows), p_plant, p_in, bound, {}, poses,
+                  np.array([f(q, v) for _, f in self.extra_powers], dtype=float), modes)
+        E.xdot = np.concatenate([qdot, E.vdot, udot, np.array(
+            [E.friction_power, E.applied_power, E.external_power, *E.extra_power])
+            / self.energy_scale])
+        value.set_value(E)
 
     def _travel_bounds(self, idx, poses, pairs):
         """Travel bounds of the far pairs ``idx`` (their states in ``pairs``) at ``poses``, at
@@ -555,11 +567,7 @@ class RigidContactSystem(LeafSystem):
         return self._cache.Eval(context)
 
     def DoCalcTimeDerivatives(self, context, derivatives):
-        E = self._cache.Eval(context)
-        derivatives.get_mutable_vector().SetFromVector(np.concatenate(
-            [E.qdot, E.vdot, E.udot,
-             np.array([E.friction_power, E.applied_power, E.external_power,
-                       *E.extra_power]) / self.energy_scale]))
+        derivatives.get_mutable_vector().SetFromVector(self._cache.Eval(context).xdot)
 
     # ------------------------------------------------------------------ outputs
     def _out_state(self, context, out):
@@ -585,32 +593,36 @@ class RigidContactSystem(LeafSystem):
                                            self.get_modes(context).impact_loss], w[3:]]))
 
     def _out_couple(self, context, out, i):
-        out.SetFromVector(self._couple_row(context, self._cache.Eval(context),
-                                           self.get_modes(context).pairs[i], i))
+        y = np.zeros(COUPLE_OUTPUT_SIZE)
+        self._couple_row(y, context.get_continuous_state_vector().CopyToVector(),
+                         self._cache.Eval(context), self.get_modes(context).pairs[i], i)
+        out.SetFromVector(y)
 
     def couple_table(self, context) -> np.ndarray:
         """All couples' outputs at once, row i the value of port ``couple_<pairs[i].name>``
         (for loggers: one call instead of one port evaluation per couple)."""
         E = self._cache.Eval(context)
-        modes = self.get_modes(context)
-        return np.stack([self._couple_row(context, E, st, i)
-                         for i, st in enumerate(modes.pairs)])
+        x = context.get_continuous_state_vector().CopyToVector()
+        Y = np.zeros((len(self.pairs), COUPLE_OUTPUT_SIZE))
+        for i, st in enumerate(self.get_modes(context).pairs):
+            self._couple_row(Y[i], x, E, st, i)
+        return Y
 
-    def _couple_row(self, context, E, st, i):
-        y = np.zeros(COUPLE_OUTPUT_SIZE)
+    _EYE = np.eye(3).ravel()
+
+    def _couple_row(self, y, x, E, st, i):
+        """Fills the zeroed row y of pair i (state x, evaluation E, pair state st)."""
         ev = E.evals[i]
         S = COUPLE_SLICES
         if ev is None:
-            p = self.pairs[i]
             a, b = self._fidx[i]
-            u = context.get_continuous_state_vector().CopyToVector()[
-                self.nq + self.nv + self._uoff[i]:self.nq + self.nv + self._uoff[i + 1]]
+            u = x[self.nq + self.nv + self._uoff[i]:self.nq + self.nv + self._uoff[i + 1]]
             y[S["gap"]] = st.distance - self._bound(E, i, st)
             y[S["u"]][:len(u)] = u
             r1, r2 = self._far_points(i, u)
             y[S["p1"]] = E.poses[a][0] @ r1 + E.poses[a][1]
             y[S["p2"]] = E.poses[b][0] @ r2 + E.poses[b][1]
-            y[S["frame"]] = np.eye(3).ravel()
+            y[S["frame"]] = self._EYE
         else:
             y[S["status"]] = st.status + (1 if st.status == CONTACT and st.stick else 0)
             y[S["gap"]], y[S["vn"]] = ev.gap, ev.vn
@@ -618,8 +630,8 @@ class RigidContactSystem(LeafSystem):
             y[S["vt"]] = ev.vt
             y[S["u"]][:len(ev.u)] = ev.u
             y[S["p1"]], y[S["p2"]] = ev.p1, ev.p2
-            y[S["frame"]] = ev.frame.ravel()
-        return y
+            frame = y[S["frame"]].reshape(3, 3)     # columns ta, tb, n (CoupleEval.frame)
+            frame[:, 0], frame[:, 1], frame[:, 2] = ev.ta, ev.tb, ev.n
 
     def _far_points(self, i, u):
         """The points of far pair i's last sought couple in the two body frames (they change

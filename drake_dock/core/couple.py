@@ -142,18 +142,30 @@ def _conditioning(Fu, T1, T2):
     """|det| / product of row norms of Fu with its columns scaled by the parameters' tangent
     lengths (invariant to how the patches are parametrised): sin^2 / (1 + cos^2) of the angle
     between the curves of a C-C couple at contact; 0 when Eq. (39) fails."""
-    scale = [math.sqrt(_dot(t, t)) for t in list(T1) + list(T2)]
-    if all(s > 0.0 for s in scale):
-        Fu = [[f / s for f, s in zip(row, scale)] for row in Fu]
+    scale = [math.sqrt(_dot(t, t)) for t in (*T1, *T2)]
+    if min(scale) > 0.0:
+        Fu = [[f / c for f, c in zip(row, scale)] for row in Fu]
     den = 1.0
     for row in Fu:
-        den *= math.sqrt(sum(f * f for f in row))
+        den *= math.hypot(*row)
     return abs(_det(Fu)) / den if den > 0 else 0.0
 
 
-def _pose(X):
+def float_pose(X):
+    """A pose (R, p) as (rows of R as lists, p as a tuple) of floats, the form the couple
+    evaluation works in; a pose already in that form is returned as is."""
     R, p = X
-    return R.tolist() if hasattr(R, "tolist") else R, tuple(float(a) for a in p)
+    return R.tolist() if hasattr(R, "tolist") else R, float_vec(p)
+
+
+def float_vec(a):
+    """A 3-vector as a tuple of floats (unchanged if it is one)."""
+    if type(a) is tuple:
+        return a
+    return tuple(a.tolist()) if hasattr(a, "tolist") else tuple(float(c) for c in a)
+
+
+_pose = float_pose
 
 
 def closest_point_conditions(kind, patch1, X1, patch2, X2, u, *, conditioning=False):
@@ -178,8 +190,8 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
     the integrated couple before anything else is computed (its size is returned)."""
     n1 = patch1.dim
     (R1, p1o), (R2, p2o) = _pose(X1), _pose(X2)
-    w1, v1 = (tuple(float(a) for a in x) for x in V1)
-    w2, v2 = (tuple(float(a) for a in x) for x in V2)
+    w1, v1 = (float_vec(x) for x in V1)
+    w2, v2 = (float_vec(x) for x in V2)
     u0 = [float(a) for a in u_state]
     u = u0
     r1, T1, K1 = _geometry(patch1, R1, u[:n1])

@@ -362,9 +362,12 @@ class PolarCurve(Patch):
     dim = 1
     periodic = (False,)
 
-    def __init__(self, radial, axial, theta_range):
+    def __init__(self, radial, axial, theta_range, parts=None):
         self.radial = radial
         self.axial = axial
+        # Optional th -> (radial triple, axial triple) at one float theta, for curves whose
+        # axial part follows from the radial one (`jet` then evaluates them once).
+        self.parts = parts
         self.lower = np.array([min(theta_range)], dtype=float)
         self.upper = np.array([max(theta_range)], dtype=float)
 
@@ -387,8 +390,11 @@ class PolarCurve(Patch):
 
     def jet(self, u):
         th = float(u[0])
-        r, r1, r2 = (float(a) for a in self.radial(th))
-        z, z1, z2 = (float(a) for a in self.axial(th))
+        if self.parts is not None:
+            (r, r1, r2), (z, z1, z2) = self.parts(th)
+        else:
+            r, r1, r2 = (float(a) for a in self.radial(th))
+            z, z1, z2 = (float(a) for a in self.axial(th))
         c, s = math.cos(th), math.sin(th)
         return ((r * c, r * s, z), ((r1 * c - r * s, r1 * s + r * c, z1),),
                 (((r2 * c - 2 * r1 * s - r * c, r2 * s + 2 * r1 * c - r * s, z2),),))

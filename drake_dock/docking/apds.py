@@ -107,11 +107,17 @@ def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
         rho = A / sw
         return rho, -sigma * A * cw / sw**2, A * (1.0 + cw**2) / sw**3
 
-    def axial(th):
-        rho, r1, r2 = radial(th)
+    def axial_of(rho, r1, r2):
         return (g.R - rho) * tan1, -r1 * tan1, -r2 * tan1
 
-    return PolarCurve(radial, axial, (phi, phi + sigma * g.theta_end))
+    def axial(th):
+        return axial_of(*radial(th))
+
+    def parts(th):
+        rad = radial(th)
+        return rad, axial_of(*rad)
+
+    return PolarCurve(radial, axial, (phi, phi + sigma * g.theta_end), parts)
 
 
 class _PetalMap:

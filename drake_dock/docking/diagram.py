@@ -85,10 +85,11 @@ def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagra
     pairs = [ContactPair(p.name, p.kind, frames[p.body1], p.patch1, frames[p.body2], p.patch2)
              for p in apds_pairs(scenario.geometry)]
     if options is None:
-        # LZB's relative accuracy 1e-3 of the integrator's (within [1e-12, 1e-8]): its error in
-        # the post-impact velocities (about 10 rtol) stays far below the integration error.
+        # LZB's relative accuracy 1e-2 of the integrator's (within [1e-12, 1e-8]): its error in
+        # the post-impact velocities (4e-10 relative at rtol 1e-8 on the example's impacts)
+        # stays far below the integration error.
         options = ContactOptions(impact_rtol=min(1e-8, max(1e-12,
-                                                           1e-3 * scenario.simulation.accuracy)))
+                                                           1e-2 * scenario.simulation.accuracy)))
     contact = builder.AddSystem(RigidContactSystem(
         dp.plant, pairs, contact_law(scenario), options,
         wrench_bodies=("chaser",),
