@@ -166,3 +166,23 @@ def test_seeking_matches_brute_force_points(geom, kind):
         u1, u2, _ = _brute_force_closest(P1, P2)
         np.testing.assert_allclose(cp.p1, P1.position(u1), atol=1e-9)
         np.testing.assert_allclose(cp.p2, P2.position(u2), atol=1e-9)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_far_pair_distance_mode_matches_brute_force(geom, seed):
+    """The contact system's seeks of far pairs (`seek_couple` with ``distance_rtol``: the
+    Newton finish stops once the distance has converged): never below the true distance, above
+    it by at most 1e-4 of it, and exact to 1e-9 m for pairs nearer than ``rtol_beyond``."""
+    rng = np.random.default_rng(200 + seed)
+    R = rot_z(rng.uniform(-0.6, 0.6)) @ rot_x(math.pi + rng.uniform(-0.3, 0.3))
+    p = np.array([*rng.uniform(-0.15, 0.15, 2), rng.uniform(0.01, 0.3)])
+    poses = {"target_apds": (np.eye(3), np.zeros(3)), "chaser_apds": (R, p)}
+    beyond = 0.02
+    for pair in apds_pairs(geom):
+        P1, P2 = posed(pair.patch1, *poses[pair.body1]), posed(pair.patch2, *poses[pair.body2])
+        cp = seek_couple(P1, P2, distance_rtol=1e-7, rtol_beyond=beyond)
+        d = np.linalg.norm(_brute_force_closest(P1, P2)[2])
+        assert cp.distance >= d - 1e-9, pair.name
+        assert cp.distance <= d * (1 + 1e-4) + 1e-9, pair.name
+        if d < beyond:
+            assert cp.distance == pytest.approx(d, abs=1e-9), pair.name

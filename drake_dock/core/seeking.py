@@ -43,17 +43,20 @@ def _pairwise_d2(X1, X2):
 
 
 def _distinct_best(d2, U1, U2, h1, h2, k):
-    """The k best grid couples that lie more than 2 cells apart in one of the patches."""
-    order = np.argsort(d2, axis=None)
-    chosen = []
-    for flat in order:
-        i, j = np.unravel_index(flat, d2.shape)
-        if all(np.any(np.abs(U1[i] - U1[a]) > 2 * h1) or np.any(np.abs(U2[j] - U2[b]) > 2 * h2)
-               for a, b in chosen):
-            chosen.append((i, j))
-            if len(chosen) == k:
-                break
-    return [U1[i] for i, _ in chosen], [U2[j] for _, j in chosen]
+    """The k best grid couples that lie more than 2 cells apart in one of the patches: the
+    best, then the best of those not within 2 cells of a chosen one in both patches, ..."""
+    d2 = d2.copy()
+    chosen1, chosen2 = [], []
+    for _ in range(k):
+        i, j = np.unravel_index(np.argmin(d2), d2.shape)
+        if not np.isfinite(d2[i, j]):
+            break
+        chosen1.append(U1[i])
+        chosen2.append(U2[j])
+        near1 = np.all(np.abs(U1 - U1[i]) <= 2 * h1, axis=1)
+        near2 = np.all(np.abs(U2 - U2[j]) <= 2 * h2, axis=1)
+        d2[np.ix_(near1, near2)] = np.inf
+    return chosen1, chosen2
 
 
 def _local_grids(patch, centres, half_width, n):
