@@ -269,6 +269,13 @@ class RigidContactSystem(LeafSystem):
         self.nu = int(self._uoff[-1])
         self._spans = [np.concatenate([p.patch1.span, p.patch2.span]) for p in pairs]
         self._periodic = [np.array(p.patch1.periodic + p.patch2.periodic) for p in pairs]
+        # Per pair, (lower, upper, span) of its bounded parameters (u = (u1, u2)), in floats
+        # for the domain-end witness.
+        self._bounded = [[(float(lo), float(hi), float(hi - lo)) if not per else None
+                          for lo, hi, per in zip(np.concatenate([p.patch1.lower, p.patch2.lower]),
+                                                 np.concatenate([p.patch1.upper, p.patch2.upper]),
+                                                 p.patch1.periodic + p.patch2.periodic)]
+                         for p in pairs]
         self._spheres = [_bounding_sphere(p.patch1) for p in pairs]
         self._sphere_c = np.array([c for c, _ in self._spheres]).reshape(-1, 3)
         self._sphere_r = np.array([r for _, r in self._spheres])
@@ -721,10 +728,13 @@ class RigidContactSystem(LeafSystem):
         ev = E.evals[i]
         if ev is None:
             return 1.0
-        p = self.pairs[i]
-        n1 = p.patch1.dim
-        return min(float(np.min(p.patch1.margin(ev.u[:n1]) / self._spans[i][:n1])),
-                   float(np.min(p.patch2.margin(ev.u[n1:]) / self._spans[i][n1:])))
+        # The smallest margin of a bounded parameter to its domain's ends, relative to the
+        # span (periodic parameters have none).
+        w = math.inf
+        for a, b in zip(ev.u.tolist(), self._bounded[i]):
+            if b is not None:
+                w = min(w, (a - b[0]) / b[2], (b[1] - a) / b[2])
+        return w
 
     def _w_cond(self, E, st, i):
         ev = E.evals[i]
