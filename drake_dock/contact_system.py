@@ -691,6 +691,31 @@ class RigidContactSystem(LeafSystem):
                 out[f"{self.pairs[i].name} {k}"] = self._witness(context, i, k)
         return out
 
+    def witness_rates(self, context) -> dict:
+        """Time derivatives of the gap witnesses of the tracked couples, by description:
+        g' = v_n (for `drake_dock.stepping.WitnessApproach`)."""
+        out = {}
+        E = None
+        for i, st in enumerate(self.get_modes(context).pairs):
+            if st.status == TRACKED:
+                E = E or self._cache.Eval(context)
+                out[f"{self.pairs[i].name} gap"] = E.evals[i].vn
+        return out
+
+    def witness_second_rates(self, context, names) -> dict:
+        """Second time derivatives of the gap witnesses ``names`` (of tracked couples), g'' =
+        W^3 . v' + b_n (Eq. 52) at the evaluation's accelerations: a couple leaving an impact
+        has no history in the new epoch from which `WitnessApproach` could predict its
+        landing."""
+        E = self._cache.Eval(context)
+        ctx = self._set_scratch(E.q, E.v)
+        out = {}
+        for i, p in enumerate(self.pairs):
+            if f"{p.name} gap" in names and E.evals[i] is not None:
+                row = self._row(i, E.evals[i], E.poses, ctx)
+                out[f"{p.name} gap"] = float(row.Wn @ E.vdot + row.bn)
+        return out
+
     def witness_epoch(self, context) -> int:
         """Changes whenever an event has changed the state or the modes (a witness's history
         from before it is not continued by its values after it)."""

@@ -18,7 +18,11 @@ maximum step size changes, and it returns to its configured value after each eve
 Sources are systems with ``witness_values(context) -> {name: value}`` (the values of the
 witness functions they return now, all with direction positive-then-non-positive) and
 optionally ``witness_epoch(context)``, which changes whenever an event changes their state or
-modes (values from different epochs are not joined by a secant).
+modes (values from different epochs are not joined by a secant), and ``witness_rates(context)
+-> {name: dw/dt}`` with ``witness_second_rates(context, names) -> {name: d2w/dt2}`` for
+witnesses whose derivatives they know (a couple's gap): those are also predicted by their
+Taylor parabola, the second derivative taken from the last two rates, or asked for at the
+first point of an epoch (just after an impact, where no history predicts the landing).
 """
 import math
 
@@ -53,6 +57,21 @@ def _lead(pts) -> float:
     return lead
 
 
+def _lead_jet(w, wd, wdd) -> float:
+    """Time to the first zero of w + wd h + wdd h^2 / 2 (the witness's own derivatives), inf if
+    none ahead."""
+    a, b, c = 0.5 * wdd, wd, w
+    if a == 0.0:
+        return -c / b if b < 0.0 else math.inf
+    disc = b * b - 4.0 * a * c
+    if disc < 0.0:
+        return math.inf
+    r = math.sqrt(disc)
+    q = -0.5 * (b + math.copysign(r, b))
+    roots = [h for h in (q / a, c / q if q != 0.0 else math.inf) if h > 0.0]
+    return min(roots) if roots else math.inf
+
+
 class WitnessApproach:
     """Simulator monitor. ``window`` is Drake's witness isolation window (0.01 x the context's
     accuracy, in s, for error-controlled integration); ``max_step`` the configured maximum."""
@@ -77,27 +96,50 @@ class WitnessApproach:
         self.shortened_steps = 0
 
     def _values(self, root):
-        out = {}
+        out, rates = {}, {}
         for s in self.sources:
             c = s.GetMyContextFromRoot(root)
             epoch = s.witness_epoch(c) if hasattr(s, "witness_epoch") else 0
             for k, w in s.witness_values(c).items():
                 out[(id(s), k)] = (epoch, float(w))
+            if hasattr(s, "witness_rates"):
+                for k, wd in s.witness_rates(c).items():
+                    rates[(id(s), k)] = float(wd)
+        return out, rates
+
+    def _second_rates(self, root, keys):
+        out = {}
+        for s in self.sources:
+            names = [k for sid, k in keys if sid == id(s)]
+            if names:
+                c = s.GetMyContextFromRoot(root)
+                out.update({(id(s), k): v for k, v in s.witness_second_rates(c, names).items()})
         return out
 
     def predicted_zero(self, root) -> float:
         """Earliest predicted zero time (inf if none); updates the history."""
         t = root.get_time()
         best = math.inf
-        values = self._values(root)
+        values, rates = self._values(root)
         hist = {}
+        need = []      # witnesses with a rate but no earlier rate in this epoch
         for key, (epoch, w) in values.items():
             h = self._hist.get(key)
             pts = [p for p in h[1] if p[0] < t] if h is not None and h[0] == epoch else []
-            pts = (pts + [(t, w)])[-3:]
+            pts = (pts + [(t, w, rates.get(key))])[-3:]
             hist[key] = (epoch, pts)
             if w > 0.0:
-                best = min(best, t + _lead(pts))
+                best = min(best, t + _lead([p[:2] for p in pts]))
+                if key in rates:
+                    if len(pts) > 1 and pts[-2][2] is not None:
+                        # The second derivative from the last two rates.
+                        (t1, _, r1), (t2, _, r2) = pts[-2], pts[-1]
+                        best = min(best, t + _lead_jet(w, r2, (r2 - r1) / (t2 - t1)))
+                    else:
+                        need.append(key)
+        if need:
+            for key, wdd in self._second_rates(root, need).items():
+                best = min(best, t + _lead_jet(values[key][1], rates[key], wdd))
         self._hist = hist
         return best
 

@@ -4,6 +4,7 @@ derivative evaluations."""
 import math
 
 import numpy as np
+import pytest
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 
 from drake_dock.contact_system import ContactOptions
@@ -45,3 +46,33 @@ def test_same_impact_times_with_fewer_evaluations():
     np.testing.assert_allclose(t_plain, expected, atol=2 * window + 1e-12)
     np.testing.assert_allclose(t_fast, expected, atol=2 * window + 1e-12)
     assert n_fast < n_plain / 2, (n_fast, n_plain)
+
+
+def test_lead_jet_is_the_first_root_of_the_taylor_parabola():
+    from drake_dock.stepping import _lead_jet
+    # w = 1 - 3 h + 2 h^2 = (1 - h)(1 - 2 h): first zero at h = 1/2.
+    assert _lead_jet(1.0, -3.0, 4.0) == pytest.approx(0.5, rel=1e-15)
+    # Ballistic gap w = 0.01 + 0.5 h - g h^2 / 2: the positive root.
+    h = (0.5 + math.sqrt(0.25 + 2 * G * 0.01)) / G
+    assert _lead_jet(0.01, 0.5, -G) == pytest.approx(h, rel=1e-14)
+    assert _lead_jet(0.01, -0.5, 0.0) == pytest.approx(0.02, rel=1e-15)
+    assert math.isinf(_lead_jet(0.01, 0.5, 0.0))          # receding, no curvature
+    assert math.isinf(_lead_jet(0.01, 0.1, 1.0))          # receding and accelerating away
+
+
+def test_gap_rates_of_a_falling_disk_are_its_velocity_and_gravity():
+    """The gap witness's derivatives that `WitnessApproach` predicts with: g' = v_z and
+    g'' = -g for a disk in free flight above the plane, spinning about its axle (y), which
+    keeps its lowest point (closed form)."""
+    sc = disk_on_incline(0.0, mu=0.3, restitution=E)
+    r = sc.params["radius"]
+    sim = Simulator(sc.system)
+    ctx = sim.get_mutable_context()
+    sc.set_state(ctx, (np.eye(3), np.array([0, 0, r + 0.01])),
+                 (np.array([0.0, 3.0, 0.0]), np.array([0.2, 0.0, 0.7])))
+    sim.Initialize()
+    name = f"{sc.system.pairs[0].name} gap"
+    rates = sc.system.witness_rates(ctx)
+    assert rates[name] == pytest.approx(0.7, rel=1e-12)
+    second = sc.system.witness_second_rates(ctx, [name])
+    assert second[name] == pytest.approx(-G, rel=1e-9)
