@@ -345,6 +345,7 @@ class RigidContactSystem(LeafSystem):
         self._eval_memo = {}
         # Reused by `_free_acceleration` (never written: the first two).
         self._zero_v = np.zeros(self.nv)
+        self._world = plant.world_frame()
         self._no_forces = MultibodyForces(plant)
         self._forces_fe = MultibodyForces(plant)
         self._forces_in = MultibodyForces(plant)
@@ -395,7 +396,7 @@ class RigidContactSystem(LeafSystem):
         """W^3, W^1, W^2 (Eq. 11) from Drake's point Jacobians and the bias terms (Eq. 52)."""
         p = self.pairs[i]
         a, b = self._fidx[i]
-        world = self.plant.world_frame()
+        world = self._world
         R1, o1 = poses[a]
         R2, o2 = poses[b]
         s1, s2 = (ev.p1 - o1) @ R1, (ev.p2 - o2) @ R2     # the points in their frames
