@@ -448,12 +448,20 @@ class RigidContactSystem(LeafSystem):
     eval_memo_size = 16
 
     def _eval_key(self, context):
-        """Everything an evaluation depends on: time, continuous state, the modes object (its
-        identity, held by the memo so that it cannot be reused, and its version) and the
-        inputs."""
+        """Everything an evaluation depends on: time, the continuous state (the bodies' and the
+        tracked couples' u*; a far pair's u* and its far-pair data are not used), the modes of
+        the pairs that are not far, and the inputs."""
         modes = self.get_modes(context)
-        key = [context.get_time(), context.get_continuous_state_vector().CopyToVector().tobytes(),
-               id(modes), modes.mode_changes]
+        x = context.get_continuous_state_vector().CopyToVector()[:self.ie]
+        base = self.nq + self.nv
+        sig = []
+        for i, st in enumerate(modes.pairs):
+            if st.status == FAR:
+                x[base + self._uoff[i]:base + self._uoff[i + 1]] = 0.0
+            else:
+                sig.append((i, st.status, st.sigma, st.stick, None if st.slide_dir is None
+                            else np.asarray(st.slide_dir, dtype=float).tobytes()))
+        key = [context.get_time(), x.tobytes(), tuple(sig)]
         if self._gf_port.HasValue(context):
             key.append(self._gf_port.Eval(context).tobytes())
         for _, port in self._wrench_ports.values():
@@ -466,18 +474,24 @@ class RigidContactSystem(LeafSystem):
         with the same values (the integrator restores a step's initial state before the step,
         and the witness isolation restores it before each re-integration): about a quarter of
         the requests in the docking example. The last few evaluations are kept by their full
-        dependencies (`_eval_key`) and reused."""
+        dependencies (`_eval_key`) and reused; one reused under other modes (a far pair sought
+        again at a step start changes only far-pair data) gets those modes and fresh far-pair
+        bounds and witness values."""
         t0 = _perf()
         try:
             key, modes = self._eval_key(context)
             hit = self._eval_memo.get(key)
             if hit is not None:
-                value.set_value(hit[0])
+                if hit.modes is not modes:
+                    hit = dataclasses.replace(hit, modes=modes, witness={},
+                                              bound=np.full(len(self.pairs), np.nan))
+                    self._eval_memo[key] = hit
+                value.set_value(hit)
                 return
             self._calc_eval_timed(context, value)
             if len(self._eval_memo) >= self.eval_memo_size:
                 self._eval_memo.pop(next(iter(self._eval_memo)))
-            self._eval_memo[key] = (value.get_value(), modes)
+            self._eval_memo[key] = value.get_value()
         finally:
             self.timing.contact_dynamics += _perf() - t0
 

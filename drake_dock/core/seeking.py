@@ -296,7 +296,14 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, **grid_options) 
     ``distance_rtol`` the Newton finish ends once the distance has converged to that fraction,
     where it is beyond ``rtol_beyond`` (see `newton_closest`)."""
     best = None
+    tol = 1e-9 * np.concatenate([P1.patch.span, P2.patch.span])
+    started = []
     for u1, u2 in hierarchical_seek(P1, P2, **grid_options):
+        # Two candidates refined onto the same grid couple: one Newton finish serves both.
+        u0 = np.concatenate([u1, u2])
+        if any(np.all(np.abs(u0 - s) <= tol) for s in started):
+            continue
+        started.append(u0)
         u1, u2, it = newton_closest(P1, P2, u1, u2, distance_rtol=distance_rtol,
                                     rtol_beyond=rtol_beyond)
         p1, p2 = P1.position(u1), P2.position(u2)
