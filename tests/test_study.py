@@ -15,7 +15,7 @@ from drake_dock.docking.compliant import (CompliantConfig, build_compliant_diagr
 from drake_dock.docking.plant import set_initial_state
 from drake_dock.docking.scene import initial_state
 from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.study import METRICS
+from drake_dock.study import METRICS, Point, converged_points, converged_speedups
 
 
 @pytest.fixture(scope="module")
@@ -122,7 +122,19 @@ def test_quick_study_prints_one_speedup_line_per_metric(quick_study):
         else:
             assert "unbounded" in ln or "none" in ln, ln
     assert (out / "work_precision.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert (out / "speedups.txt").read_text().splitlines() == lines
+    written = (out / "speedups.txt").read_text().splitlines()
+    assert [ln for ln in written if ln.startswith("speed-up ")] == lines
+    assert [ln for ln in written if ln.startswith("  ")] == [
+        ln for ln in stdout.splitlines() if ln.startswith("  ") and ": " in ln
+        and ln.split(":")[0].strip() in METRICS]
+    # The contact effect on the chaser's axial velocity, from the reference's value and the
+    # scenario's approach speed (the chaser moves along the axis at t = 0).
+    ref = next(r for r in rows if r["role"] == "reference")
+    v = abs(float(ref["chaser_axial_velocity"]))
+    speed = load_scenario(PAPER_EXAMPLE).initial.chaser_speed
+    m = re.search(r"contact effect on chaser_axial_velocity: ([0-9.e+-]+) ", stdout)
+    assert m, stdout
+    np.testing.assert_allclose(float(m.group(1)), abs(v - speed) / v, rtol=4e-3)  # 3 digits
 
 
 def test_quick_study_reference_self_converged(quick_study):
@@ -142,3 +154,32 @@ def test_quick_study_reference_self_converged(quick_study):
                 assert float(r[f"error_{k}"]) <= 1e-3, (r["label"], k)
     assert sum(r["method"] == "compliant" for r in rows) == 3
     assert all(math.isfinite(float(r["wall_time"])) for r in rows)
+
+
+def _pt(method, step, accuracy, wall, err, model="point", k=1e6):
+    errs = {m: err for m in METRICS}
+    return Point(method, "point", "", model, k, step, accuracy, wall, err is not None,
+                 {m: None for m in METRICS}, errs)
+
+
+def test_converged_points_drop_lucky_runs():
+    """A run within the tolerance counts as converged only if every finer run of its family
+    (method, model, stiffness; step or accuracy) is within it too."""
+    nan = math.nan
+    lucky = _pt("compliant", 1e-2, nan, 0.01, 5e-4)           # coarse, within by chance
+    bad = _pt("compliant", 1e-3, nan, 0.1, 2e-3)
+    fine = _pt("compliant", 1e-4, nan, 1.0, 5e-4)
+    b_none = _pt("compliant", 1e-2, nan, 0.02, None, k=1e7)    # no capture
+    b_ok = _pt("compliant", 1e-3, nan, 0.3, 1e-4, k=1e7)
+    rk = _pt("compliant", 0.0, 1e-2, 0.5, 9e-4, k=1e7)         # continuous: its own family
+    rk_bad = _pt("compliant", 0.0, 1e-3, 0.8, 2e-3, k=1e7)
+    d1 = _pt("drake_dock", 0.01, 1e-2, 0.2, 2e-3, model="rigid", k=nan)
+    d2 = _pt("drake_dock", 0.01, 1e-3, 0.25, 1e-4, model="rigid", k=nan)
+    d3 = _pt("drake_dock", 0.01, 1e-4, 0.3, 1e-5, model="rigid", k=nan)
+    d4 = _pt("drake_dock", 0.002, 1e-2, 0.22, 9e-4, model="rigid", k=nan)
+    pts = [lucky, bad, fine, b_none, b_ok, rk, rk_bad, d1, d2, d3, d4]
+    conv = converged_points(pts, METRICS[0], 1e-3)
+    assert [pts.index(p) for p in conv] == [pts.index(p) for p in (fine, b_ok, d2, d3, d4)]
+    ratio, t_dd, t_cc = converged_speedups(pts, 1e-3)[METRICS[0]]
+    assert (t_dd, t_cc) == (0.22, 0.3)
+    np.testing.assert_allclose(ratio, 0.3 / 0.22)
