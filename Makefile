@@ -23,6 +23,7 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/contact_eval.py
 	$(BIN)/python bench/paper_example.py
 	$(BIN)/python bench/time_shares.py
+	$(BIN)/python bench/target_floor.py
 
 clean:
 	rm -rf $(VENV) out

@@ -61,7 +61,7 @@ from drake_dock.core.couple import (closest_point_conditions, evaluate_couple, f
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.core.tracking import SingularCoupleError
-from drake_dock.errors import NumericalError, SeekingError
+from drake_dock.errors import InputError, NumericalError, SeekingError
 from drake_dock.impact import solve_lzb
 
 FAR, TRACKED, CONTACT = 0, 1, 2
@@ -829,17 +829,19 @@ class RigidContactSystem(LeafSystem):
         state.get_mutable_abstract_state(self._mode_index).set_value(copy.deepcopy(modes_new))
         return EventStatus.Succeeded()
 
-    def _seek(self, i, poses, modes, u, time, was_contact):
-        """Sect. 5.1 for pair i, and the status that follows (module docstring)."""
+    def _seek(self, i, poses, modes, u, time, was_contact, initial=False):
+        """Sect. 5.1 for pair i, and the status that follows (module docstring). At the
+        initial seek a pair with a declared ``sigma`` whose couple lies on the wrong side by
+        more than ``impact_gap_tol`` is refused: the bodies start interpenetrating."""
         t0 = _perf()
         try:
-            self._seek_timed(i, poses, modes, u, time, was_contact)
+            self._seek_timed(i, poses, modes, u, time, was_contact, initial)
         finally:
             self.timing.seeking += _perf() - t0
             name = self.pairs[i].name
             self.timing.seeks[name] = self.timing.seeks.get(name, 0) + 1
 
-    def _seek_timed(self, i, poses, modes, u, time, was_contact):
+    def _seek_timed(self, i, poses, modes, u, time, was_contact, initial):
         p = self.pairs[i]
         a, b = self._fidx[i]
         st = modes.pairs[i]
@@ -878,6 +880,15 @@ class RigidContactSystem(LeafSystem):
             # model has no contact. Such a pair is not made potential.
             crossing = (abs(ev.gap) > c.distance + opt.impact_gap_tol
                         or sigma * ev.gap < -opt.impact_gap_tol)
+            if initial and p.sigma is not None and (sigma * ev.gap < -opt.impact_gap_tol or (
+                    crossing and c.distance <= opt.impact_gap_tol)):
+                # The scene declares the sides: a couple on the wrong side, or patches that
+                # intersect, is a body started inside another.
+                value = (f"signed gap {sigma * ev.gap:.6g} m" if sigma * ev.gap < 0.0
+                         else f"patches intersecting (distance {c.distance:.3g} m)")
+                raise InputError(f"initial state of pair {p.name}", value,
+                                 f"signed gap >= -impact_gap_tol = {-opt.impact_gap_tol:g} m",
+                                 "the bodies start interpenetrating")
         if c.interior and isolated and not crossing and c.distance < opt.track_distance \
                 and not was_contact:
             st.sigma = sigma
@@ -912,7 +923,7 @@ class RigidContactSystem(LeafSystem):
             sl = slice(self._uoff[i], self._uoff[i + 1])
             if initial or (st.status == FAR and self._travel_bound(i, poses, st)
                            >= early * st.clearance):
-                self._seek(i, poses, modes, u, t, False)
+                self._seek(i, poses, modes, u, t, False, initial)
                 continue
             if st.status == FAR:
                 continue

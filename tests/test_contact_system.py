@@ -373,3 +373,27 @@ def test_drift_is_measured_and_bounded():
         sim2, _, _ = start(sc2.system, lambda c: sc2.set_state(
             c, (np.eye(3), np.array([0, 0, r])), (np.zeros(3), np.array([V0, 0, 0]))))
         sim2.AdvanceTo(0.2)
+
+
+@pytest.mark.parametrize("depth", [1e-3, 0.2])
+def test_initial_interpenetration_is_refused(depth):
+    """A disk started below the plane (declared sigma) is refused at Initialize with the pair,
+    its signed gap (-depth, the disk's rim below the plane) and the allowed range; a disk
+    started resting (gap 0) is accepted and stays at rest on lambda_n = m g."""
+    from drake_dock.errors import InputError
+    sc = disk_on_incline(0.0, mu=0.3)
+    r = sc.params["radius"]
+    with pytest.raises(InputError, match="pair rim_plane = .*interpenetrating") as ex:
+        start(sc.system, lambda c: sc.set_state(
+            c, (np.eye(3), np.array([0, 0, r - depth])), (np.zeros(3), np.zeros(3))))
+    if ex.value.value.startswith("signed gap"):
+        np.testing.assert_allclose(float(ex.value.value.split()[2]), -depth, rtol=1e-9)
+    else:
+        assert "intersecting" in ex.value.value
+    assert "impact_gap_tol" in str(ex.value)
+    sc = disk_on_incline(0.0, mu=0.3)
+    sim, root, ctx = start(sc.system, lambda c: sc.set_state(
+        c, (np.eye(3), np.array([0, 0, r])), (np.zeros(3), np.zeros(3))))
+    sim.AdvanceTo(0.05)
+    np.testing.assert_allclose(couple(sc.system, ctx, "rim_plane")["lambda_n"],
+                               sc.params["mass"] * G, rtol=1e-8)

@@ -1,0 +1,141 @@
+"""What #6's 10x target asks of drake_dock, measured side by side in one run.
+
+For each metric: the fastest coarse compliant configuration (point contact, SAP at the coarse
+steps a Drake user tries first) within the tolerance of the rigid reference, the drake_dock
+wall time 10x would need, and that time against two floors measured here:
+
+- drake_dock's fastest run within the tolerance (accuracy 1e-3, step cap 0.01 s; median of
+  ``--repeats`` identical runs) and its derivative evaluations;
+- the floor: the plant alone without contact over the same time and integrator settings,
+  plus the same number of evaluations of an *empty* Python LeafSystem in Drake's simulator
+  (the design card's architecture: a custom LeafSystem supplies the contact forces). No
+  implementation in that architecture that needs as many evaluations runs below it.
+
+Also each metric's contact effect: its change from t = 0 to capture relative to its value at
+capture; a tolerance that is a large share of it is met by runs that barely resolve contact.
+
+    python bench/target_floor.py [--repeats 5]
+"""
+import argparse
+import copy
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
+from pydrake.systems.framework import LeafSystem
+
+from drake_dock.docking.compliant import (CompliantConfig, hunt_crossley_dissipation,
+                                          run_compliant)
+from drake_dock.docking.scene import initial_state
+from drake_dock.docking.simulate import simulate
+from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.study import METRICS, rigid_metrics
+
+sys.path.insert(0, str(Path(__file__).parent))
+from paper_example import free_flight  # noqa: E402  (a sibling bench script)
+
+
+class _Empty(LeafSystem):
+    """Two states, a derivative that copies numbers: the least a Python LeafSystem costs."""
+
+    def __init__(self):
+        super().__init__()
+        self.DeclareContinuousState(2)
+        self.n = 0
+
+    def DoCalcTimeDerivatives(self, context, derivatives):
+        self.n += 1
+        x = context.get_continuous_state_vector().CopyToVector()
+        derivatives.get_mutable_vector().SetFromVector([x[1], -1e4 * x[0]])
+
+
+def empty_leaf_cost(scheme, n_min=3000) -> float:
+    """Wall seconds per derivative evaluation of `_Empty` under ``scheme``."""
+    s = _Empty()
+    sim = Simulator(s)
+    sim.get_mutable_context().SetContinuousState([1.0, 0.0])
+    ApplySimulatorConfig(SimulatorConfig(integration_scheme=scheme, accuracy=1e-3), sim)
+    t0 = time.perf_counter()
+    sim.Initialize()
+    t = 0.0
+    while s.n < n_min:
+        t += 0.1
+        sim.AdvanceTo(t)
+    return (time.perf_counter() - t0) / s.n
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--tolerance", type=float, default=1e-3)
+    args = ap.parse_args()
+    tol = args.tolerance
+    scenario = load_scenario(PAPER_EXAMPLE)
+    state = initial_state(scenario)
+    e3 = state.X_WB["target_apds"][0][:, 2].copy()
+    sc = copy.deepcopy(scenario)
+    sc.simulation.accuracy = 1e-8
+    ref = rigid_metrics(simulate(sc, state=state), e3)
+
+    def err(m):
+        return {k: abs(m[k] - ref[k]) / abs(ref[k]) for k in METRICS}
+
+    fast = copy.deepcopy(scenario)
+    fast.simulation.accuracy = 1e-3
+    fast.simulation.max_step = 0.01
+    runs = [simulate(fast, state=state) for _ in range(args.repeats)]
+    t_dd = float(np.median([r.wall_time for r in runs]))
+    evals = runs[0].evaluations
+    e_dd = err(rigid_metrics(runs[0], e3))
+    d_hc = hunt_crossley_dissipation(scenario.contact.restitution,
+                                     scenario.initial.chaser_speed)
+    rows = []
+    for k_c in (1e6, 1e7, 1e8):
+        for h in (1e-2, 3e-3):
+            cfg = CompliantConfig("point", k_c, h, dissipation=d_hc)
+            r = run_compliant(scenario, state, cfg, t_max=2 * ref["capture_time"])
+            m = {"capture_time": r.capture_time, "apds_spin_rate": r.apds_spin_rate,
+                 "chaser_axial_velocity": r.chaser_axial_velocity,
+                 "peak_contact_force": r.peak_force}
+            rows.append((cfg.label(), r.wall_time, err(m) if r.captured else None))
+    leaf = empty_leaf_cost(scenario.simulation.integration_scheme)
+    t_free = free_flight(fast, state, ref["capture_time"])
+    w0 = state.V_WB["target_apds"][0] @ e3
+    v0 = state.V_WB["chaser"][1] @ e3
+    effect = {"capture_time": None,
+              "apds_spin_rate": abs(ref["apds_spin_rate"] - w0) / abs(ref["apds_spin_rate"]),
+              "chaser_axial_velocity": abs(ref["chaser_axial_velocity"] - v0)
+              / abs(ref["chaser_axial_velocity"]),
+              "peak_contact_force": None}
+    print("coarse compliant runs (point contact, SAP), errors against drake_dock at 1e-8:")
+    for label, wall, e in rows:
+        es = ("no capture" if e is None else
+              " ".join(f"{k}={e[k]:.1e}" for k in METRICS))
+        print(f"  {label:<32s} {wall:.4f} s  {es}")
+    print(f"drake_dock accuracy 1e-3, step cap 0.01 s: {t_dd:.3f} s (median of {len(runs)}), "
+          f"{evals} evaluations; errors "
+          + " ".join(f"{k}={e_dd[k]:.1e}" for k in METRICS))
+    print(f"empty Python LeafSystem in Drake's simulator: {1e6 * leaf:.1f} us per evaluation; "
+          f"x {evals} evaluations = {1e3 * leaf * evals:.2f} ms")
+    print(f"the plant alone (no contact) to the capture time: {1e3 * t_free:.2f} ms")
+    floor = t_free + leaf * evals
+    print(f"floor: the plant alone + {evals} empty-LeafSystem evaluations = "
+          f"{1e3 * floor:.2f} ms (drake_dock now: {t_dd / floor:.0f}x the floor)")
+    for k in METRICS:
+        ok = [(w, label) for label, w, e in rows if e is not None and e[k] <= tol]
+        eff = "" if effect[k] is None else f"; contact effect {effect[k]:.3g}"
+        if not ok:
+            print(f"target {k}: no coarse compliant run within {tol:g}{eff}")
+            continue
+        w, label = min(ok)
+        need = w / 10
+        print(f"target {k}: compliant {label} {w:.4f} s within {tol:g}; 10x needs drake_dock "
+              f"at {1e3 * need:.2f} ms = {t_dd / need:.0f}x faster than now, "
+              f"{need / floor:.2f}x the floor"
+              + (" (below it: cannot be met)" if need < floor else "") + eff)
+
+
+if __name__ == "__main__":
+    main()
