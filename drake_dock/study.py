@@ -323,21 +323,27 @@ def work_precision_figure(result, path):
     tol = result["tolerance"]
     fig, axs = plt.subplots(2, 2, figsize=(11, 8.5))
     floor = 1e-16
+
+    def group(p):
+        if p.method == "drake_dock":
+            return f"drake_dock (rigid, LZB), step <= {p.step:g} s"
+        if p.step > 0:
+            return f"SAP {p.model} k={p.stiffness:.0e}"
+        return f"continuous RK3 {p.model} k={p.stiffness:.0e}"
+    # One colour per compliant family in every panel.
+    fams = list(dict.fromkeys(group(p) for p in pts if p.method == "compliant"))
+    colour = {g: plt.cm.tab10(i % 10) for i, g in enumerate(fams)}
     for ax, k in zip(axs.ravel(), METRICS):
+        conv = {id(p) for p in converged_points(pts, k, tol)}
         groups = {}
         for p in pts:
             if p.role == "reference" or p.errors[k] is None:
                 continue
-            if p.method == "drake_dock":
-                key = f"drake_dock (rigid, LZB), step <= {p.step:g} s"
-            elif p.step > 0:
-                key = f"SAP {p.model} k={p.stiffness:.0e}"
-            else:
-                key = f"continuous RK3 {p.model} k={p.stiffness:.0e}"
-            groups.setdefault(key, []).append((p.wall_time, max(p.errors[k], floor)))
-        for key, xy in groups.items():
-            xy.sort()
-            x, y = zip(*xy)
+            groups.setdefault(group(p), []).append(
+                (p.wall_time, max(p.errors[k], floor), p.role != "point" or id(p) in conv))
+        for key, xyc in groups.items():
+            xyc.sort()
+            x, y, c = zip(*xyc)
             if key.startswith("drake_dock"):
                 # The finest step cap solid black, coarser caps dashed in lighter greys.
                 dd = sorted((g for g in groups if g.startswith("drake_dock")),
@@ -346,14 +352,21 @@ def work_precision_figure(result, path):
                 style = dict(lw=2.2, marker="o", color=("k", "0.4", "0.65", "0.8")[min(rank, 3)],
                              ls="--" if rank else "-")
             else:
-                style = dict(lw=1, marker="s" if "SAP" in key else "^", ms=4)
-            ax.loglog(x, y, label=key, **style)
+                style = dict(lw=1, marker="s" if "SAP" in key else "^", ms=4,
+                             color=colour[key])
+            line, = ax.loglog(x, y, label=key, **style)
+            # Runs within the tolerance by chance (a finer run of the family is not): hollow.
+            lucky = [(xi, yi) for xi, yi, ci in zip(x, y, c) if yi <= tol and not ci]
+            if lucky:
+                ax.loglog(*zip(*lucky), ls="none", marker=style["marker"], ms=9, mfc="w",
+                          mec=line.get_color(), mew=1.5)
         ax.axhline(tol, color="r", ls="--", lw=0.8)
         ax.set_title(k.replace("_", " "))
         ax.set_xlabel("wall time [s]")
         ax.set_ylabel("relative error vs reference")
     axs[0, 0].legend(fontsize=7)
-    fig.suptitle(f"Work-precision: error against wall time (red: tolerance {tol:g})")
+    fig.suptitle(f"Work-precision: error against wall time (red: tolerance {tol:g}; hollow: "
+                 "within it by chance, a finer run of the same family is not)")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
