@@ -1,4 +1,4 @@
-"""Work-precision of the LZB solver on ball chains (issue: LZB solver).
+"""Work-precision of the LZB solver on ball chains.
 
 For each chain case, prints the error of v_plus against a converged compliant reference
 (the chain with force K delta^eta integrated in time by scipy's DOP853 at rtol 1e-13) and the

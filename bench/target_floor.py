@@ -1,4 +1,4 @@
-"""What #6's 10x target asks of drake_dock, measured side by side in one run.
+"""What a 10x speed-up over Drake's compliant contact asks of drake_dock, measured in one run.
 
 For each metric: the fastest coarse compliant configuration (point contact, SAP at the coarse
 steps a Drake user tries first) within the tolerance of the rigid reference, the drake_dock
@@ -8,7 +8,7 @@ wall time 10x would need, and that time against two floors measured here:
   ``--repeats`` identical runs) and its derivative evaluations;
 - the floor: the plant alone without contact over the same time and integrator settings,
   plus the same number of evaluations of an *empty* Python LeafSystem in Drake's simulator
-  (the design card's architecture: a custom LeafSystem supplies the contact forces). No
+  (drake_dock's architecture: a custom LeafSystem supplies the contact forces). No
   implementation in that architecture that needs as many evaluations runs below it.
 
 Also each metric's contact effect: its change from t = 0 to capture relative to its value at

@@ -3,8 +3,8 @@ the paper's contact model (Sect. 5-7): analytic couples tracked by Eq. (47), acc
 constraints with Coulomb friction (Eq. 48-52) and LZB impacts (Sect. 6) triggered by witness
 functions. Generic over the plant and the declared pairs; the docking scene is one user.
 
-Design (see the README, "Hybrid simulation"): the system owns the state. A continuous-time
-MultibodyPlant has no constraints and no velocity jumps (model notes / Drake facts), so this
+Design (docs/model.md, "Hybrid simulation: witness functions and modes"): the system owns the
+state. A continuous-time MultibodyPlant has no constraints and no velocity jumps, so this
 system holds x = [q, v, u*, energy integrals] and uses the plant as a calculator on its own
 scratch context (mass matrix, force elements, Jacobians). The plant's bodies, force elements and
 gravity are the model; `state` is an output in the plant's layout, so poses can be sent to
@@ -759,8 +759,8 @@ class RigidContactSystem(LeafSystem):
         missed. This witness triggers if it turns back (v_n reaches zero) while the gap is still
         not positive. Once the gap is positive the gap witness takes over: the value jumps from
         v_n > 0 to 1 (no trigger) on the way out, and from 1 to v_n < 0 on the way back, at the
-        gap's zero, together with the gap witness. (Stopping at every bounce's apex cost an
-        isolated event each.)"""
+        gap's zero, together with the gap witness. (A rate witness active at every bounce's apex
+        would cost an isolated event each.)"""
         ev = E.evals[i]
         return 1.0 if ev is None or ev.gap > 0.0 else ev.vn
 

@@ -23,7 +23,8 @@ PAPER_EXAMPLE = MODELS_DIR / "paper_example.yaml"
 class RigidBodyParams:
     """Mass (kg) and principal moments of inertia about the body's x, y, z axes (kg m^2),
     about the mass centre (Table 1; its repeated 'I11' headings read as I_x, I_y, I_z). The
-    defaults are the paper's example read as axisymmetric about z (README, "Reading Table 1")."""
+    defaults are the paper's example read as axisymmetric about z (docs/model.md, "Reading
+    Tables 1 and 2")."""
 
     mass: float = 1.0
     inertia: list[float] = dataclasses.field(default_factory=lambda: [1.0, 1.0, 1.0])
@@ -53,7 +54,7 @@ class StewartParams:
 
 @dataclasses.dataclass
 class ContactParams:
-    """Contact parameters the paper does not give (see model notes): friction mu (sliding) and
+    """Contact parameters the paper does not give (docs/model.md): friction mu (sliding) and
     mu_s (static), energetic restitution e, and the LZB stiffness K and exponent eta of Eq. (28),
     equal for all couples."""
 
@@ -84,7 +85,7 @@ class SimulationParams:
     # Drake's error-controlled explicit integrator (SimulatorConfig.integration_scheme). The
     # third-order Bogacki-Shampine reuses its last stage (3 evaluations a step against RK5's
     # 6): where the step cap, not the accuracy, sets the step, it does the same work for half
-    # the evaluations (bench/paper_example.py, README "Speed").
+    # the evaluations (bench/paper_example.py prints both; docs/performance.md).
     integration_scheme: str = "bogacki_shampine3"
 
 

@@ -302,8 +302,8 @@ def test_stool_three_couples_share_weight():
 def test_stool_dropped_flat_lands_on_three_feet(mu):
     """Dropped flat from 1 mm, the stool hits on its three feet at once at the free-fall time
     sqrt(2 h / g); with a plastic impact it stays, each foot carrying m g / 3, without sliding.
-    With friction this used to stall the LZB solver (the feet's stick/slip were decided one
-    at a time)."""
+    With friction the LZB solver must decide the feet's stick/slip together (one at a time it
+    would not end)."""
     h = 1e-3
     sc = stool(mu=mu)
     sim, root, ctx = start(sc.system, lambda c: sc.set_state(

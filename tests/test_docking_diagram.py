@@ -11,7 +11,7 @@ from drake_dock.docking.scene import initial_state
 @pytest.fixture(scope="module")
 def axisymmetric_scenario():
     """The paper's example with inertias made axisymmetric about the docking axis (Table 1's
-    chaser, I = (40211, 6402, 40242), is not: see the README). Only then are the three
+    chaser, I = (40211, 6402, 40242), is not: see docs/model.md). Only then are the three
     couples' forces equal by symmetry."""
     import yaml
     from drake_dock.scenario import PAPER_EXAMPLE, load_scenario

@@ -66,7 +66,7 @@ def test_guide_side_ends(geom):
         np.testing.assert_allclose([np.hypot(X0[0], X0[1]), X0[2]], [g.R, 0.0], atol=1e-14)
         X1 = c.position(np.array([stop]))
         assert X1[2] == pytest.approx(g.H, abs=1e-13)
-        # Published in the model notes: 18.59 deg for the paper's numbers.
+        # docs/model.md, "APDS geometry": 18.59 deg for the paper's numbers.
         assert math.degrees(abs(stop - phi)) == pytest.approx(18.59, abs=0.005)
 
 

@@ -377,7 +377,7 @@ def _three_fold_body(slant_deg=30.0, r=0.6):
 @pytest.mark.parametrize("mu", [0.0, 0.1])
 def test_symmetric_couples_ending_together_stay_symmetric(e, mu):
     """Three symmetric couples reach their phase events at the same instant; every one must
-    be applied (a lost simultaneous event once left a couple expanding forever, or broke the
+    be applied (a lost simultaneous event leaves a couple expanding for ever, or breaks the
     symmetry by round-off). By symmetry the impulses are equal and the body leaves along its
     axis; the result is converged in the tolerance."""
     M, Wn, Wt = _three_fold_body()
@@ -411,10 +411,10 @@ def _stool(r=0.25, h=0.25):
 def test_three_feet_landing_together_with_friction(e, mu):
     """A stool dropped flat lands on three feet at once. With friction the feet must be decided
     together: each foot alone would need a tangential force (its load tips the stool), but with
-    the three loads together none is needed, so all stick. Deciding one foot at a time made the
-    feet slip and stick in turn without end (the impact never finished). Closed form: the stool
-    only translates, P_j = (1 + e) m |v| / 3, v+ = -e v, no tangential impulse; the result does
-    not depend on the order of the couples."""
+    the three loads together none is needed, so all stick. Deciding one foot at a time would
+    make the feet slip and stick in turn without end (the impact would never finish). Closed
+    form: the stool only translates, P_j = (1 + e) m |v| / 3, v+ = -e v, no tangential impulse;
+    the result does not depend on the order of the couples."""
     M, Wn, Wt = _stool()
     v = np.array([0, 0, 0, 0, 0, -0.14])
     res = solve_lzb(M, Wn, v, 1e9, 1.5, e, Wt=Wt, mu=mu, rtol=1e-10, max_steps=5000)

@@ -105,7 +105,7 @@ def test_first_contact_after_declared_travel(paper_scenario, paper_setup):
 
 def test_first_contact_distance_matches_coarse_check(paper_setup):
     state, _ = paper_setup
-    # Model notes: a coarse check puts the first touch at a ring-face distance of ~0.083 m.
+    # docs/model.md: a coarse check puts the first touch at a ring-face distance of ~0.083 m.
     assert state.d_contact == pytest.approx(0.083, abs=1e-3)
 
 

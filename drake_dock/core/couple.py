@@ -18,7 +18,7 @@ perpendicular to the curve tangents). Their Jacobian Fu = dF/du is the paper's J
 Eq. (47) follows from dF/dt = 0 along the motion: u' = -Fu^-1 (dF/dt at fixed u).
 
 Contact frame (Definition 2): n = sigma N/|N| (CS) or sigma (t1 x t2)/|t1 x t2| (CC), sigma = +-1
-fixed when the pair becomes potential so that n points from Body 2 to Body 1 (model notes);
+fixed when the pair becomes potential so that n points from Body 2 to Body 1 (docs/model.md);
 tangents ta = s_u/|s_u| (CS) or t2/|t2| (CC), tb = n x ta. Signed gap g = n . d.
 
 Relative velocity (Eq. 23-25) of the material points at the couple, v_rel = v_1(P_1) - v_2(P_2);

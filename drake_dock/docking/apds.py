@@ -1,7 +1,7 @@
 """APDS contact geometry of Sect. 4 (Eq. 12-17), in the APDS frame.
 
 APDS frame: origin at the centre of the guide ring, e3 along the docking axis towards the other
-APDS, ring face at zeta = 0, petals in 0 <= zeta <= H (see shared model notes).
+APDS, ring face at zeta = 0, petals in 0 <= zeta <= H (docs/model.md, "APDS geometry").
 
 - Guide side i (i = 1..6), Eq. (14) in its sine form: the line of the auxiliary plane through the
   outer circle at phi_i = (i - 1) pi / 3, lifted onto the cone zeta = (R - rho) tan(alpha1):

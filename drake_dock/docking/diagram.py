@@ -6,7 +6,7 @@ Exported ports: ``state`` (the plant's [q, v]), ``couple_<name>`` for each pair,
 ``ring_distance`` (outputs) and ``chaser_wrench`` (input: [torque, force] on the chaser at its
 mass centre, world frame), so that a controller can be connected.
 
-Capture (model notes): the axial distance between the guide rings' centres, measured along the
+Capture (docs/model.md): the axial distance between the guide rings' centres, measured along the
 target APDS axis, reaching ``simulation.capture_distance``. `CaptureMonitor` declares it as a
 witness function whose publish event ends the simulation (`EventStatus.ReachedTermination`), so
 the capture time is located to the witness isolation accuracy."""

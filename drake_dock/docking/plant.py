@@ -170,7 +170,7 @@ def stewart_potential(dp: DockingPlant, plant_context) -> float:
     Drake's bushing coordinates. Drake 1.51 does not implement the bushing's potential; the
     rotational part of this one is exact for Drake's torque law, the translational part is
     exact when R_AC turns about one axis of the bushing (the paper's example) and conservative
-    to second order in the tilt otherwise (measured in tests/test_plant.py)."""
+    to second order in the tilt otherwise."""
     x, rpy = stewart_deflection(dp, plant_context)
     b = dp.bushing
     k = np.asarray(b.force_stiffness_constants())

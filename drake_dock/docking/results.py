@@ -1,6 +1,6 @@
 """The arrays of timeseries.npz and the numbers of summary.json, from a `RunResult`.
 
-Field layout (issue 5): t[N]; body_names[3]; p_WB[N,3,3], R_WB[N,3,3,3], v_WB[N,3,3], w_WB[N,3,3]
+Field layout: t[N]; body_names[3]; p_WB[N,3,3], R_WB[N,3,3,3], v_WB[N,3,3], w_WB[N,3,3]
 (mass centres, world frame); apds_names[2]; p_WA[N,2,3], R_WA[N,2,3,3] (ring centre, e3 along the
 axis towards the other APDS); couple_names[12]; status[N,12] (0 far, 1 tracked, 2 sliding,
 3 sticking); active[N,12] (tracked or in contact); gap[N,12]; lambda_n[N,12]; lambda_t[N,12,2];

@@ -57,7 +57,7 @@ def rot_x(a):
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
-# Matched facing (model notes): the chaser's APDS frame is the target's turned by pi about a
+# Matched facing (docs/model.md): the chaser's APDS frame is the target's turned by pi about a
 # transverse axis and by 240 deg about the docking axis, so that the pairs of Sect. 2.2 face.
 R_MATCHED = rot_z(math.radians(240.0)) @ rot_x(math.pi)
 
@@ -78,7 +78,7 @@ def _gaps_at(pairs, yaw, d, refs):
     """Signed gaps of the pairs at ring-face distance d. A pair is a potential contact only
     while its couple is interior (see `is_interior`); otherwise its gap is +inf and its side
     reference is dropped. The sign is fixed by the side the couple lies on when the pair becomes
-    potential (model notes) and continued from ``refs`` (the previous unit directions)."""
+    potential (docs/model.md) and continued from ``refs`` (the previous unit directions)."""
     R, p = relative_pose(yaw, d)
     poses = {TARGET_APDS: (np.eye(3), np.zeros(3)), CHASER_APDS: (R, p)}
     out, dirs = [], []
@@ -129,7 +129,7 @@ class InitialState:
 
 
 def initial_state(scenario) -> InitialState:
-    """Sect. 8.2 (model notes): the target at the origin turned by yaw about its docking axis,
+    """Sect. 8.2 (docs/model.md): the target at the origin turned by yaw about its docking axis,
     its APDS at the Stewart element's equilibrium, the chaser coaxial at ring-face distance
     d_contact + approach_travel, moving at chaser_speed towards the target; all else at rest."""
     ic = scenario.initial
