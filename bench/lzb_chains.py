@@ -1,11 +1,12 @@
 """Work-precision of the LZB solver on ball chains.
 
-For each chain case, prints the error of v_plus against a converged compliant reference
-(the chain with force K delta^eta integrated in time by scipy's DOP853 at rtol 1e-13) and the
+For each chain case, prints the error of v_plus against the continuous limit of the chain
+(`drake_dock.lzb_limit`, integrated in time by scipy's DOP853 at rtol 1e-12) and the
 wall time (best of several runs, side by side in this run) of
 - `solve_lzb` (adaptive 8th order, located events) at several rtol, and
 - `solve_lzb_fixed_step` (the same equations, explicit Euler in fixed impulse steps dP, phase
   changes at step ends: first order in dP, like Siconos's MultipleImpact).
+Then a column over the restitution e for each law, so that a low-e regression shows at once.
 
 Run: .venv/bin/python bench/lzb_chains.py [--quick]
 """
@@ -13,9 +14,12 @@ import argparse
 import time
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
-from drake_dock.impact import solve_lzb, solve_lzb_fixed_step
+from drake_dock.impact import check_inputs, per_couple, solve_lzb
+from drake_dock.impact_problem import ImpactProblem
+from drake_dock.lzb_limit import continuous_limit_chain
+
+E_GRID = (0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0)
 
 
 def chain(n):
@@ -25,22 +29,45 @@ def chain(n):
     return np.eye(n), Wn
 
 
-def compliant_reference(n, K, eta, v0):
-    def rhs(t, y):
-        x, v = y[:n], y[n:]
-        d = x[:-1] - x[1:]
-        f = K * np.maximum(d, 0.0) ** eta
-        a = np.zeros(n)
-        a[:-1] -= f
-        a[1:] += f
-        return np.concatenate([v, a])
-    y = np.concatenate([np.zeros(n), v0])
-    t = 0.0
-    while True:
-        sol = solve_ivp(rhs, (t, t + 1e-2), y, method="DOP853", rtol=1e-13, atol=1e-17)
-        t, y = sol.t[-1], sol.y[:, -1]
-        if np.all(y[:n - 1] - y[1:n] <= 0) and np.all(y[n:-1] - y[n + 1:] <= 0):
-            return y[n:]
+def solve_lzb_fixed_step(M, Wn, v_minus, stiffness, eta, restitution, *, dP, law="paper"):
+    """First-order reference variant (frictionless): the same equations and restitution laws
+    as `solve_lzb`, advanced by explicit Euler steps of a fixed increment ``dP`` (N s) of the
+    primary impulse P* (the couple of largest force, Eq. 32), with phase changes applied at the
+    end of the step in which they occur (no event location). This is how fixed-step LZB codes
+    (e.g. Siconos's MultipleImpact) integrate; it is first order in dP. For benchmarks.
+    Returns v_plus."""
+    M, L, Wn, v, _, n, s = check_inputs(M, Wn, v_minus, None)
+    K = per_couple("stiffness", stiffness, s, positive=True)
+    eta_ = per_couple("eta", eta, s, positive=True)
+    e = per_couple("restitution", restitution, s, lo=0.0, hi=1.0)
+    MinvW = np.linalg.solve(M, Wn)
+    G = Wn.T @ MinvW
+    u0 = Wn.T @ v
+    if np.any(u0 > 0):
+        raise ValueError("v_minus: a couple is already separating")
+    zeros = np.zeros(s)
+    prob = ImpactProblem(np.pad(G, ((0, 2 * s), (0, 2 * s))), np.concatenate([u0, np.zeros(2 * s)]),
+                    K, eta_, e, zeros, zeros, law, zeros, False)
+    y = prob.y0.copy()
+    events = []
+    g_old = prob.event_values(y)
+    j0 = int(np.argmin(u0))
+    # First step from zero energy (Eq. 33-34): the time in which the fastest couple's impulse
+    # reaches dP, x = |u| t, P = K |u|^eta t^(eta+1) / (eta+1).
+    t_step = (dP * (eta_[j0] + 1) / (K[j0] * abs(u0[j0]) ** eta_[j0])) ** (1 / (eta_[j0] + 1))
+    for _ in range(50_000_000):
+        if prob.finished(y) and _ > 0:
+            break
+        y = y + t_step * prob.rhs(0.0, y)
+        g_new = prob.event_values(y)
+        for kind, j in zip(*np.nonzero((g_old > 0) & (g_new <= 0))):
+            prob.apply_event(y, kind, j, events, 0.0)
+        g_old = prob.event_values(y)
+        lam = K * np.maximum(y[prob.ix], 0.0) ** eta_
+        if lam.max() > 0:
+            t_step = dP / lam.max()
+    P = y[prob.iP]
+    return v + MinvW @ P
 
 
 def best_time(f, repeat):
@@ -50,6 +77,30 @@ def best_time(f, repeat):
         out = f()
         best = min(best, time.perf_counter() - t0)
     return best, out
+
+
+def restitution_column(quick):
+    """Error of `solve_lzb` (rtol 1e-10) against the continuous limit of each law over e
+    (e = 0: against the shared velocity of the balls moving together), so that a low-e
+    regression shows at once; and the number of phase events."""
+    chains = [("3 equal balls, eta 1.5", [1.0, 1.0, 1.0], [1e7, 1e7], 1.5),
+              ("5 unequal balls, eta 1", [2.0, 0.5, 1.0, 3.0, 1.0], [1e7, 1e8, 3e6, 1e7], 1.0)]
+    grid = E_GRID[:4] if quick else E_GRID
+    print(f"\nerror against the continuous limit over e (rtol 1e-10), [events]")
+    print(f"{'case':24s} {'law':6s} " + " ".join(f"{'e=%g' % e:>15s}" for e in grid))
+    for name, m, K, eta in chains[:1] if quick else chains:
+        M, Wn = chain(len(m))
+        M = np.diag(m)
+        v0 = np.zeros(len(m))
+        v0[0] = 1.0
+        for law in ("bi", "mono", "paper"):
+            cells = []
+            for e in grid:
+                ref = (np.full(len(m), m[0] / sum(m)) if e == 0 else
+                       continuous_limit_chain(m, v0, K, eta, e, law, max_step=1e-3))
+                r = solve_lzb(M, Wn, v0, K, eta, e, law=law, rtol=1e-10)
+                cells.append(f"{np.abs(r.v_plus - ref).max():9.1e} [{len(r.events):3d}]")
+            print(f"{name:24s} {law:6s} " + " ".join(f"{c:>15s}" for c in cells))
 
 
 def main():
@@ -70,7 +121,7 @@ def main():
         K[1] *= ratio
         v0 = np.zeros(n)
         v0[0] = 1.0
-        ref = compliant_reference(n, K, eta, v0)
+        ref = continuous_limit_chain(np.ones(n), v0, K, eta, 1.0)
         for rtol in rtols:
             t, r = best_time(lambda: solve_lzb(M, Wn, v0, K, eta, 1.0, rtol=rtol), 5)
             err = np.abs(r.v_plus - ref).max()
@@ -81,6 +132,7 @@ def main():
             t, v = best_time(lambda: solve_lzb_fixed_step(M, Wn, v0, K, eta, 1.0, dP=dP), 1)
             err = np.abs(v - ref).max()
             print(f"{name:28s} {'fixed dP=%.0e' % dP:24s} {err:10.2e} {t * 1e3:10.2f}")
+    restitution_column(args.quick)
     if target:
         rtol, err, t = target
         print(f"\ntarget (1e-9 on the 3-ball Hertz chain in under 20 ms): rtol={rtol:.0e} gives "

@@ -17,19 +17,44 @@ sub-impacts when no couple is loaded. Everything is written in contact space: wi
 W = [Wn, Wt] and the Delassus matrix G = W^T M^-1 W, the relative velocities u = W^T v obey
 du/dtau = G lambda, and v+ = v- + M^-1 W P at the end.
 
-Each couple has an effective indentation x_j (dx_j/dtau = -v^3_j while it exists; x_j < 0 is a
-gap opened during the impact, so that a couple that separated re-impacts when x_j returns to 0)
-and a phase: compression or expansion. The restitution laws act at the couple's maximal
-compression (v^3_j = 0, energy W_c = K x_max^(eta+1)/(eta+1), initial energy included as in
-Eq. 36) and end its expansion:
+Phases
+------
+Each couple has an effective indentation x_j >= 0 and a phase. The configuration is frozen,
+so there is no gap: a couple whose indentation is zero is unloaded, and it loads again as soon
+as it approaches again (u_n < 0). This is the continuous-time limit of LZB that Siconos's
+`MultipleImpact` also converges to; `drake_dock.lzb_limit` integrates it on ball chains in
+physical time, as the tests' reference.
 
-- ``"paper"``, Eq. (54): in expansion the force derives from E' = E - (1 - e^2) W_c, that is
-  x jumps to e^(2/(eta+1)) x_max and unloads on the loading curve; the couple ends at E' = 0,
-  having returned W_r = e^2 W_c (Eq. 36).
-- ``"mono"``: the stored energy is released on the loading curve until (1 - e^2) W_c is left,
-  at x = (1 - e^2)^(1/(eta+1)) x_max, which is then dropped.
-- ``"bi"``: during expansion dE = -(1/e^2) delta dP, i.e. dx/dtau = -v^3/e^2 (a stiffer
-  unloading branch); E reaches zero when e^2 W_c has been returned.
+- Compression: dx/dtau = -u_n (x does not fall below zero while unloaded).
+- Maximal compression (u_n = 0 while loaded): the work of this compression,
+  W = E - E_start (E_start: the stored energy when it began), enters W_c (Eq. 36) and the law
+  turns the couple to expansion.
+- Expansion, then either the end (x reaches x_end: the couple is unloaded, its remaining
+  energy lost), or a re-compression when u_n turns negative again before the end: compression
+  resumes on the loading curve from the energy stored then (E_start = E).
+- A couple at u_n = 0 within round-off after an event takes the phase its motion starts with
+  (`_Problem.turn_at_once`).
+
+The laws, at each maximal compression:
+
+- ``"paper"``, Eq. (54): E' = E - (1 - e^2) W, so x jumps to the loading curve at E' and
+  unloads on it to x_end = 0; over a contact's compressions the work returned is e^2 times
+  the work received (Eq. 36).
+- ``"mono"``: the stored energy is released on the loading curve; the contact ends when
+  (1 - e^2) W_c is left, W_c being the compression work since the contact began, at
+  x_end = ((eta+1)(1 - e^2) W_c / K)^(1/(eta+1)); that energy is dropped.
+- ``"bi"``: during expansion dE = -(1/e^2) delta dP, i.e. dx/dtau = -u_n/e^2 (a stiffer
+  unloading branch), to x_end = 0; a re-compression takes dx/dtau = -u_n again.
+
+Repeated impacts
+----------------
+- e = 0: at its maximal compression a couple loses its stored energy and is locked: a
+  constraint force rate lambda_n >= 0 keeps u_n = 0 (the limit e -> 0 of every law, which
+  would otherwise re-impact without end). It is released, and separates, when lambda_n
+  reaches zero. A plastic chain thus ends with the balls moving together.
+- Small e: the couples can re-compress many times with ever smaller amplitudes. The impact
+  ends when no couple approaches faster, nor could the stored energy move one faster, than
+  ``rtol`` times the largest initial approach speed (the bodies have settled).
 
 With one couple the three laws give the same post-impact velocity; with several they differ.
 
@@ -38,7 +63,9 @@ Friction, Eq. (27) and (53): a loaded couple slides with dP^t = -mu dP^3 u_t/|u_
 the static cone mu_s dP^3. Slip-to-stick, stick-to-slip and slip reversal are located events.
 
 Numerics: scipy's DOP853 (8th order, error controlled by ``rtol``), every phase change located
-on its dense output and the integration restarted there. The problem is nondimensionalised
+on its dense output and the integration restarted there. The normal event functions are also
+sampled inside each step, so that u_n crossing zero twice within one step (a brief separation
+between two compressions) is not missed. The problem is nondimensionalised
 (velocity scale: the largest initial relative velocity; mass scale: the smallest effective mass
 of a couple; stiffness scale: the largest K), so all thresholds are relative to the impact's
 scale and scaling every K by the same factor leaves the result unchanged.
@@ -52,19 +79,11 @@ from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
 from drake_dock.errors import NumericalError
+from drake_dock.impact_problem import ImpactEvent, ImpactProblem
 
 LAWS = ("paper", "mono", "bi")
-_COMP, _EXP = 0, 1
-
-
-@dataclasses.dataclass
-class ImpactEvent:
-    """A phase event: ``kind`` is one of 'max_compression', 'end', 're_impact', 'stick',
-    'slip', 'slip_reversal', 'reload'; ``impulse`` is the total normal impulse (N s) so far."""
-
-    impulse: float
-    kind: str
-    couple: int
+_INSIDE = np.arange(1, 32) / 32.0   # where a step's dense output is sampled for events
+_CLEAR = 1e-14                      # scaled event values below this are round-off
 
 
 @dataclasses.dataclass
@@ -90,7 +109,7 @@ class ImpactResult:
         return self.compression_work - self.restitution_work + self.friction_loss
 
 
-def _per_couple(name, value, s, *, positive=False, lo=None, hi=None):
+def per_couple(name, value, s, *, positive=False, lo=None, hi=None):
     a = np.broadcast_to(np.asarray(value, dtype=float), (s,)).copy() if np.ndim(value) == 0 \
         else np.asarray(value, dtype=float)
     if a.shape != (s,):
@@ -107,7 +126,7 @@ def _per_couple(name, value, s, *, positive=False, lo=None, hi=None):
     return a
 
 
-def _check_inputs(M, Wn, v_minus, Wt):
+def check_inputs(M, Wn, v_minus, Wt):
     M = np.asarray(M, dtype=float)
     if M.ndim != 2 or M.shape[0] != M.shape[1]:
         raise ValueError(f"M: expected a square matrix, got shape {M.shape}")
@@ -146,312 +165,26 @@ def _check_inputs(M, Wn, v_minus, Wt):
     return M, L, Wn, v, Wt, n, s
 
 
-class _Problem:
-    """Nondimensional contact-space impact problem and its state machine."""
-
-    def __init__(self, G, u0, kappa, eta, e, mu, mu_s, law, x0, friction):
-        self.s = s = len(kappa)
-        self.kappa, self.eta, self.e, self.mu, self.mu_s = kappa, eta, e, mu, mu_s
-        self.law = law
-        self.friction = friction
-        self.phase = np.full(s, _COMP)
-        self.comp_f = np.ones(s)          # 1.0 in compression, 0.0 in expansion
-        # A scalar exponent when all couples share eta (faster power).
-        self.eta_pow = float(eta[0]) if np.all(eta == eta[0]) else eta
-        self.rate = np.ones(s)           # dx/dtau = -rate * u_n
-        self.x_end = np.zeros(s)         # expansion ends at x = x_end
-        self.stuck = np.zeros(s, dtype=bool)
-        self.v_tiny = 1e-12              # |u_t| (scaled velocity) below which a couple is at rest
-        self._stick_cache = {}
-        self.slip_dir = np.zeros((s, 2))
-        self.wc = np.zeros(s)            # compression work, summed over episodes
-        # State: x (s), u (nu: normal then tangential pairs), P (nu), W_comp (s), W_exp (s),
-        # friction dissipation (s); nu = 3s with friction, s without.
-        nu = 3 * s if friction else s
-        if not friction:
-            G, u0 = G[:s, :s], u0[:s]
-        self.G = G
-        self.ix = slice(0, s)
-        self.iu = slice(s, s + nu)
-        self.iun = slice(s, 2 * s)
-        self.iP = slice(s + nu, s + 2 * nu)
-        self.iwc = slice(s + 2 * nu, 2 * s + 2 * nu)
-        self.iwe = slice(2 * s + 2 * nu, 3 * s + 2 * nu)
-        self.iwf = slice(3 * s + 2 * nu, 4 * s + 2 * nu)
-        y = np.zeros(4 * s + 2 * nu)
-        y[self.ix] = x0
-        y[self.iu] = u0
-        self.y0 = y
-
-    # Forces ---------------------------------------------------------------------------------
-    def forces(self, y):
-        s = self.s
-        x = y[self.ix]
-        u = y[self.iu]
-        lam_n = self.kappa * np.maximum(x, 0.0) ** self.eta_pow     # 0 where x <= 0
-        if self.friction and not self.stuck.any():
-            # Fast path (every couple slips or is unloaded): unloaded couples get zero.
-            ut = u[s:].reshape(s, 2)
-            nt = np.sqrt(ut[:, 0] ** 2 + ut[:, 1] ** 2)
-            big = nt > self.v_tiny
-            d = np.where(big[:, None], ut / np.where(big, nt, 1.0)[:, None], self.slip_dir)
-            return lam_n, (-self.mu * lam_n)[:, None] * d
-        lam_t = np.zeros((s, 2))
-        if self.friction:
-            ut = u[s:].reshape(s, 2)
-            loaded = lam_n > 0
-            slip = loaded & ~self.stuck
-            if slip.any():
-                nt = np.linalg.norm(ut[slip], axis=1)
-                # Near |u_t| = 0 (slip just started from rest) the slip direction is the one
-                # set by the stick-to-slip transition: the direction of a round-off-sized u_t
-                # is noise, and following it makes the force chatter.
-                big = nt > self.v_tiny
-                d = np.where(big[:, None], ut[slip] / np.where(big, nt, 1.0)[:, None],
-                             self.slip_dir[slip])
-                lam_t[slip] = -self.mu[slip, None] * lam_n[slip, None] * d
-            stick = loaded & self.stuck
-            if stick.any():
-                lam_t[stick] = self._stick_forces(lam_n, lam_t, stick)
-        return lam_n, lam_t
-
-    def _stick_forces(self, lam_n, lam_t, stick):
-        """Tangential force rates that keep u_t = 0 on the sticking couples (Eq. 27, second
-        line): G_SS lam_S = -(G_Sn lam_n + G_S,slip lam_slip)."""
-        s = self.s
-        key = stick.tobytes()
-        hit = self._stick_cache.get(key)
-        if hit is None:
-            # Per set of sticking couples: the rows and the pseudo-inverse of G_SS (the
-            # least-squares solution, as lstsq with rcond 1e-12), factored once.
-            idx = np.concatenate([[s + 2 * j, s + 2 * j + 1] for j in np.flatnonzero(stick)])
-            GS = self.G[idx].copy()
-            GS[:, idx] = 0.0
-            hit = self._stick_cache[key] = (-np.linalg.pinv(self.G[np.ix_(idx, idx)],
-                                                           rcond=1e-12) @ GS)
-        return (hit @ np.concatenate([lam_n, lam_t.ravel()])).reshape(-1, 2)
-
-    def rhs(self, t, y):
-        s = self.s
-        x = y[self.ix]
-        un = y[self.iun]
-        if not self.friction:
-            # Fast path (most impacts): a handful of numpy operations.
-            return self._assemble(y, self.kappa * np.maximum(x, 0.0) ** self.eta_pow, un, 0.0)
-        if not self.stuck.any():
-            return self._rhs_sliding(y)
-        lam_n, lam_t = self.forces(y)
-        lam = np.concatenate([lam_n, lam_t.ravel()])
-        du = self.G @ lam
-        if self.stuck.any():
-            for j in np.flatnonzero(self.stuck & (lam_n > 0)):
-                du[s + 2 * j: s + 2 * j + 2] = 0.0
-        power = lam_n * (-un)
-        dy = np.empty_like(y)
-        dy[self.ix] = -self.rate * un
-        dy[self.iu] = du
-        dy[self.iP] = lam
-        dy[self.iwc] = power * self.comp_f
-        dy[self.iwe] = power * (1.0 - self.comp_f)
-        ut = y[self.iu][s:].reshape(s, 2)
-        dy[self.iwf] = -(lam_t * ut).sum(axis=1)
-        return dy
-
-    def _rhs_sliding(self, y):
-        """`rhs` with friction when no couple sticks (most frictional impacts): the loaded
-        couples slide, lambda_t = -mu lambda_n u_t/|u_t|, and their friction power is
-        mu lambda_n |u_t|; the same equations in fewer numpy operations."""
-        s = self.s
-        x, un = y[:s], y[s:2 * s]
-        lam = np.empty(3 * s)
-        lam_n = lam[:s]
-        np.power(np.maximum(x, 0.0), self.eta_pow, out=lam_n)
-        lam_n *= self.kappa
-        ut = y[2 * s:4 * s].reshape(s, 2)
-        nt = np.sqrt(np.einsum("ij,ij->i", ut, ut))
-        big = nt > self.v_tiny
-        if big.all():
-            d = ut / nt[:, None]
-        else:
-            d = np.where(big[:, None], ut / np.where(big, nt, 1.0)[:, None], self.slip_dir)
-        lam_t = lam[s:].reshape(s, 2)
-        mu_lam = self.mu * lam_n
-        np.multiply(d, -mu_lam[:, None], out=lam_t)
-        return self._assemble(y, lam, un, mu_lam * np.einsum("ij,ij->i", d, ut))
-
-    def _assemble(self, y, lam, un, friction_power):
-        """dy/dtau from the force rates lam (normal, then tangential pairs if any): x, u, P,
-        compression and expansion works, friction dissipation (Eq. 30-31, 35)."""
-        s, nu = self.s, len(lam)
-        dy = np.empty_like(y)
-        dy[:s] = -self.rate * un
-        dy[s:s + nu] = self.G @ lam
-        dy[s + nu:s + 2 * nu] = lam
-        power = lam[:s] * un
-        dy[s + 2 * nu:2 * s + 2 * nu] = -power * self.comp_f
-        dy[2 * s + 2 * nu:3 * s + 2 * nu] = power * (self.comp_f - 1.0)
-        dy[3 * s + 2 * nu:] = friction_power
-        return dy
-
-    # Events ---------------------------------------------------------------------------------
-    def event_values(self, y):
-        """Per couple, functions whose crossing from > 0 to <= 0 is a phase event:
-        [max compression or end of expansion or re-impact, friction]."""
-        s = self.s
-        x = y[self.ix]
-        g = np.empty((2, s))
-        un = y[self.iun]
-        # Compression with x > 0: -u_n crosses zero (maximal compression). Compression with
-        # x <= 0 (a gap): x crosses zero upwards (re-impact), written as -x.
-        g[0] = np.where(self.phase == _COMP, np.where(x > 0, -un, -x), x - self.x_end)
-        g[1] = np.inf
-        if self.friction and not self.stuck.any():
-            # No couple sticks: the loaded ones (x > 0) slide.
-            ut = y[2 * s:4 * s].reshape(s, 2)
-            loaded = x > 0
-            g[1][loaded] = np.einsum("ij,ij->i", ut, self.slip_dir)[loaded]
-        elif self.friction:
-            lam_n, lam_t = self.forces(y)
-            ut = y[self.iu][s:].reshape(s, 2)
-            loaded = lam_n > 0
-            slip = loaded & ~self.stuck
-            g[1][slip] = np.einsum("ij,ij->i", ut[slip], self.slip_dir[slip])
-            st = loaded & self.stuck
-            g[1][st] = self.mu_s[st] * lam_n[st] - np.linalg.norm(lam_t[st], axis=1)
-        return g
-
-    def _probe_loads(self, y):
-        """Normal forces for the friction-mode test: the current ones, or, when no couple is
-        loaded yet (the instant of loading), their ratio as loading starts: couples closing at
-        rates -u_n load as lambda = kappa (-u_n tau)^eta (Eq. 28)."""
-        s = self.s
-        x, un = y[self.ix], y[self.iun]
-        lam_n = np.where(x > 0, self.kappa * np.maximum(x, 0.0) ** self.eta, 0.0)
-        if not (lam_n > 0).any():
-            loading = (x >= 0) & (un < 0) & (self.phase == _COMP)
-            lam_n = np.where(loading, self.kappa * np.maximum(-un, 0.0) ** self.eta, 0.0)
-        return lam_n
-
-    def select_friction_modes(self, y, js, events, impulse):
-        """Stick or slip for the couples ``js`` (loaded or loading, Eq. 27), decided jointly
-        with the couples that stick now, since their sticking forces depend on each other: a
-        couple that moves tangentially slips along its motion; the couples at rest all stick
-        if the tangential forces that keep them at rest lie in their static cones; otherwise
-        the one furthest outside its cone slips, along minus its sticking force, and the rest
-        are tested again (at most s rounds). Testing one couple at a time, with the others'
-        loads not yet counted, made three feet landing together slip and stick in turn without
-        end."""
-        s = self.s
-        ut = y[self.iu][s:].reshape(s, 2)
-        scale = max(np.abs(y[self.iu]).max(), 1e-300)
-        lam_n = self._probe_loads(y)
-        was = self.stuck.copy()
-        rest = []
-        for j in js:
-            if np.linalg.norm(ut[j]) > 1e-12 * scale:
-                self.stuck[j] = False
-                self.slip_dir[j] = ut[j] / np.linalg.norm(ut[j])
-            else:
-                rest.append(j)
-        cand = sorted(set(rest) | {j for j in np.flatnonzero(self.stuck) if lam_n[j] > 0
-                                   or j in js})
-        for j in cand:
-            y[self.iu][s + 2 * j: s + 2 * j + 2] = 0.0
-            self.stuck[j] = True
-        while cand:
-            mask = np.zeros(s, dtype=bool)
-            mask[cand] = True
-            lam_t = np.zeros((s, 2))
-            slip = (lam_n > 0) & ~mask
-            lam_t[slip] = -self.mu[slip, None] * lam_n[slip, None] * self.slip_dir[slip]
-            lt = self._stick_forces(lam_n, lam_t, mask)
-            norm = np.linalg.norm(lt, axis=1)
-            cone = self.mu_s[cand] * lam_n[cand]
-            excess = norm - cone * (1 + 1e-12)
-            # A couple at zero load sticks only with zero force (to round-off of the loads).
-            excess = np.where(cone > 0, excess, norm - 1e-12 * max(lam_n.max(), 1e-300))
-            k = int(np.argmax(excess / np.maximum(cone, 1e-300)))
-            if excess[k] <= 0:
-                break
-            j = cand.pop(k)
-            self.stuck[j] = False
-            self.slip_dir[j] = -lt[k] / norm[k]
-        for j in sorted(set(js) | set(np.flatnonzero(was != self.stuck))):
-            if self.stuck[j] and not was[j]:
-                events.append(ImpactEvent(impulse, "stick", j))
-            elif not self.stuck[j] and np.linalg.norm(ut[j]) <= 1e-12 * scale:
-                events.append(ImpactEvent(impulse, "slip" if was[j] else "slip_reversal", j))
-
-    def apply_event(self, y, kind, j, events, impulse):
-        s = self.s
-        x = y[self.ix]
-        if kind == 0:
-            if self.phase[j] == _COMP and x[j] > 0:
-                # Maximal compression: W_c (Eq. 36) and the restitution law.
-                eta, e = self.eta[j], self.e[j]
-                self.wc[j] += self.kappa[j] * x[j] ** (eta + 1) / (eta + 1)
-                events.append(ImpactEvent(impulse, "max_compression", j))
-                self.phase[j] = _EXP
-                self.comp_f[j] = 0.0
-                if e == 0.0:
-                    self._end(y, j, events, impulse)
-                elif self.law == "paper":      # Eq. (54): E' = E - (1 - e^2) W_c
-                    x[j] *= e ** (2.0 / (eta + 1))
-                    self.x_end[j] = 0.0
-                elif self.law == "mono":
-                    self.x_end[j] = (1.0 - e * e) ** (1.0 / (eta + 1)) * x[j]
-                else:                          # bi: dE = -(1/e^2) delta dP
-                    self.rate[j] = 1.0 / (e * e)
-                    self.x_end[j] = 0.0
-            elif self.phase[j] == _COMP:
-                # A gap closes: re-impact (or the first loading of a resting couple).
-                x[j] = 0.0
-                events.append(ImpactEvent(impulse, "re_impact", j))
-                if self.friction:
-                    self.select_friction_modes(y, [j], events, impulse)
-            else:
-                self._end(y, j, events, impulse)
-        else:
-            if self.stuck[j]:
-                # The sticking force reached the static cone: slip along minus it (the others
-                # that stick are decided again with it).
-                lam_n = self._probe_loads(y)
-                mask = self.stuck & ((lam_n > 0) | (np.arange(s) == j))
-                lam_t = np.zeros((s, 2))
-                slip = (lam_n > 0) & ~mask
-                lam_t[slip] = -self.mu[slip, None] * lam_n[slip, None] * self.slip_dir[slip]
-                lt = self._stick_forces(lam_n, lam_t, mask)[list(np.flatnonzero(mask)).index(j)]
-                self.stuck[j] = False
-                if np.linalg.norm(lt) > 0:
-                    self.slip_dir[j] = -lt / np.linalg.norm(lt)
-                events.append(ImpactEvent(impulse, "slip", j))
-                others = [k for k in np.flatnonzero(self.stuck) if k != j]
-                if others:
-                    self.select_friction_modes(y, others, events, impulse)
-            else:
-                ut = y[self.iu][s:].reshape(s, 2)[j]
-                scale = np.abs(y[self.iu]).max()
-                if np.linalg.norm(ut) <= 1e-9 * scale:
-                    self.select_friction_modes(y, [j], events, impulse)
-                else:  # the slip direction turned by more than 90 deg: follow it
-                    self.slip_dir[j] = ut / np.linalg.norm(ut)
-
-    def _end(self, y, j, events, impulse):
-        y[self.ix][j] = 0.0   # mono drops the remaining (1 - e^2) W_c here
-        self.phase[j] = _COMP
-        self.comp_f[j] = 1.0
-        self.rate[j] = 1.0
-        self.x_end[j] = 0.0
-        self.stuck[j] = False
-        events.append(ImpactEvent(impulse, "end", j))
-
-    def finished(self, y):
-        s = self.s
-        x = y[self.ix]
-        un = y[self.iun]
-        # u is scaled by the largest approach speed: a residual approach of 1e-12 of it (the
-        # round-off left when symmetric couples end together) does not start a new impact.
-        return bool(np.all(x <= 0) and np.all(self.phase == _COMP) and np.all(un >= -1e-12))
+def _crossings(prob, dense, t0, t1, g0, g1):
+    """The events of a step from t0 to t1 as (row, couple, ta, tb) with a sign change of the
+    event function inside [ta, tb]. The normal rows are sampled inside the step as well, so
+    that u_n crossing zero twice in one step (a brief separation or approach between two
+    phases) is not missed, nor a crossing that follows a start at the threshold."""
+    out = []
+    for kind, j in zip(*np.nonzero((g0 > 0) & (g1 <= 0))):
+        if kind == 1 or prob.locked[j]:     # friction, a locked couple's release
+            out.append((kind, j, t0, t1))
+    T = np.concatenate([[t0], t0 + _INSIDE * (t1 - t0), [t1]])
+    inside = prob.normal_event_values(dense(T[1:-1]))
+    for kind, G in ((0, inside[0]), (2, inside[1])):
+        G = np.column_stack([g0[kind], G, g1[kind]])       # (s, samples)
+        # Inside the step a crossing counts from a value clear of round-off.
+        down = ((G[:, :-1] > _CLEAR) | ((G[:, :-1] > 0) & (np.arange(len(T) - 1) == 0))) \
+            & (G[:, 1:] <= 0)
+        for j in np.flatnonzero(down.any(axis=1) & ~prob.locked):
+            i = int(np.argmax(down[j]))
+            out.append((kind, j, T[i], T[i + 1]))
+    return out
 
 
 def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, mu_s=None,
@@ -477,18 +210,18 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     SPD, wrong shapes, non-finite values, a couple already separating) and NumericalError when
     the impact does not end within ``max_steps``.
     """
-    M, L, Wn, v, Wt, n, s = _check_inputs(M, Wn, v_minus, Wt)
+    M, L, Wn, v, Wt, n, s = check_inputs(M, Wn, v_minus, Wt)
     if law not in LAWS:
         raise ValueError(f"law: expected one of {LAWS}, got {law!r}")
     if not 1e-14 <= rtol <= 1e-2:
         raise ValueError(f"rtol: expected 1e-14 <= rtol <= 1e-2, got {rtol}")
-    K = _per_couple("stiffness", stiffness, s, positive=True)
-    eta_ = _per_couple("eta", eta, s, positive=True)
-    e = _per_couple("restitution", restitution, s, lo=0.0, hi=1.0)
-    mu_ = _per_couple("mu", mu, s, lo=0.0)
-    mu_s_ = mu_ if mu_s is None else _per_couple("mu_s", mu_s, s, lo=0.0)
+    K = per_couple("stiffness", stiffness, s, positive=True)
+    eta_ = per_couple("eta", eta, s, positive=True)
+    e = per_couple("restitution", restitution, s, lo=0.0, hi=1.0)
+    mu_ = per_couple("mu", mu, s, lo=0.0)
+    mu_s_ = mu_ if mu_s is None else per_couple("mu_s", mu_s, s, lo=0.0)
     E0 = np.zeros(s) if initial_energy is None else \
-        _per_couple("initial_energy", initial_energy, s, lo=0.0)
+        per_couple("initial_energy", initial_energy, s, lo=0.0)
     friction = Wt is not None and np.any(mu_ > 0)
     W = Wn if Wt is None else np.concatenate([Wn, Wt], axis=1)
     # M^-1 W by the Cholesky factor; Delassus matrix G = W^T M^-1 W.
@@ -519,7 +252,8 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     t_s = d_s / v_s
     kappa = K * d_s**eta_ * t_s / (m_s * v_s)   # nondimensional stiffness (Eq. 28)
     x0 = ((eta_ + 1.0) * (E0 / (m_s * v_s**2)) / kappa) ** (1.0 / (eta_ + 1.0))
-    prob = _Problem(G * m_s, u_minus / v_s, kappa, eta_, e, mu_, mu_s_, law, x0, friction)
+    prob = ImpactProblem(G * m_s, u_minus / v_s, kappa, eta_, e, mu_, mu_s_, law, x0, friction)
+    prob.settle = rtol
     events = []
     y = prob.y0.copy()
     if friction:
@@ -533,6 +267,7 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     h = None
     while not prob.finished(y):
         solver = DOP853(prob.rhs, t, y, np.inf, rtol=rtol, atol=atol, first_step=h)
+        prob.classify(y)
         g_old = prob.event_values(y)
         restart = False
         while not restart:
@@ -546,19 +281,18 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
                                      couples=sorted({ev.couple for ev in events[-10:]}))
             y_new = solver.y
             g_new = prob.event_values(y_new)
-            crossed = (g_old > 0) & (g_new <= 0)
             h = solver.step_size
-            if crossed.any():
-                dense = solver.dense_output()
+            dense = solver.dense_output()
+            brackets = _crossings(prob, dense, solver.t_old, solver.t, g_old, g_new)
+            if brackets:
                 t_first, which = np.inf, None
                 roots = []
-                for kind, j in zip(*np.nonzero(crossed)):
+                for kind, j, ta, tb in brackets:
                     f = lambda tt, kind=kind, j=j: prob.event_values(dense(tt))[kind, j]  # noqa
-                    ta = solver.t_old
                     if f(ta) <= 0:    # started on the boundary: the event is at ta
                         tr = ta
                     else:
-                        tr = brentq(f, ta, solver.t, xtol=1e-15 * max(1.0, abs(solver.t)),
+                        tr = brentq(f, ta, tb, xtol=1e-15 * max(1.0, abs(tb)),
                                     rtol=4 * np.finfo(float).eps)
                     roots.append((tr, kind, j))
                     if tr < t_first:
@@ -576,11 +310,13 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
                     if (kind, j) != which and tr <= t_first + same \
                             and prob.event_values(y)[kind, j] <= 0:
                         prob.apply_event(y, kind, j, events, impulse)
+                prob.turn_at_once(y, events, impulse)
                 restart = True
             else:
                 y = y_new
                 t = solver.t
-                g_old = g_new
+                # A couple that separated unloaded waits for its approach (same rhs).
+                g_old = prob.event_values(y) if prob.classify(y) else g_new
             history.append(y[prob.iP][:s] * m_s * v_s)
             energies = np.where(y[prob.ix] > 0, prob.kappa * np.maximum(y[prob.ix], 0)
                                 ** (eta_ + 1) / (eta_ + 1), 0.0)
@@ -604,44 +340,3 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
         primary_sequence=primary, steps=steps, events=events,
         kinetic_energy_minus=KE_minus, kinetic_energy_plus=0.5 * v_plus @ M @ v_plus,
         impulse_history=np.array(history))
-
-
-def solve_lzb_fixed_step(M, Wn, v_minus, stiffness, eta, restitution, *, dP, law="paper"):
-    """First-order reference variant (frictionless): the same equations and restitution laws
-    as `solve_lzb`, advanced by explicit Euler steps of a fixed increment ``dP`` (N s) of the
-    primary impulse P* (the couple of largest force, Eq. 32), with phase changes applied at the
-    end of the step in which they occur (no event location). This is how fixed-step LZB codes
-    (e.g. Siconos's MultipleImpact) integrate; it is first order in dP. For benchmarks.
-    Returns v_plus."""
-    M, L, Wn, v, _, n, s = _check_inputs(M, Wn, v_minus, None)
-    K = _per_couple("stiffness", stiffness, s, positive=True)
-    eta_ = _per_couple("eta", eta, s, positive=True)
-    e = _per_couple("restitution", restitution, s, lo=0.0, hi=1.0)
-    MinvW = np.linalg.solve(M, Wn)
-    G = Wn.T @ MinvW
-    u0 = Wn.T @ v
-    if np.any(u0 > 0):
-        raise ValueError("v_minus: a couple is already separating")
-    zeros = np.zeros(s)
-    prob = _Problem(np.pad(G, ((0, 2 * s), (0, 2 * s))), np.concatenate([u0, np.zeros(2 * s)]),
-                    K, eta_, e, zeros, zeros, law, zeros, False)
-    y = prob.y0.copy()
-    events = []
-    g_old = prob.event_values(y)
-    j0 = int(np.argmin(u0))
-    # First step from zero energy (Eq. 33-34): the time in which the fastest couple's impulse
-    # reaches dP, x = |u| t, P = K |u|^eta t^(eta+1) / (eta+1).
-    t_step = (dP * (eta_[j0] + 1) / (K[j0] * abs(u0[j0]) ** eta_[j0])) ** (1 / (eta_[j0] + 1))
-    for _ in range(50_000_000):
-        if prob.finished(y) and _ > 0:
-            break
-        y = y + t_step * prob.rhs(0.0, y)
-        g_new = prob.event_values(y)
-        for kind, j in zip(*np.nonzero((g_old > 0) & (g_new <= 0))):
-            prob.apply_event(y, kind, j, events, 0.0)
-        g_old = prob.event_values(y)
-        lam = K * np.maximum(y[prob.ix], 0.0) ** eta_
-        if lam.max() > 0:
-            t_step = dP / lam.max()
-    P = y[prob.iP]
-    return v + MinvW @ P

@@ -10,7 +10,7 @@ drake_dock's documented behaviour, a figure and the data it is drawn from.
 (b) ``stiffness_ratio``: LZB's stiffness-ratio effect. Three equal balls, the first hitting the
     two at rest, the two contacts' stiffness ratio K2/K1 from 1e-3 to 1e3 (elastic, Hertz
     eta = 1.5): LZB's post-impact velocities against the compliant chain integrated in time
-    (`compliant_chain`), and the cost of each.
+    (`drake_dock.lzb_limit.continuous_limit_chain`), and the cost of each.
 (c) ``high_friction``: Painleve's rod (`small_scenes.painleve_rod`, tip sliding at 1 m/s, 30 deg)
     over mu: lambda_n against the planar closed form below the critical mu_c, a
     `PainleveError` naming the couple and the time above it; and the docking example at higher
@@ -36,6 +36,7 @@ from drake_dock.contact_system import COUPLE_SLICES, ContactOptions, ZenoError
 from drake_dock.core.constraints import PainleveError
 from drake_dock.errors import DrakeDockError, NumericalError
 from drake_dock.impact import solve_lzb
+from drake_dock.lzb_limit import continuous_limit_chain
 from drake_dock.small_scenes import G, disk_on_incline, painleve_rod
 from drake_dock.stepping import WitnessApproach
 
@@ -152,31 +153,6 @@ def chain_matrices(n):
     return np.eye(n), Wn
 
 
-def compliant_chain(K, eta, v0, *, rtol=1e-12):
-    """Elastic Hertz chain of unit balls integrated in time (DOP853) until every contact is
-    open and separating; returns the final velocities."""
-    from scipy.integrate import solve_ivp
-    K = np.asarray(K, float)
-    n = len(v0)
-
-    def rhs(t, y):
-        d = np.maximum(y[:n - 1] - y[1:n], 0.0)
-        f = K * d ** eta
-        a = np.zeros(n)
-        a[:-1] -= f
-        a[1:] += f
-        return np.concatenate([y[n:], a])
-
-    y = np.concatenate([np.zeros(n), np.asarray(v0, float)])
-    T = 2e-3 * (1e7 / K.min()) ** 0.4          # several contact durations of the softest
-    for _ in range(10_000):
-        sol = solve_ivp(rhs, (0.0, T), y, method="DOP853", rtol=rtol, atol=1e-16)
-        y = sol.y[:, -1]
-        if np.all(y[:n - 1] - y[1:n] <= 0) and np.all(np.diff(y[n:]) >= 0):
-            return y[n:]
-    raise RuntimeError("the compliant chain did not separate")
-
-
 def stiffness_ratio_case(ratios, *, eta=1.5, log=print) -> dict:
     M, Wn = chain_matrices(3)
     v0 = np.array([1.0, 0.0, 0.0])
@@ -187,7 +163,7 @@ def stiffness_ratio_case(ratios, *, eta=1.5, log=print) -> dict:
         res = solve_lzb(M, Wn, v0, K, eta, 1.0, rtol=1e-12)
         t_lzb = _time.perf_counter() - t0
         t0 = _time.perf_counter()
-        ref = compliant_chain(K, eta, v0)
+        ref = continuous_limit_chain(np.ones(3), v0, K, eta, 1.0)
         t_ref = _time.perf_counter() - t0
         rows.append(dict(ratio=ratio, lzb=res.v_plus.tolist(), compliant=ref.tolist(),
                          difference=float(np.abs(res.v_plus - ref).max()), lzb_steps=res.steps,
