@@ -1,8 +1,10 @@
 """``drake-dock``: a thin command line over `drake_dock.run.run`.
 
 Exit codes: 0 success; 2 bad input (the message names the field, the value and the allowed
-range); 3 numerical failure (the message names the time and the couples). On failure no output
-directory is written, or the previous complete one is left untouched.
+range), ``--out`` included, before anything is simulated; 3 numerical failure (the message
+names the time and the couples). On failure no output directory is written, or the previous
+complete one is left untouched. ``--out`` must be a new path, an empty directory or a previous
+drake_dock output (`drake_dock.output.check_destination`).
 """
 from __future__ import annotations
 
@@ -43,8 +45,14 @@ class ProgressBar:
             self.stream.flush()
 
 
+OUT_HELP = ("output directory: a new path, an empty directory or a previous drake_dock output, "
+            "replaced atomically (anything else is refused)")
+
+
 def _error(kind, e) -> str:
-    return textwrap.fill(f"drake-dock: {kind}: {e}", width=100)
+    # Paths and names are never split (no breaks inside words or at hyphens).
+    return textwrap.fill(f"drake-dock: {kind}: {e}", width=100, break_long_words=False,
+                         break_on_hyphens=False)
 
 
 def main(argv=None) -> int:
@@ -53,7 +61,7 @@ def main(argv=None) -> int:
     run_p = sub.add_parser("run", help="simulate a docking scenario and write its outputs")
     run_p.add_argument("scenario", nargs="?", default=str(PAPER_EXAMPLE),
                        help="scenario YAML (default: the paper's example)")
-    run_p.add_argument("--out", required=True, help="output directory (replaced atomically)")
+    run_p.add_argument("--out", required=True, help=OUT_HELP)
     run_p.add_argument("--duration", type=float, default=None,
                        help="override simulation.duration (s)")
     run_p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -63,18 +71,20 @@ def main(argv=None) -> int:
                               "stability: the five cases where methods fail")
     study_p.add_argument("scenario", nargs="?", default=str(PAPER_EXAMPLE),
                          help="scenario YAML (default: the paper's example)")
-    study_p.add_argument("--out", required=True, help="output directory (replaced atomically)")
+    study_p.add_argument("--out", required=True, help=OUT_HELP)
     study_p.add_argument("--quick", action="store_true",
                          help="a few points only (for CI)")
     args = parser.parse_args(argv)
     if args.command == "study":
         return _study(args)
     # Imported here so that `--help` stays fast.
+    from drake_dock.output import check_destination
     from drake_dock.run import format_summary, run
     from drake_dock.scenario import load_scenario
     bar = None if args.no_progress else ProgressBar()
 
     def work():
+        check_destination(args.out)
         scenario = load_scenario(args.scenario)
         if args.duration is not None:
             if not args.duration > 0:
@@ -105,6 +115,7 @@ def _guarded(work, out) -> int:
 
 
 def _study(args) -> int:
+    from drake_dock.output import check_destination
     from drake_dock.scenario import load_scenario
     if args.which == "stability":
         from drake_dock.stability import StabilityPlan as Plan
@@ -118,6 +129,7 @@ def _study(args) -> int:
         from drake_dock.study import write_study as write
 
     def work():
+        check_destination(args.out)
         scenario = load_scenario(args.scenario)
         result = run_plan(scenario, Plan.quick() if args.quick else Plan.full(),
                           log=lambda s: print(s, flush=True))

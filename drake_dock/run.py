@@ -2,7 +2,9 @@
 ``timeseries.npz``, ``summary.json``, the figures (PNG) and ``replay.html``.
 
 A failed run (bad input, numerical failure) leaves no directory, or the previous complete one
-untouched (`drake_dock.output.atomic_directory`).
+untouched (`drake_dock.output.atomic_directory`). The destination is checked before anything is
+simulated (`drake_dock.output.check_destination`): only a new path, an empty directory or a
+previous drake_dock output is replaced.
 """
 from __future__ import annotations
 
@@ -16,7 +18,7 @@ from drake_dock.docking.replay import replay_html
 from drake_dock.docking.results import momenta, momentum_reference_point, summary, timeseries
 from drake_dock.docking.simulate import simulate
 from drake_dock.figures import initial_configuration_figure, run_figures
-from drake_dock.output import atomic_directory
+from drake_dock.output import atomic_directory, check_destination
 
 
 def _npz_bytes(arrays: dict) -> bytes:
@@ -28,7 +30,9 @@ def _npz_bytes(arrays: dict) -> bytes:
 
 
 def run(scenario, out_dir, *, progress=None, state=None) -> dict:
-    """Simulates ``scenario`` and writes everything into ``out_dir``; returns the summary."""
+    """Simulates ``scenario`` and writes everything into ``out_dir``; returns the summary.
+    Raises `InputError` for a destination that may not be replaced, before simulating."""
+    check_destination(out_dir)
     result = simulate(scenario, progress=progress, state=state)
     ts = timeseries(result)
     summ = summary(result, ts)
