@@ -1,16 +1,18 @@
 """``drake-dock``: a thin command line over `drake_dock.run.run`.
 
 Exit codes: 0 success; 2 bad input (the message names the field, the value and the allowed
-range), ``--out`` included, before anything is simulated; 3 numerical failure (the message
-names the time and the couples). On failure no output directory is written, or the previous
-complete one is left untouched. ``--out`` must be a new path, an empty directory or a previous
-drake_dock output (`drake_dock.output.check_destination`).
+range), found before anything is simulated, ``--out`` included; 3 numerical failure (the
+message names the time and the couples). Any other error is reported in one paragraph too
+(exit 3, "internal error"), never as a traceback. On failure no output directory is written, or
+the previous complete one is left untouched. ``--out`` must be a new path, an empty directory
+or a previous drake_dock output (`drake_dock.output.check_destination`).
 """
 from __future__ import annotations
 
 import argparse
 import sys
 import textwrap
+import warnings
 
 from drake_dock.errors import DrakeDockError, InputError
 from drake_dock.scenario import PAPER_EXAMPLE
@@ -80,7 +82,7 @@ def main(argv=None) -> int:
     # Imported here so that `--help` stays fast.
     from drake_dock.output import check_destination
     from drake_dock.run import format_summary, run
-    from drake_dock.scenario import load_scenario
+    from drake_dock.scenario import load_scenario, validate
     bar = None if args.no_progress else ProgressBar()
 
     def work():
@@ -90,28 +92,47 @@ def main(argv=None) -> int:
             if not args.duration > 0:
                 raise InputError("--duration", args.duration, "> 0 s")
             scenario.simulation.duration = args.duration
+            validate(scenario)
         return [format_summary(run(scenario, args.out, progress=bar))]
-    try:
-        return _guarded(work, args.out)
-    finally:
-        if bar is not None:
-            bar.close()
+    return _guarded(work, args.out, None if bar is None else bar.close)
 
 
-def _guarded(work, out) -> int:
-    """Runs ``work() -> lines``; maps the typed errors to the exit codes."""
+def _guarded(work, out, finish=None) -> int:
+    """Runs ``work() -> lines``; maps the typed errors to the exit codes. Anything else (a
+    bug, an I/O error while writing) is one paragraph too, never a traceback. Warnings raised
+    meanwhile (numpy's overflow, say) are shown after a success, and only summed up in the
+    paragraph of a failure. ``finish()`` (the progress bar's) runs before any of it."""
+    caught = []
     try:
-        lines = work()
+        with warnings.catch_warnings(record=True) as caught:
+            lines = work()
     except InputError as e:
-        print(_error("bad input", e), file=sys.stderr)
-        return 2
+        return _failed(2, "bad input", e, caught, finish)
     except DrakeDockError as e:
-        print(_error("numerical failure", e), file=sys.stderr)
-        return 3
+        return _failed(3, "numerical failure", e, caught, finish)
+    except Exception as e:  # noqa: BLE001 - the last resort of a command line
+        kind = "I/O error" if isinstance(e, OSError) else "internal error"
+        return _failed(3, f"{kind} ({type(e).__name__})", str(e)[:2000] or repr(e), caught,
+                       finish)
+    if finish is not None:
+        finish()
+    for w in caught:
+        warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     for line in lines:
         print(line)
     print(f"wrote {out}")
     return 0
+
+
+def _failed(code, kind, e, caught, finish) -> int:
+    if finish is not None:
+        finish()
+    text = str(e)
+    notes = list(dict.fromkeys(str(w.message).split("\n")[0] for w in caught))
+    if notes:
+        text += f" (after {len(caught)} warnings: {'; '.join(notes[:3])})"
+    print(_error(kind, text), file=sys.stderr)
+    return code
 
 
 def _study(args) -> int:

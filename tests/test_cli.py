@@ -50,6 +50,9 @@ def test_bad_input_exits_2_and_leaves_previous_output(tmp_path):
 
 BAD = {
     "interpenetration": ("initial: {approach_travel: -0.01}\n", "initial.approach_travel"),
+    "zero closing speed": ("initial: {chaser_speed: 0}\n", "initial.chaser_speed"),
+    "capture beyond the start": ("simulation: {capture_distance: 0.2}\n",
+                                 "simulation.capture_distance"),
     "nan": ("initial: {chaser_speed: .nan}\n", "initial.chaser_speed"),
     "negative mass": ("bodies: {target: {mass: -5.0}}\n", "bodies.target.mass"),
     "unknown key": ("contact: {friction: 0.2}\n", "contact.friction"),
@@ -83,3 +86,12 @@ def test_unreadable_file_exit_2(tmp_path):
     assert "scenario file" in r.stderr and "Traceback" not in r.stderr
     assert not out.exists()
 
+
+def test_binary_scenario_file_exit_2(tmp_path):
+    bad = tmp_path / "scenario.yaml"
+    bad.write_bytes(bytes(range(256)) * 4)
+    out = tmp_path / "out"
+    r = _run(["run", str(bad), "--out", str(out), "--no-progress"])
+    assert r.returncode == 2, r.stderr
+    assert "scenario file" in r.stderr and "UTF-8" in r.stderr and "Traceback" not in r.stderr
+    assert not out.exists()

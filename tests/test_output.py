@@ -1,6 +1,6 @@
 """Output safety: `--out` is written only if it is new, an empty directory or a previous
 drake_dock output; anything else is refused with exit 2 before simulating, naming the path, and
-left as it was. Replacing a previous output is atomic."""
+left as it was. Replacing a previous output is atomic. Failures are one paragraph, typed."""
 import json
 import os
 from pathlib import Path
@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from drake_dock.cli import main
-from drake_dock.errors import InputError
+from drake_dock.errors import InputError, NumericalError
 from drake_dock.output import MARKER, atomic_directory, check_destination
 
 BOOM = "simulated although the destination is refused"
@@ -216,3 +216,55 @@ def test_new_path_and_empty_directory_are_accepted(tmp_path):
     link = tmp_path / "link"                         # a link to a previous output: followed
     link.symlink_to(empty)
     assert check_destination(link) == empty
+
+
+def _one_paragraph_exit_3(capsys, rc, out):
+    err = capsys.readouterr().err
+    assert rc == 3, err
+    text = err.strip()
+    assert "Traceback" not in text and "\n\n" not in text and text.startswith("drake-dock: ")
+    assert not out.exists() and _siblings(out) == []
+    return " ".join(text.split())
+
+
+def test_unexpected_exception_is_one_paragraph_exit_3(tmp_path, capsys, monkeypatch):
+    def bug(*args, **kwargs):
+        raise TypeError("unsupported operand\n\nsecond paragraph")
+    monkeypatch.setattr("drake_dock.run.simulate", bug)
+    out = tmp_path / "results"
+    msg = _one_paragraph_exit_3(capsys, main(["run", "--out", str(out), "--no-progress"]), out)
+    assert "internal error (TypeError)" in msg and "second paragraph" in msg
+
+
+def test_numerical_failure_names_time_and_couples(tmp_path, capsys):
+    """A real one: an accuracy no step can meet (Drake's minimum step is violated)."""
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text("simulation: {accuracy: 1.0e-300}\n")
+    out = tmp_path / "results"
+    rc = main(["run", str(scenario), "--out", str(out), "--no-progress"])
+    msg = _one_paragraph_exit_3(capsys, rc, out)
+    assert "numerical failure" in msg and "t = " in msg and "couples cc_" in msg
+
+
+def test_contact_system_refusal_at_t0_is_exit_2(tmp_path, capsys, monkeypatch):
+    """The contact system refuses bodies that start interpenetrating (InputError naming the
+    pair) while the simulator initializes: it stays a bad input, not a numerical failure."""
+    def refuse(self, root):
+        raise InputError("initial state of pair cc_T1_C5", "signed gap -0.001 m",
+                         "signed gap >= -impact_gap_tol = -1e-08 m",
+                         "the bodies start interpenetrating")
+    monkeypatch.setattr("drake_dock.docking.simulate._Recorder.sample", refuse)
+    out = tmp_path / "results"
+    rc = main(["run", "--out", str(out), "--no-progress"])
+    err = " ".join(capsys.readouterr().err.split())
+    assert rc == 2 and "cc_T1_C5" in err and "interpenetrating" in err
+    assert not out.exists()
+
+
+def test_numerical_error_from_the_run_maps_to_exit_3(tmp_path, capsys, monkeypatch):
+    def fail(*args, **kwargs):
+        raise NumericalError("LZB impact did not end", time=0.0123, couples=["cc_T1_C5"])
+    monkeypatch.setattr("drake_dock.run.simulate", fail)
+    out = tmp_path / "results"
+    msg = _one_paragraph_exit_3(capsys, main(["run", "--out", str(out), "--no-progress"]), out)
+    assert "t = 0.0123 s" in msg and "cc_T1_C5" in msg
