@@ -1,14 +1,18 @@
 """``drake-dock``: a thin command line over `drake_dock.run.run`.
 
 Exit codes: 0 success; 2 bad input (the message names the field, the value and the allowed
-range); 3 numerical failure (the message names the time and the couples). On failure no output
-directory is written, or the previous complete one is left untouched.
+range), found before anything is simulated, ``--out`` included; 3 numerical failure (the
+message names the time and the couples). Any other error is reported in one paragraph too
+(exit 3, "internal error"), never as a traceback. On failure no output directory is written, or
+the previous complete one is left untouched. ``--out`` must be a new path, an empty directory
+or a previous drake_dock output (`drake_dock.output.check_destination`).
 """
 from __future__ import annotations
 
 import argparse
 import sys
 import textwrap
+import warnings
 
 from drake_dock.errors import DrakeDockError, InputError
 from drake_dock.scenario import PAPER_EXAMPLE
@@ -43,8 +47,14 @@ class ProgressBar:
             self.stream.flush()
 
 
+OUT_HELP = ("output directory: a new path, an empty directory or a previous drake_dock output, "
+            "replaced atomically (anything else is refused)")
+
+
 def _error(kind, e) -> str:
-    return textwrap.fill(f"drake-dock: {kind}: {e}", width=100)
+    # Paths and names are never split (no breaks inside words or at hyphens).
+    return textwrap.fill(f"drake-dock: {kind}: {e}", width=100, break_long_words=False,
+                         break_on_hyphens=False)
 
 
 def main(argv=None) -> int:
@@ -53,7 +63,7 @@ def main(argv=None) -> int:
     run_p = sub.add_parser("run", help="simulate a docking scenario and write its outputs")
     run_p.add_argument("scenario", nargs="?", default=str(PAPER_EXAMPLE),
                        help="scenario YAML (default: the paper's example)")
-    run_p.add_argument("--out", required=True, help="output directory (replaced atomically)")
+    run_p.add_argument("--out", required=True, help=OUT_HELP)
     run_p.add_argument("--duration", type=float, default=None,
                        help="override simulation.duration (s)")
     run_p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -63,48 +73,70 @@ def main(argv=None) -> int:
                               "stability: the five cases where methods fail")
     study_p.add_argument("scenario", nargs="?", default=str(PAPER_EXAMPLE),
                          help="scenario YAML (default: the paper's example)")
-    study_p.add_argument("--out", required=True, help="output directory (replaced atomically)")
+    study_p.add_argument("--out", required=True, help=OUT_HELP)
     study_p.add_argument("--quick", action="store_true",
                          help="a few points only (for CI)")
     args = parser.parse_args(argv)
     if args.command == "study":
         return _study(args)
     # Imported here so that `--help` stays fast.
+    from drake_dock.output import check_destination
     from drake_dock.run import format_summary, run
-    from drake_dock.scenario import load_scenario
+    from drake_dock.scenario import load_scenario, validate
     bar = None if args.no_progress else ProgressBar()
 
     def work():
+        check_destination(args.out)
         scenario = load_scenario(args.scenario)
         if args.duration is not None:
             if not args.duration > 0:
                 raise InputError("--duration", args.duration, "> 0 s")
             scenario.simulation.duration = args.duration
+            validate(scenario)
         return [format_summary(run(scenario, args.out, progress=bar))]
-    try:
-        return _guarded(work, args.out)
-    finally:
-        if bar is not None:
-            bar.close()
+    return _guarded(work, args.out, None if bar is None else bar.close)
 
 
-def _guarded(work, out) -> int:
-    """Runs ``work() -> lines``; maps the typed errors to the exit codes."""
+def _guarded(work, out, finish=None) -> int:
+    """Runs ``work() -> lines``; maps the typed errors to the exit codes. Anything else (a
+    bug, an I/O error while writing) is one paragraph too, never a traceback. Warnings raised
+    meanwhile (numpy's overflow, say) are shown after a success, and only summed up in the
+    paragraph of a failure. ``finish()`` (the progress bar's) runs before any of it."""
+    caught = []
     try:
-        lines = work()
+        with warnings.catch_warnings(record=True) as caught:
+            lines = work()
     except InputError as e:
-        print(_error("bad input", e), file=sys.stderr)
-        return 2
+        return _failed(2, "bad input", e, caught, finish)
     except DrakeDockError as e:
-        print(_error("numerical failure", e), file=sys.stderr)
-        return 3
+        return _failed(3, "numerical failure", e, caught, finish)
+    except Exception as e:  # noqa: BLE001 - the last resort of a command line
+        kind = "I/O error" if isinstance(e, OSError) else "internal error"
+        return _failed(3, f"{kind} ({type(e).__name__})", str(e)[:2000] or repr(e), caught,
+                       finish)
+    if finish is not None:
+        finish()
+    for w in caught:
+        warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     for line in lines:
         print(line)
     print(f"wrote {out}")
     return 0
 
 
+def _failed(code, kind, e, caught, finish) -> int:
+    if finish is not None:
+        finish()
+    text = str(e)
+    notes = list(dict.fromkeys(str(w.message).split("\n")[0] for w in caught))
+    if notes:
+        text += f" (after {len(caught)} warnings: {'; '.join(notes[:3])})"
+    print(_error(kind, text), file=sys.stderr)
+    return code
+
+
 def _study(args) -> int:
+    from drake_dock.output import check_destination
     from drake_dock.scenario import load_scenario
     if args.which == "stability":
         from drake_dock.stability import StabilityPlan as Plan
@@ -118,6 +150,7 @@ def _study(args) -> int:
         from drake_dock.study import write_study as write
 
     def work():
+        check_destination(args.out)
         scenario = load_scenario(args.scenario)
         result = run_plan(scenario, Plan.quick() if args.quick else Plan.full(),
                           log=lambda s: print(s, flush=True))

@@ -14,7 +14,10 @@ class InputError(DrakeDockError, ValueError):
         self.field = field
         self.value = value
         self.allowed = allowed
-        msg = f"{field} = {value!r} is not allowed: {allowed}"
+        shown = repr(value)
+        if len(shown) > 200:          # a whole file read as one value, say
+            shown = shown[:200] + "..."
+        msg = f"{field} = {shown} is not allowed: {allowed}"
         if why:
             msg += f" ({why})"
         super().__init__(msg)

@@ -9,6 +9,7 @@ import numpy as np  # noqa: E402
 
 from drake_dock.core.patches import posed  # noqa: E402
 from drake_dock.docking.apds import apds_patches  # noqa: E402
+from drake_dock.docking.results import relative_text  # noqa: E402
 
 
 def _draw_apds(ax, g, R, p, color, label):
@@ -149,8 +150,9 @@ def run_figures(ts, summary, momentum, out_dir, focus_couples=()):
         ax.set_xlabel("t [s]")
         ax.legend(fontsize=8)
     d = summary["momentum_drift_relative"]
-    fig.suptitle(f"Fig. 9 equivalent: momentum (relative drift {d['linear']:.1e}, "
-                 f"angular {d['angular']:.1e})")
+    fig.suptitle(f"Fig. 9 equivalent: momentum (relative drift "
+                 f"{relative_text(d['linear'], '.1e')}, "
+                 f"angular {relative_text(d['angular'], '.1e')})")
     save(fig, "fig9_momentum.png")
 
     # All couples' forces.
@@ -186,6 +188,7 @@ def run_figures(ts, summary, momentum, out_dir, focus_couples=()):
     axs[1].set_ylabel("ledger residual / initial energy")
     for ax in axs:
         ax.set_xlabel("t [s]")
-    fig.suptitle(f"Energy ledger (closure {summary['energy_ledger']['closure_error_relative']:.1e})")
+    closure = summary["energy_ledger"]["closure_error_relative"]
+    fig.suptitle(f"Energy ledger (closure {relative_text(closure, '.1e')})")
     save(fig, "energy_ledger.png")
     return files

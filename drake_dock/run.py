@@ -2,7 +2,9 @@
 ``timeseries.npz``, ``summary.json``, the figures (PNG) and ``replay.html``.
 
 A failed run (bad input, numerical failure) leaves no directory, or the previous complete one
-untouched (`drake_dock.output.atomic_directory`).
+untouched (`drake_dock.output.atomic_directory`). The destination is checked before anything is
+simulated (`drake_dock.output.check_destination`): only a new path, an empty directory or a
+previous drake_dock output is replaced.
 """
 from __future__ import annotations
 
@@ -13,10 +15,12 @@ from types import SimpleNamespace
 import numpy as np
 
 from drake_dock.docking.replay import replay_html
-from drake_dock.docking.results import momenta, momentum_reference_point, summary, timeseries
+from drake_dock.docking.results import (momenta, momentum_reference_point, relative_text, summary,
+                                        timeseries)
 from drake_dock.docking.simulate import simulate
+from drake_dock.errors import NumericalError
 from drake_dock.figures import initial_configuration_figure, run_figures
-from drake_dock.output import atomic_directory
+from drake_dock.output import atomic_directory, check_destination
 
 
 def _npz_bytes(arrays: dict) -> bytes:
@@ -27,11 +31,33 @@ def _npz_bytes(arrays: dict) -> bytes:
     return buf.getvalue()
 
 
+def _non_finite(node, path=""):
+    """The dotted key of the first non-finite number in a summary, or None."""
+    if isinstance(node, dict):
+        items = node.items()
+    elif isinstance(node, (list, tuple)):
+        items = enumerate(node)
+    else:
+        return (path or "value") if isinstance(node, float) and not np.isfinite(node) else None
+    for k, v in items:
+        bad = _non_finite(v, f"{path}.{k}" if path else str(k))
+        if bad is not None:
+            return bad
+    return None
+
+
 def run(scenario, out_dir, *, progress=None, state=None) -> dict:
-    """Simulates ``scenario`` and writes everything into ``out_dir``; returns the summary."""
+    """Simulates ``scenario`` and writes everything into ``out_dir``; returns the summary.
+    Raises `InputError` for a destination that may not be replaced, before simulating, and
+    `NumericalError` for a failed simulation or a non-finite summary value (nothing written)."""
+    check_destination(out_dir)
     result = simulate(scenario, progress=progress, state=state)
     ts = timeseries(result)
     summ = summary(result, ts)
+    bad = _non_finite(summ)
+    if bad is not None:
+        raise NumericalError(f"the run's summary value {bad} is not finite (an overflow of "
+                             f"extreme inputs)", time=result.end_time)
     params = [getattr(scenario.bodies, n) for n in ts["body_names"]]
     P, L, _, _ = momenta(ts, [p.mass for p in params], [p.inertia for p in params],
                          momentum_reference_point(scenario, ts))
@@ -62,11 +88,12 @@ def format_summary(s) -> str:
         f"{cap} (axial ring-centre distance <= {s['capture_distance_m']} m)",
         f"impacts: {s['number_of_impacts']}; peak contact force {s['peak_contact_force_N']:.6g} N;"
         f" largest impulse {s['largest_impulse_Ns']:.6g} N s",
-        f"momentum drift (relative): linear {md['linear']:.2e}, angular {md['angular']:.2e}",
+        f"momentum drift (relative): linear {relative_text(md['linear'])}, angular "
+        f"{relative_text(md['angular'])}",
         f"energy: initial {led['initial_total_J']:.6g} J; dissipated by the damper "
         f"{led['dissipated_damper_J']:.6g} J, friction {led['dissipated_friction_J']:.6g} J, "
         f"impacts {led['dissipated_impacts_J']:.6g} J; ledger closure "
-        f"{led['closure_error_relative']:.2e}",
+        f"{relative_text(led['closure_error_relative'])}",
         f"wall time {s['wall_time_s']:.2f} s for {s['end_time_s']:.4f} s simulated "
         f"({s['derivative_evaluations']} derivative evaluations)",
         time_shares_line(s["time_shares"])])

@@ -89,6 +89,7 @@ class SimulationParams:
     integration_scheme: str = "bogacki_shampine3"
 
 
+MAX_STEPS = 1e6      # simulation.duration / simulation.max_step: a run that can end
 INTEGRATION_SCHEMES = ("bogacki_shampine3", "runge_kutta3", "runge_kutta5")
 
 
@@ -161,6 +162,17 @@ def _nonnegative(field, v):
         raise InputError(field, v, ">= 0")
 
 
+def _mounted_ahead(field, v, body):
+    """An APDS sits on its spacecraft's docking face: its ring centre is ahead of the body's
+    mass centre along the docking axis (offset z > 0). The bodies carry no contact geometry
+    but their APDSes, so this is the rule that keeps each APDS outside its own body (and the
+    other spacecraft out of it); the rings' clearance at t = 0 is initial.approach_travel."""
+    if _vector(field, v)[2] <= 0:
+        raise InputError(f"{field}[2]", v[2], "> 0 m (the APDS ahead of the mass centre of "
+                         f"the {body}, towards the other spacecraft)",
+                         f"the APDS would lie inside or behind the {body} body")
+
+
 def validate(s: Scenario) -> Scenario:
     s.geometry.validate("geometry")
     for name in ("target", "target_apds", "chaser"):
@@ -176,14 +188,17 @@ def validate(s: Scenario) -> Scenario:
                 raise InputError(f"{f}.inertia", b.inertia,
                                  "principal moments with I_k <= I_i + I_j for every k",
                                  "not the inertia of a physical body")
-    _vector("stewart.p_TA", s.stewart.p_TA)
     for name in ("force_stiffness", "force_damping", "torque_stiffness", "torque_damping"):
         for k, x in enumerate(_vector(f"stewart.{name}", getattr(s.stewart, name))):
             _nonnegative(f"stewart.{name}[{k}]", x)
-    _vector("chaser_apds_offset", s.chaser_apds_offset)
+    _mounted_ahead("stewart.p_TA", s.stewart.p_TA, "target")
+    _mounted_ahead("chaser_apds_offset", s.chaser_apds_offset, "chaser")
     c = s.contact
     _nonnegative("contact.mu", c.mu)
     _nonnegative("contact.mu_s", c.mu_s)
+    if c.mu_s < c.mu:
+        raise InputError("contact.mu_s", c.mu_s, f">= contact.mu = {c.mu!r}",
+                         "static friction below sliding friction")
     if _finite("contact.restitution", c.restitution) < 0 or c.restitution > 1:
         raise InputError("contact.restitution", c.restitution, "0 <= e <= 1")
     _positive("contact.stiffness", c.stiffness)
@@ -194,11 +209,18 @@ def validate(s: Scenario) -> Scenario:
     if _finite("initial.approach_travel", ic.approach_travel) < 0:
         raise InputError("initial.approach_travel", ic.approach_travel,
                          ">= 0 m (a negative travel means initial interpenetration)")
-    _finite("initial.chaser_speed", ic.chaser_speed)
+    if _finite("initial.chaser_speed", ic.chaser_speed) <= 0:
+        raise InputError("initial.chaser_speed", ic.chaser_speed,
+                         "> 0 m/s (the closing speed towards the target)")
     _positive("simulation.duration", s.simulation.duration)
     if not 0 < _finite("simulation.accuracy", s.simulation.accuracy) < 1:
         raise InputError("simulation.accuracy", s.simulation.accuracy, "0 < accuracy < 1")
     _positive("simulation.max_step", s.simulation.max_step)
+    if s.simulation.duration / s.simulation.max_step > MAX_STEPS:
+        raise InputError("simulation.max_step", s.simulation.max_step,
+                         f">= simulation.duration / {MAX_STEPS:.0e} = "
+                         f"{s.simulation.duration / MAX_STEPS:.3g} s",
+                         f"more than {MAX_STEPS:.0e} steps")
     _positive("simulation.capture_distance", s.simulation.capture_distance)
     if s.simulation.integration_scheme not in INTEGRATION_SCHEMES:
         raise InputError("simulation.integration_scheme", s.simulation.integration_scheme,
@@ -213,10 +235,13 @@ def load_scenario(filename=None, *, data: str | None = None) -> Scenario:
     if data is None:
         filename = Path(filename) if filename is not None else PAPER_EXAMPLE
         try:
-            data = filename.read_text()
+            data = filename.read_text(encoding="utf-8")
         except OSError as e:
             raise InputError("scenario file", str(filename), "a readable YAML file",
                              e.strerror or str(e)) from None
+        except UnicodeDecodeError as e:
+            raise InputError("scenario file", str(filename), "a YAML text file (UTF-8)",
+                             f"byte {e.start} is not UTF-8 text: a binary file?") from None
     try:
         raw = yaml.safe_load(data)
     except yaml.YAMLError as e:

@@ -388,7 +388,7 @@ def write_stability(res, out_dir):
     """stability.json, summary.txt and one figure per case, atomically."""
     from drake_dock.output import atomic_directory
     from drake_dock.stability_figures import stability_figures
-    with atomic_directory(out_dir) as tmp:
+    with atomic_directory(out_dir, kind="study stability") as tmp:
         (tmp / "stability.json").write_text(json.dumps(res, indent=1, default=_json))
         (tmp / "summary.txt").write_text("\n".join(summary_lines(res)) + "\n")
         stability_figures(res, tmp)

@@ -375,7 +375,7 @@ def work_precision_figure(result, path):
 def write_study(result, out_dir):
     """chart, CSV and the printed lines, atomically."""
     from drake_dock.output import atomic_directory
-    with atomic_directory(out_dir) as tmp:
+    with atomic_directory(out_dir, kind="study speed-accuracy") as tmp:
         (tmp / "points.csv").write_text(points_csv(result["points"]))
         work_precision_figure(result, tmp / "work_precision.png")
         (tmp / "speedups.txt").write_text("\n".join(speedup_lines(result)) + "\n")

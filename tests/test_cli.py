@@ -7,6 +7,8 @@ import sys
 import pytest
 from pathlib import Path
 
+from drake_dock.output import MARKER, atomic_directory
+
 EXE = [sys.executable, "-m", "drake_dock.cli"]
 
 
@@ -34,13 +36,13 @@ def test_bad_input_exits_2_and_leaves_previous_output(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("bodies: {chaser: {mass: -1.0}}\n")
     out = tmp_path / "out"
-    out.mkdir()
-    (out / "keep.txt").write_text("previous")
+    with atomic_directory(out) as tmp:                 # a previous drake_dock output
+        (tmp / "keep.txt").write_text("previous")
     r = _run(["run", str(bad), "--out", str(out)])
     assert r.returncode == 2
     assert "bodies.chaser.mass" in r.stderr
     assert (out / "keep.txt").read_text() == "previous"
-    assert sorted(os.listdir(out)) == ["keep.txt"]
+    assert sorted(os.listdir(out)) == [MARKER, "keep.txt"]
     r = _run(["run", str(tmp_path / "nope.yaml"), "--out", str(tmp_path / "new")])
     assert r.returncode == 2 and not (tmp_path / "new").exists()
     assert "nope.yaml" in r.stderr
@@ -48,6 +50,9 @@ def test_bad_input_exits_2_and_leaves_previous_output(tmp_path):
 
 BAD = {
     "interpenetration": ("initial: {approach_travel: -0.01}\n", "initial.approach_travel"),
+    "zero closing speed": ("initial: {chaser_speed: 0}\n", "initial.chaser_speed"),
+    "capture beyond the start": ("simulation: {capture_distance: 0.2}\n",
+                                 "simulation.capture_distance"),
     "nan": ("initial: {chaser_speed: .nan}\n", "initial.chaser_speed"),
     "negative mass": ("bodies: {target: {mass: -5.0}}\n", "bodies.target.mass"),
     "unknown key": ("contact: {friction: 0.2}\n", "contact.friction"),
@@ -79,4 +84,14 @@ def test_unreadable_file_exit_2(tmp_path):
     r = _run(["run", str(target), "--out", str(out), "--no-progress"])
     assert r.returncode == 2
     assert "scenario file" in r.stderr and "Traceback" not in r.stderr
+    assert not out.exists()
+
+
+def test_binary_scenario_file_exit_2(tmp_path):
+    bad = tmp_path / "scenario.yaml"
+    bad.write_bytes(bytes(range(256)) * 4)
+    out = tmp_path / "out"
+    r = _run(["run", str(bad), "--out", str(out), "--no-progress"])
+    assert r.returncode == 2, r.stderr
+    assert "scenario file" in r.stderr and "UTF-8" in r.stderr and "Traceback" not in r.stderr
     assert not out.exists()

@@ -95,3 +95,58 @@ def test_paper_example_loads_tables():
     assert (s.bodies.chaser.mass, s.bodies.target.mass, s.bodies.target_apds.mass) == \
         (7600.0, 1000.0, 150.0)
     assert s.stewart.force_stiffness == [938.0, 71400.0, 947.0]
+
+
+# Physical consistency -----------------------------------------------------------------------
+# case: (scenario, the field named, what else the message names)
+PHYSICAL = {
+    "static friction below sliding": ("contact: {mu: 0.3, mu_s: 0.1}", "contact.mu_s",
+                                      "contact.mu = 0.3"),
+    "no closing speed": ("initial: {chaser_speed: 0.0}", "initial.chaser_speed", "> 0 m/s"),
+    "chaser moving away": ("initial: {chaser_speed: -1.0}", "initial.chaser_speed", "> 0 m/s"),
+    "chaser APDS at its mass centre": ("chaser_apds_offset: [0.0, 0.0, 0.0]",
+                                       "chaser_apds_offset[2]", "chaser body"),
+    "chaser APDS behind its mass centre": ("chaser_apds_offset: [0.5, 0.0, -1.0]",
+                                           "chaser_apds_offset[2]", "chaser body"),
+    "target APDS behind the target": ("stewart: {p_TA: [0.0, 0.0, -5.03]}", "stewart.p_TA[2]",
+                                      "target body"),
+    "more steps than a run can take": ("simulation: {max_step: 1.0e-12}", "simulation.max_step",
+                                       "simulation.duration"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(PHYSICAL))
+def test_physically_inconsistent(case):
+    data, field, named = PHYSICAL[case]
+    assert named in str(_fails(data, field))
+
+
+def test_target_apds_near_its_mass_centre_builds():
+    """p_TA z in (0, 1] m is valid (the target's display hull used to refuse it)."""
+    from drake_dock.docking.diagram import build_docking_diagram
+    build_docking_diagram(load_scenario(data="stewart: {p_TA: [0.0, 0.0, 0.5]}"))
+
+
+def test_binary_file(tmp_path):
+    f = tmp_path / "scenario.yaml"
+    f.write_bytes(b"\x89PNG\r\n\x1a\n\xff\xfe")
+    with pytest.raises(InputError) as e:
+        load_scenario(f)
+    assert e.value.field == "scenario file" and "UTF-8" in str(e.value)
+
+
+@pytest.mark.parametrize("beyond", [0.0, 0.1])
+def test_capture_distance_at_or_beyond_the_start(beyond):
+    """The initial ring distance is the first-contact distance plus the approach travel; a
+    capture distance at or beyond it is refused when the chaser is placed, before simulating,
+    naming both fields."""
+    from drake_dock.docking.scene import first_contact_distance, initial_state
+    s = load_scenario()
+    d_c, _ = first_contact_distance(s.geometry, s.initial.target_yaw_deg)
+    s.simulation.capture_distance = d_c + s.initial.approach_travel + beyond
+    with pytest.raises(InputError) as e:
+        initial_state(s)
+    assert e.value.field == "simulation.capture_distance"
+    assert "initial.approach_travel" in str(e.value)
+    s.simulation.capture_distance = 0.99 * (d_c + s.initial.approach_travel)
+    assert initial_state(s).d0 == d_c + s.initial.approach_travel

@@ -131,6 +131,8 @@ def test_quick_study_writes_figures_and_lines(quick):
                    .splitlines())
     assert "(d) grazing: impacts detected for delta < 0 only: True" in stdout
     assert "(e) Zeno guard: impact counts equal the closed form: True" in stdout
+    marker = json.loads((out / ".drake_dock_output").read_text())   # a study output too
+    assert marker["kind"] == "study stability" and "stability.json" in marker["entries"]
 
 
 def test_step_size_drake_dock_smooth_at_every_output_step(quick):

@@ -1,5 +1,6 @@
 """The compliant baseline scene and `drake-dock study speed-accuracy --quick`."""
 import csv
+import json
 import math
 import re
 import subprocess
@@ -97,6 +98,7 @@ def quick_study(tmp_path_factory):
                         "--quick", "--out", str(out)], capture_output=True, text=True,
                        timeout=900)
     assert p.returncode == 0, p.stderr
+    assert "points.csv" in json.loads((out / ".drake_dock_output").read_text())["entries"]
     with open(out / "points.csv") as f:
         rows = list(csv.DictReader(f))
     return p.stdout, rows, out

@@ -98,9 +98,12 @@ def _populate(plant, scene_graph, scenario, collision=None) -> DockingPlant:
             np.array(scenario.chaser_apds_offset)), mesh, "chaser_apds_visual",
             np.array(_COLORS["chaser_apds"]))
         # Spacecraft hulls, for orientation only (not contact geometry).
-        c = float(st.p_TA[2])
-        plant.RegisterVisualGeometry(bodies["target"], RigidTransform([0, 0, (c - 1.0) / 2 - 1.0]),
-                                     Cylinder(1.2, c - 1.0), "target_hull",
+        # The target's runs from 1 m behind its mass centre to 2 m behind its APDS (0.5 m long
+        # when the APDS is within 1 m of the mass centre).
+        length = float(st.p_TA[2]) - 1.0
+        length = length if length > 0 else 0.5
+        plant.RegisterVisualGeometry(bodies["target"], RigidTransform([0, 0, length / 2 - 1.0]),
+                                     Cylinder(1.2, length), "target_hull",
                                      np.array(_COLORS["target"]))
         off = float(scenario.chaser_apds_offset[2])
         plant.RegisterVisualGeometry(bodies["chaser"], RigidTransform([0, 0, off - 1.0 - 1.5]),

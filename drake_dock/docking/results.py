@@ -92,6 +92,17 @@ def momentum_reference_point(scenario, ts) -> np.ndarray:
     return ts["p_WA"][0, 0] + scenario.geometry.R * ts["R_WA"][0, 0][:, 0]
 
 
+def _relative(value, scale):
+    """value / scale; None (null in summary.json) when the scale is zero (a chaser so slow
+    that its kinetic energy underflows): the ratio is undefined, not NaN."""
+    return float(value / scale) if scale > 0 else None
+
+
+def relative_text(x, spec=".2e") -> str:
+    """A relative quantity of the summary as text ("undefined" for None)."""
+    return "undefined" if x is None else format(x, spec)
+
+
 def energy_ledger(ts: dict) -> dict:
     """kinetic + Stewart potential + dissipated (damper, friction, impacts) - input work must
     equal the initial total; closure is the largest |residual| over the run relative to it."""
@@ -105,7 +116,7 @@ def energy_ledger(ts: dict) -> dict:
             "stewart_potential_J": float(pe[-1]), "dissipated_damper_J": float(damper[-1]),
             "dissipated_friction_J": float(friction[-1]),
             "dissipated_impacts_J": float(impacts[-1]), "input_work_J": float(inputs[-1]),
-            "closure_error_relative": float(np.abs(residual).max() / abs(total0))}
+            "closure_error_relative": _relative(np.abs(residual).max(), abs(total0))}
 
 
 def summary(result, ts: dict) -> dict:
@@ -130,8 +141,8 @@ def summary(result, ts: dict) -> dict:
         "peak_contact_force_couple": (str(ts["couple_names"][k_peak[1]]) if peak > 0 else None),
         "peak_contact_force_time_s": (float(ts["t"][k_peak[0]]) if peak > 0 else None),
         "momentum_drift_relative": {
-            "linear": float(np.linalg.norm(P - P[0], axis=1).max() / sP),
-            "angular": float(np.linalg.norm(L - L[0], axis=1).max() / sL)},
+            "linear": _relative(np.linalg.norm(P - P[0], axis=1).max(), sP),
+            "angular": _relative(np.linalg.norm(L - L[0], axis=1).max(), sL)},
         "energy_ledger": energy_ledger(ts),
         "first_contact_ring_distance_m": result.initial.d_contact,
         "initial_ring_distance_m": result.initial.d0,

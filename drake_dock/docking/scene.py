@@ -3,6 +3,7 @@ and 8.1, the facing of the two APDSes and the initial configuration of Sect. 8.2
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -94,12 +95,23 @@ def _gaps_at(pairs, yaw, d, refs):
     return np.array(out), dirs
 
 
-def first_contact_distance(g: ApdsGeometry, yaw_deg: float, *, step=1e-2, xtol=1e-13):
+def first_contact_distance(g: ApdsGeometry, yaw_deg: float, *, step=None, xtol=1e-13):
     """Ring-face distance d at which the first of the 12 pairs closes when the chaser moves
-    along the axis from far away; returns (d, names of the pairs that close at d within 1e-9)."""
+    along the axis from far away; returns (d, names of the pairs that close at d within 1e-9).
+    The search steps by 1 cm, or by 1/100 of its start distance for a larger APDS (H > 0.475 m),
+    so that it takes at most about 100 steps. Remembered per geometry and yaw (a pure
+    function of them)."""
+    d_c, names = _first_contact(dataclasses.astuple(g), float(yaw_deg), step, xtol)
+    return d_c, list(names)
+
+
+@functools.lru_cache(maxsize=64)
+def _first_contact(geometry: tuple, yaw_deg: float, step, xtol):
+    g = ApdsGeometry(*geometry)
     pairs = apds_pairs(g)
     yaw = math.radians(yaw_deg)
     d = 2.0 * g.H + 0.05   # petals do not overlap axially: every pair is apart
+    step = max(1e-2, d / 100) if step is None else step
     gaps, refs = _gaps_at(pairs, yaw, d, [None] * len(pairs))
     while d > 0:
         d_lo = d - step
@@ -112,7 +124,7 @@ def first_contact_distance(g: ApdsGeometry, yaw_deg: float, *, step=1e-2, xtol=1
                     return _gaps_at([pairs[j]], yaw, dd, [refs[j]])[0][0]
                 roots[pairs[j].name] = brentq(f, d_lo, d, xtol=xtol, rtol=1e-15)
             d_c = max(roots.values())
-            return d_c, sorted(n for n, r in roots.items() if r >= d_c - 1e-9)
+            return d_c, tuple(sorted(n for n, r in roots.items() if r >= d_c - 1e-9))
         d, gaps, refs = d_lo, gaps_lo, refs_lo
     raise NumericalError(f"no pair closes for yaw = {yaw_deg} deg")
 
@@ -131,7 +143,8 @@ class InitialState:
 def initial_state(scenario) -> InitialState:
     """Sect. 8.2 (docs/model.md): the target at the origin turned by yaw about its docking axis,
     its APDS at the Stewart element's equilibrium, the chaser coaxial at ring-face distance
-    d_contact + approach_travel, moving at chaser_speed towards the target; all else at rest."""
+    d_contact + approach_travel, moving at chaser_speed towards the target; all else at rest.
+    Raises `InputError` for a capture distance not below that initial ring distance."""
     ic = scenario.initial
     g = scenario.geometry
     if ic.approach_travel < 0:
@@ -139,6 +152,13 @@ def initial_state(scenario) -> InitialState:
                          ">= 0 m (a negative travel means initial interpenetration)")
     d_c, closing = first_contact_distance(g, ic.target_yaw_deg)
     d0 = d_c + ic.approach_travel
+    cap = scenario.simulation.capture_distance
+    if not cap < d0:
+        raise InputError("simulation.capture_distance", cap,
+                         f"< the initial ring distance {d0:.6g} m (first contact at {d_c:.6g} m "
+                         f"+ initial.approach_travel {ic.approach_travel:g} m)",
+                         "capture would hold from t = 0 and never be detected: the rings would "
+                         "pass through each other")
     yaw = math.radians(ic.target_yaw_deg)
     R_WT, p_WT = rot_z(yaw), np.zeros(3)
     p_TA = np.asarray(scenario.stewart.p_TA, dtype=float)

@@ -12,6 +12,7 @@ value; the step is capped at ``simulation.max_step``.
 """
 from __future__ import annotations
 
+import contextlib
 import copy
 import dataclasses
 import time as _time
@@ -20,10 +21,11 @@ import numpy as np
 from pydrake.systems.analysis import (ApplySimulatorConfig, Simulator, SimulatorConfig,
                                       SimulatorStatus)
 
-from drake_dock.contact_system import COUPLE_OUTPUT_SIZE, ContactModes
+from drake_dock.contact_system import COUPLE_OUTPUT_SIZE, FAR, ContactModes
 from drake_dock.docking.diagram import DockingDiagram, build_docking_diagram
 from drake_dock.docking.plant import set_initial_state
 from drake_dock.docking.scene import InitialState, initial_state
+from drake_dock.errors import DrakeDockError, NumericalError
 from drake_dock.stepping import WitnessApproach
 
 STEP, PRE_IMPACT, POST_IMPACT = 0, 1, 2
@@ -119,16 +121,45 @@ class _Recorder:
         self._append(s, POST_IMPACT)
 
 
+@contextlib.contextmanager
+def _numerical_failure(what: str, where):
+    """Any failure but drake_dock's typed errors becomes a `NumericalError` at ``where() ->
+    (time, couples)``, naming the exception: Drake's integrator (a step below its minimum,
+    ...), the arithmetic of extreme values (overflow, NaN: Drake refuses non-finite states; a
+    C++ failure inside a Python callback arrives as SystemExit carrying its message)."""
+    try:
+        yield
+    except DrakeDockError:
+        raise
+    except (Exception, SystemExit) as e:
+        if isinstance(e, SystemExit) and not isinstance(e.code, str):
+            raise
+        time, couples = where()
+        raise NumericalError(f"{what} failed ({type(e).__name__}: {e})", time=time,
+                             couples=couples) from e
+
+
+def _couples_in_play(dd: DockingDiagram, root) -> list:
+    """The pairs tracked or in contact (not far) in the root context's state."""
+    try:
+        modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
+        return [p.name for p, st in zip(dd.contact.pairs, modes.pairs) if st.status != FAR]
+    except Exception:  # noqa: BLE001 - only a detail of an error report
+        return []
+
+
 def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram | None = None,
              progress=None, duration: float | None = None,
              witness_approach: bool = True) -> RunResult:
     """Builds (unless ``dd`` is given) and runs the scenario; ``progress(t, t_end)`` is called
-    after each step. Raises the contact system's typed errors (`NumericalError`).
+    after each step. Raises the contact system's typed errors (`NumericalError`), and any other
+    failure of the integration as a `NumericalError` with the time and the couples in play.
     ``witness_approach`` shortens the steps before predicted witness zeros
     (`drake_dock.stepping.WitnessApproach`); off, Drake's plain isolation is used."""
-    state = state or initial_state(scenario)
-    dd = dd or build_docking_diagram(scenario)
-    sim = make_simulator(dd, scenario, state)
+    with _numerical_failure("the initial placement", lambda: (0.0, ())):
+        state = state or initial_state(scenario)
+        dd = dd or build_docking_diagram(scenario)
+        sim = make_simulator(dd, scenario, state)
     rec = _Recorder(dd)
     t_end = scenario.simulation.duration if duration is None else duration
 
@@ -148,11 +179,13 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
     evals0 = dd.contact.evaluations
     dd.contact.timing.reset()
     wall0 = _time.perf_counter()
-    sim.Initialize()
     root = sim.get_context()
-    rec.sample(root)
-    sim.set_monitor(monitor)
-    status = sim.AdvanceTo(t_end)
+    with _numerical_failure("the simulation",
+                            lambda: (root.get_time(), _couples_in_play(dd, root))):
+        sim.Initialize()
+        rec.sample(root)
+        sim.set_monitor(monitor)
+        status = sim.AdvanceTo(t_end)
     wall = _time.perf_counter() - wall0
     rec.sample(root)
     captured = status.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition
