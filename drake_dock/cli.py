@@ -14,6 +14,7 @@ import sys
 import textwrap
 import warnings
 
+from drake_dock import __version__
 from drake_dock.errors import DrakeDockError, InputError
 from drake_dock.scenario import PAPER_EXAMPLE
 
@@ -59,6 +60,7 @@ def _error(kind, e) -> str:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="drake-dock", description=__doc__.splitlines()[0])
+    parser.add_argument("--version", action="version", version=f"drake-dock {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     run_p = sub.add_parser("run", help="simulate a docking scenario and write its outputs")
     run_p.add_argument("scenario", nargs="?", default=str(PAPER_EXAMPLE),
