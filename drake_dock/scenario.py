@@ -67,13 +67,24 @@ class ContactParams:
 
 @dataclasses.dataclass
 class InitialCondition:
-    """Sect. 8.2: coaxial APDSes with matched petals, the target (with its APDS) turned by
-    target_yaw_deg about the axis, the chaser placed so that it travels approach_travel along the
-    axis before the first couple closes, moving at chaser_speed towards the target."""
+    """The initial contact conditions, in the target APDS frame (z: the docking axis, towards
+    the chaser). Sect. 8.2 is the default: coaxial APDSes with matched petals, the target (with
+    its APDS) turned by target_yaw_deg (the relative roll) about the axis, the chaser moving at
+    chaser_speed towards the target. The misalignment is the chaser's at first contact:
+    lateral_offset (m) of its ring centre from the docking axis, tilt_deg (deg) its rotation
+    through its ring centre as a rotation vector in the x-y plane; lateral_velocity (m/s) of its
+    ring centre and angular_velocity_deg_s (deg/s) of the chaser add to the closing speed. The
+    chaser starts approach_travel (m) back along its straight relative motion from the pose at
+    which the first couple closes (docs/model.md, "Initial conditions")."""
 
     target_yaw_deg: float = 5.0
     approach_travel: float = 0.01
     chaser_speed: float = 1.0
+    lateral_offset: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0])
+    tilt_deg: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0])
+    lateral_velocity: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0])
+    angular_velocity_deg_s: list[float] = dataclasses.field(
+        default_factory=lambda: [0.0, 0.0, 0.0])
 
 
 @dataclasses.dataclass
@@ -89,6 +100,9 @@ class SimulationParams:
     integration_scheme: str = "bogacki_shampine3"
 
 
+MAX_TILT_DEG = 30.0        # initial.tilt_deg: beyond it the petals no longer guide the rings
+MAX_LATERAL_SPEED = 1.0    # initial.lateral_velocity (m/s)
+MAX_RATE_DEG_S = 90.0      # initial.angular_velocity_deg_s
 MAX_STEPS = 1e6      # simulation.duration / simulation.max_step: a run that can end
 INTEGRATION_SCHEMES = ("bogacki_shampine3", "runge_kutta3", "runge_kutta5")
 
@@ -212,6 +226,14 @@ def validate(s: Scenario) -> Scenario:
     if _finite("initial.chaser_speed", ic.chaser_speed) <= 0:
         raise InputError("initial.chaser_speed", ic.chaser_speed,
                          "> 0 m/s (the closing speed towards the target)")
+    for name, n, limit, allowed in (
+            ("lateral_offset", 2, s.geometry.R, f"|offset| < the ring radius R = {s.geometry.R} m"),
+            ("tilt_deg", 2, MAX_TILT_DEG, f"|tilt| < {MAX_TILT_DEG:g} deg"),
+            ("lateral_velocity", 2, MAX_LATERAL_SPEED, f"|v| < {MAX_LATERAL_SPEED:g} m/s"),
+            ("angular_velocity_deg_s", 3, MAX_RATE_DEG_S, f"|w| < {MAX_RATE_DEG_S:g} deg/s")):
+        value = getattr(ic, name)
+        if not math.hypot(*_vector(f"initial.{name}", value, n)) < limit:
+            raise InputError(f"initial.{name}", value, allowed)
     _positive("simulation.duration", s.simulation.duration)
     if not 0 < _finite("simulation.accuracy", s.simulation.accuracy) < 1:
         raise InputError("simulation.accuracy", s.simulation.accuracy, "0 < accuracy < 1")

@@ -69,18 +69,55 @@ def relative_pose(yaw_rad: float, d: float):
     return rot_z(-yaw_rad) @ R_MATCHED, np.array([0.0, 0.0, d])
 
 
+def rot_vec(r):
+    """Rotation matrix of the rotation vector r (Rodrigues)."""
+    r = np.asarray(r, dtype=float)
+    a = float(np.linalg.norm(r))
+    if a == 0.0:
+        return np.eye(3)
+    k = r / a
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + math.sin(a) * K + (1.0 - math.cos(a)) * (K @ K)
+
+
+@dataclasses.dataclass(frozen=True)
+class Approach:
+    """A straight relative approach of the chaser APDS in the target APDS frame: turned by
+    yaw about the axis and tilted by the rotation vector ``tilt`` (rad, x-y plane, through its
+    ring centre) from the matched facing; its ring centre on the line aim - lam * direction,
+    where ``direction`` is the unit relative velocity (z < 0) and ``aim`` lies in the target's
+    ring-face plane. Coaxial along the axis: lam is the ring-face distance."""
+
+    yaw: float
+    tilt: tuple = (0.0, 0.0)
+    aim: tuple = (0.0, 0.0)
+    direction: tuple = (0.0, 0.0, -1.0)
+
+    def pose(self, lam: float):
+        R, p = relative_pose(self.yaw, lam)
+        if self.tilt != (0.0, 0.0):
+            R = rot_vec((*self.tilt, 0.0)) @ R
+        if self.aim != (0.0, 0.0) or self.direction != (0.0, 0.0, -1.0):
+            p = np.array([*self.aim, 0.0]) - lam * np.asarray(self.direction)
+        return R, p
+
+    def height(self, lam: float) -> float:
+        """Ring-face distance along the axis at lam."""
+        return -lam * self.direction[2]
+
+
 def pair_couples(pairs, poses, **grid):
     """Seeks the closest couple of every pair; ``poses`` maps body name -> (R_WB, p_WB)."""
     return [seek_couple(posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2]),
                         **grid) for pr in pairs]
 
 
-def _gaps_at(pairs, yaw, d, refs):
+def _gaps_at(pairs, approach, d, refs):
     """Signed gaps of the pairs at ring-face distance d. A pair is a potential contact only
     while its couple is interior (see `is_interior`); otherwise its gap is +inf and its side
     reference is dropped. The sign is fixed by the side the couple lies on when the pair becomes
     potential (docs/model.md) and continued from ``refs`` (the previous unit directions)."""
-    R, p = relative_pose(yaw, d)
+    R, p = approach.pose(d)
     poses = {TARGET_APDS: (np.eye(3), np.zeros(3)), CHASER_APDS: (R, p)}
     out, dirs = [], []
     for cp, ref in zip(pair_couples(pairs, poses), refs):
@@ -97,36 +134,42 @@ def _gaps_at(pairs, yaw, d, refs):
 
 def first_contact_distance(g: ApdsGeometry, yaw_deg: float, *, step=None, xtol=1e-13):
     """Ring-face distance d at which the first of the 12 pairs closes when the chaser moves
-    along the axis from far away; returns (d, names of the pairs that close at d within 1e-9).
-    The search steps by 1 cm, or by 1/100 of its start distance for a larger APDS (H > 0.475 m),
-    so that it takes at most about 100 steps. Remembered per geometry and yaw (a pure
-    function of them)."""
-    d_c, names = _first_contact(dataclasses.astuple(g), float(yaw_deg), step, xtol)
-    return d_c, list(names)
+    along the axis from far away; returns (d, names of the pairs that close at d within 1e-9)."""
+    return first_contact(g, Approach(math.radians(yaw_deg)), step=step, xtol=xtol)
+
+
+def first_contact(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13):
+    """Line parameter lam at which the first of the pairs closes when the chaser comes along
+    ``approach`` from far away; returns (lam, names of the pairs that close within 1e-9). The
+    search steps the ring-face distance by 1 cm, or by 1/100 of its start distance for a larger
+    APDS (H > 0.475 m), so that it takes at most about 100 steps. Remembered per geometry and
+    approach (a pure function of them)."""
+    lam_c, names = _first_contact(dataclasses.astuple(g), approach, step, xtol)
+    return lam_c, list(names)
 
 
 @functools.lru_cache(maxsize=64)
-def _first_contact(geometry: tuple, yaw_deg: float, step, xtol):
+def _first_contact(geometry: tuple, approach: Approach, step, xtol):
     g = ApdsGeometry(*geometry)
     pairs = apds_pairs(g)
-    yaw = math.radians(yaw_deg)
-    d = 2.0 * g.H + 0.05   # petals do not overlap axially: every pair is apart
-    step = max(1e-2, d / 100) if step is None else step
-    gaps, refs = _gaps_at(pairs, yaw, d, [None] * len(pairs))
-    while d > 0:
+    per_height = 1.0 / approach.height(1.0)
+    d = (2.0 * g.H + 0.05) * per_height   # petals do not overlap axially: every pair is apart
+    step = max(1e-2, (2.0 * g.H + 0.05) / 100) * per_height if step is None else step
+    gaps, refs = _gaps_at(pairs, approach, d, [None] * len(pairs))
+    while approach.height(d) > -g.H:
         d_lo = d - step
-        gaps_lo, refs_lo = _gaps_at(pairs, yaw, d_lo, refs)
+        gaps_lo, refs_lo = _gaps_at(pairs, approach, d_lo, refs)
         closing = np.flatnonzero((gaps_lo <= 0) & np.isfinite(gaps))
         if closing.size:
             roots = {}
             for j in closing:
                 def f(dd, j=j):
-                    return _gaps_at([pairs[j]], yaw, dd, [refs[j]])[0][0]
+                    return _gaps_at([pairs[j]], approach, dd, [refs[j]])[0][0]
                 roots[pairs[j].name] = brentq(f, d_lo, d, xtol=xtol, rtol=1e-15)
             d_c = max(roots.values())
             return d_c, tuple(sorted(n for n, r in roots.items() if r >= d_c - 1e-9))
         d, gaps, refs = d_lo, gaps_lo, refs_lo
-    raise NumericalError(f"no pair closes for yaw = {yaw_deg} deg")
+    raise NumericalError(f"no pair closes on the approach {approach}")
 
 
 @dataclasses.dataclass
@@ -150,7 +193,7 @@ def initial_state(scenario) -> InitialState:
     if ic.approach_travel < 0:
         raise InputError("initial.approach_travel", ic.approach_travel,
                          ">= 0 m (a negative travel means initial interpenetration)")
-    d_c, closing = first_contact_distance(g, ic.target_yaw_deg)
+    approach, d_c, closing = contact_approach(scenario)
     d0 = d_c + ic.approach_travel
     cap = scenario.simulation.capture_distance
     if not cap < d0:
@@ -163,15 +206,52 @@ def initial_state(scenario) -> InitialState:
     R_WT, p_WT = rot_z(yaw), np.zeros(3)
     p_TA = np.asarray(scenario.stewart.p_TA, dtype=float)
     R_WA, p_WA = R_WT, p_WT + R_WT @ p_TA
-    R_AC, p_AC = relative_pose(yaw, d0)
+    R_AC, p_AC = approach.pose(d0)
     R_WCA, p_WCA = R_WA @ R_AC, p_WA + R_WA @ p_AC
     # Chaser body: its APDS frame sits at chaser_apds_offset in the body frame, same axes.
     p_C_CA = np.asarray(scenario.chaser_apds_offset, dtype=float)
     R_WC, p_WC = R_WCA, p_WCA - R_WCA @ p_C_CA
-    axis = R_WA[:, 2]
     zero = np.zeros(3)
+    if ic.lateral_velocity == [0.0, 0.0] and ic.angular_velocity_deg_s == [0.0, 0.0, 0.0]:
+        w_WC, v_WC = zero, -ic.chaser_speed * R_WA[:, 2]
+    else:
+        # The ring centre moves at (lateral_velocity, -chaser_speed); the chaser's mass centre
+        # adds w x (p_WC - p_WCA).
+        w_WC = R_WA @ np.radians(ic.angular_velocity_deg_s)
+        v_ring = R_WA @ np.array([*ic.lateral_velocity, -ic.chaser_speed])
+        v_WC = v_ring + np.cross(w_WC, p_WC - p_WCA)
     return InitialState(
         X_WB={"target": (R_WT, p_WT), "target_apds": (R_WA, p_WA), "chaser": (R_WC, p_WC)},
-        V_WB={"target": (zero, zero), "target_apds": (zero, zero),
-              "chaser": (zero, -ic.chaser_speed * axis)},
+        V_WB={"target": (zero, zero), "target_apds": (zero, zero), "chaser": (w_WC, v_WC)},
         d_contact=d_c, d0=d0, closing_pairs=closing)
+
+
+def contact_approach(scenario):
+    """The scenario's straight approach and its first contact: (Approach, lam_c, closing
+    pairs). The lateral offset is the ring centre's at first contact. With a lateral velocity
+    the aim point (where the path meets the target's ring-face plane) is
+    aim = offset + s v_lateral / chaser_speed, where s, the ring-face distance at contact, solves
+    s = h_c(aim(s)) (brentq to 1e-10 m)."""
+    ic = scenario.initial
+    g = scenario.geometry
+    yaw = math.radians(ic.target_yaw_deg)
+    tilt = tuple(math.radians(t) for t in ic.tilt_deg)
+    v = np.array([*ic.lateral_velocity, -ic.chaser_speed])
+    direction = tuple((v / np.linalg.norm(v)).tolist()) if v[0] or v[1] else (0.0, 0.0, -1.0)
+    offset = np.array(ic.lateral_offset, dtype=float)
+    slope = np.array(ic.lateral_velocity) / ic.chaser_speed
+
+    def approach(s):
+        return Approach(yaw, tilt, tuple((offset + s * slope).tolist()), direction)
+
+    def mismatch(s):
+        a = approach(s)
+        return a.height(first_contact(g, a)[0]) - s
+
+    s = 0.0
+    if slope.any():
+        s_max = 2.0 * g.H + 0.05           # no pair is closed above this ring-face distance
+        s = brentq(mismatch, 0.0, s_max, xtol=1e-10)
+    a = approach(s)
+    lam_c, closing = first_contact(g, a)
+    return a, lam_c, closing
