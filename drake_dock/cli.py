@@ -23,13 +23,16 @@ class ProgressBar:
     """A text progress bar on a stream (stderr): redrawn in place on a terminal, otherwise
     printed at every tenth of the run."""
 
-    def __init__(self, stream=sys.stderr, width=40):
-        self.stream, self.width = stream, width
-        self.tty = hasattr(stream, "isatty") and stream.isatty()
+    def __init__(self, stream=None, width=40):
+        self.stream, self.width = stream or sys.stderr, width
+        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
         self.last = -1
 
-    def __call__(self, t, t_end):
-        frac = min(max(t / t_end, 0.0), 1.0)
+    def __call__(self, t, t_end, fraction=None):
+        """``fraction``: how far the run is (the rings' way towards capture or the time
+        towards the timeout, `drake_dock.docking.outcome.progress_fraction`); t / t_end if
+        not given."""
+        frac = min(max(t / t_end if fraction is None else fraction, 0.0), 1.0)
         step = int(frac * (100 if self.tty else 10))
         if step == self.last:
             return

@@ -80,12 +80,13 @@ def run(scenario, out_dir, *, progress=None, state=None) -> dict:
 
 
 def format_summary(s) -> str:
-    cap = (f"captured at t = {s['capture_time_s']:.6f} s" if s["captured"]
-           else f"not captured by t = {s['end_time_s']:.6f} s")
+    fm = s["final_misalignment"]
     led = s["energy_ledger"]
     md = s["momentum_drift_relative"]
     return "\n".join([
-        f"{cap} (axial ring-centre distance <= {s['capture_distance_m']} m)",
+        f"{s['outcome']} at t = {s['end_time_s']:.6f} s ({s['outcome_reason']}); final "
+        f"misalignment: axial {fm['axial_m']:.4g} m, lateral {fm['lateral_m']:.3g} m, tilt "
+        f"{fm['tilt_deg']:.3g} deg",
         f"impacts: {s['number_of_impacts']}; peak contact force {s['peak_contact_force_N']:.6g} N;"
         f" largest impulse {s['largest_impulse_Ns']:.6g} N s",
         f"momentum drift (relative): linear {relative_text(md['linear'])}, angular "

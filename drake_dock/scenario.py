@@ -89,7 +89,8 @@ class InitialCondition:
 
 @dataclasses.dataclass
 class SimulationParams:
-    duration: float = 1.0
+    duration: float = 10.0           # the timeout (s): a run ends earlier at a named outcome
+    jam_time: float = 2.0            # s without 1 mm of progress of the rings: "jammed"
     accuracy: float = 1e-6           # integrator error control and witness isolation
     max_step: float = 0.002          # largest integration step (s); also the sample spacing
     capture_distance: float = 0.005  # axial ring-centre distance ending the capture phase (m)
@@ -235,6 +236,7 @@ def validate(s: Scenario) -> Scenario:
         if not math.hypot(*_vector(f"initial.{name}", value, n)) < limit:
             raise InputError(f"initial.{name}", value, allowed)
     _positive("simulation.duration", s.simulation.duration)
+    _positive("simulation.jam_time", s.simulation.jam_time)
     if not 0 < _finite("simulation.accuracy", s.simulation.accuracy) < 1:
         raise InputError("simulation.accuracy", s.simulation.accuracy, "0 < accuracy < 1")
     _positive("simulation.max_step", s.simulation.max_step)

@@ -119,6 +119,19 @@ def energy_ledger(ts: dict) -> dict:
             "closure_error_relative": _relative(np.abs(residual).max(), abs(total0))}
 
 
+def final_misalignment(ts: dict) -> dict:
+    """The chaser ring's pose in the target ring's frame at the end: axial and lateral offset
+    of its centre (m) and the tilt between the two docking axes (deg)."""
+    names = ts["apds_names"].tolist()
+    j_t, j_c = names.index("target_apds"), names.index("chaser_apds")
+    R_t, p_t = ts["R_WA"][-1, j_t], ts["p_WA"][-1, j_t]
+    R_c, p_c = ts["R_WA"][-1, j_c], ts["p_WA"][-1, j_c]
+    r = R_t.T @ (p_c - p_t)
+    cos_tilt = float(np.clip(-(R_t[:, 2] @ R_c[:, 2]), -1.0, 1.0))
+    return {"axial_m": float(r[2]), "lateral_m": float(np.hypot(r[0], r[1])),
+            "tilt_deg": float(np.degrees(np.arccos(cos_tilt)))}
+
+
 def summary(result, ts: dict) -> dict:
     s = result.scenario
     b = s.bodies
@@ -130,6 +143,9 @@ def summary(result, ts: dict) -> dict:
     peak = float(lam[k_peak]) if k_peak is not None else 0.0
     imp = ts["impact_normal_impulse"]
     return {
+        "outcome": result.outcome,
+        "outcome_reason": result.reason,
+        "final_misalignment": final_misalignment(ts),
         "captured": bool(result.captured),
         "capture_time_s": result.capture_time,
         "capture_distance_m": s.simulation.capture_distance,

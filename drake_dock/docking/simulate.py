@@ -21,8 +21,9 @@ import numpy as np
 from pydrake.systems.analysis import (ApplySimulatorConfig, Simulator, SimulatorConfig,
                                       SimulatorStatus)
 
-from drake_dock.contact_system import COUPLE_OUTPUT_SIZE, FAR, ContactModes
+from drake_dock.contact_system import CONTACT, COUPLE_OUTPUT_SIZE, FAR, ContactModes
 from drake_dock.docking.diagram import DockingDiagram, build_docking_diagram
+from drake_dock.docking.outcome import OutcomeWatch, progress_fraction
 from drake_dock.docking.plant import set_initial_state
 from drake_dock.docking.scene import InitialState, initial_state
 from drake_dock.errors import DrakeDockError, NumericalError
@@ -57,6 +58,8 @@ class RunResult:
     wall_time: float           # seconds in Simulator.Initialize + AdvanceTo (build excluded)
     evaluations: int
     timing: dict | None = None  # `Timing.shares`: seeking / contact dynamics / impacts / other
+    outcome: str = "timeout"   # `drake_dock.docking.outcome.OUTCOMES`
+    reason: str = ""
 
 
 def make_simulator(dd: DockingDiagram, scenario, state: InitialState) -> Simulator:
@@ -151,8 +154,9 @@ def _couples_in_play(dd: DockingDiagram, root) -> list:
 def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram | None = None,
              progress=None, duration: float | None = None,
              witness_approach: bool = True) -> RunResult:
-    """Builds (unless ``dd`` is given) and runs the scenario; ``progress(t, t_end)`` is called
-    after each step. Raises the contact system's typed errors (`NumericalError`), and any other
+    """Builds (unless ``dd`` is given) and runs the scenario until a named outcome
+    (`drake_dock.docking.outcome`), ``simulation.duration`` (or ``duration``) being the timeout;
+    ``progress(t, t_end, fraction)`` is called after each step. Raises the contact system's typed errors (`NumericalError`), and any other
     failure of the integration as a `NumericalError` with the time and the couples in play.
     ``witness_approach`` shortens the steps before predicted witness zeros
     (`drake_dock.stepping.WitnessApproach`); off, Drake's plain isolation is used."""
@@ -167,13 +171,23 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
     approach = WitnessApproach(sim, [dd.contact, dd.capture], sp.max_step,
                                0.01 * sp.accuracy) if witness_approach else None
 
+    watch = None
+    ended = []
+
     def monitor(root):
+        from pydrake.systems.framework import EventStatus
         rec.sample(root)
         if approach is not None:
             approach(root)
+        t = root.get_time()
+        d = dd.capture.distance(dd.capture.GetMyContextFromRoot(root))
         if progress is not None:
-            progress(root.get_time(), t_end)
-        from pydrake.systems.framework import EventStatus
+            progress(t, t_end, progress_fraction(t, t_end, d, watch.d_start, sp.capture_distance))
+        modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
+        end = watch.update(t, d, any(st.status == CONTACT for st in modes.pairs))
+        if end is not None:
+            ended.append(end)
+            return EventStatus.ReachedTermination(dd.capture, end[0])
         return EventStatus.Succeeded()
 
     evals0 = dd.contact.evaluations
@@ -184,15 +198,26 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
                             lambda: (root.get_time(), _couples_in_play(dd, root))):
         sim.Initialize()
         rec.sample(root)
+        watch = OutcomeWatch(dd.capture.distance(dd.capture.GetMyContextFromRoot(root)),
+                             sp.jam_time)
         sim.set_monitor(monitor)
         status = sim.AdvanceTo(t_end)
     wall = _time.perf_counter() - wall0
     rec.sample(root)
-    captured = status.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition
+    terminated = status.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition
+    if ended:
+        outcome, reason = ended[0]
+    elif terminated:
+        outcome, reason = "captured", (f"axial ring-centre distance <= "
+                                       f"{sp.capture_distance:g} m")
+    else:
+        outcome, reason = "timeout", f"simulation.duration {t_end:g} s reached"
+    captured = outcome == "captured"
     modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
     return RunResult(scenario, dd, state, rec.record, list(modes.impacts), modes.mode_changes,
                      captured, root.get_time() if captured else None, root.get_time(), wall,
-                     dd.contact.evaluations - evals0, dd.contact.timing.shares(wall))
+                     dd.contact.evaluations - evals0, dd.contact.timing.shares(wall),
+                     outcome, reason)
 
 
 __all__ = ["simulate", "make_simulator", "RunResult", "Record", "STEP", "PRE_IMPACT",
