@@ -61,7 +61,7 @@ def main():
     t_build = time.perf_counter() - t0
     steps = []
     r = simulate(scenario, state=state, dd=dd,
-                 progress=lambda t, T: steps.append(dd.contact.evaluations))
+                 progress=lambda t, T, frac: steps.append(dd.contact.evaluations))
     de = np.diff([0] + steps)
     iso = int(de[de > 50].sum())
     # The same run again on fresh diagrams: the wall time is the median of the runs (the first
