@@ -997,8 +997,12 @@ class RigidContactSystem(LeafSystem):
             if len(modes.impacts) >= opt.max_impacts:
                 raise ZenoError(f"more than max_impacts = {opt.max_impacts} impacts",
                                 time=t, couples=[self.pairs[i].name for i in hit])
+            # The impact set: the couples hit and those in contact that are not separating
+            # beyond round-off (1e-6 of the approach, the same test as after the impact).
+            closing = -min(evs[i].vn for i in hit)
             S = hit + [i for i, st in enumerate(modes.pairs)
-                       if st.status == CONTACT and evs[i].vn <= 0.0]
+                       if st.status == CONTACT and i not in hit
+                       and evs[i].vn <= 1e-6 * closing]
             rows = [self._row(i, evs[i], poses, ctx) for i in S]
             Wn = np.column_stack([r.Wn for r in rows])
             Wt = np.column_stack([r.Wt for r in rows])
@@ -1035,6 +1039,8 @@ class RigidContactSystem(LeafSystem):
         # Contact set: couples in contact, couples just held by the Zeno guard and resting
         # couples (closed and not moving apart).
         for i, st in enumerate(modes.pairs):
+            if st.status == CONTACT and hit and i not in candidates:
+                st.status, st.stick, st.slide_dir = TRACKED, False, None   # separating
             if (st.status == CONTACT and not (hit and i not in candidates)) or (
                     st.status == TRACKED and evs[i].gap <= opt.impact_gap_tol
                     and abs(evs[i].vn) <= opt.v_slip):
