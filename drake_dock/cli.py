@@ -45,6 +45,13 @@ class ProgressBar:
             self.stream.write(line + "\n")
         self.stream.flush()
 
+    def note(self, text):
+        """A line of its own below the bar (the output writing, say)."""
+        self.close()
+        self.last = -1
+        self.stream.write(text + "\n")
+        self.stream.flush()
+
     def close(self):
         if self.tty and self.last >= 0:
             self.stream.write("\n")

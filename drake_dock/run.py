@@ -52,6 +52,9 @@ def run(scenario, out_dir, *, progress=None, state=None) -> dict:
     `NumericalError` for a failed simulation or a non-finite summary value (nothing written)."""
     check_destination(out_dir)
     result = simulate(scenario, progress=progress, state=state)
+    if hasattr(progress, "note"):
+        progress.note(f"{result.outcome} at t = {result.end_time:.4f} s; writing the outputs "
+                      f"(arrays, figures, replay)")
     ts = timeseries(result)
     summ = summary(result, ts)
     bad = _non_finite(summ)

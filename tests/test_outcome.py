@@ -48,10 +48,16 @@ def test_progress_is_the_further_of_way_and_time():
 
 
 def test_timeout_is_a_named_outcome(tmp_path, capsys):
-    assert main(["run", str(PAPER_EXAMPLE), "--out", str(tmp_path / "o"), "--duration", "0.02",
-                 "--no-progress"]) == 0
+    assert main(["run", str(PAPER_EXAMPLE), "--out", str(tmp_path / "o"), "--duration", "0.02"
+                 ]) == 0
     s = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert s["outcome"] == "timeout" and not s["captured"] and s["end_time_s"] == 0.02
+    # The bar, then the writing of the outputs, then Drake's log lines: none between.
+    lines = capsys.readouterr().err.splitlines()
+    bar = [k for k, line in enumerate(lines) if line.startswith("[")]
+    writing = [k for k, line in enumerate(lines) if "writing the outputs" in line]
+    assert bar and writing == [bar[-1] + 1]
+    assert not any(":drake:" in line for line in lines[:writing[0]])
 
 
 def test_slow_approach_ends_named_with_a_progress_bar_on_the_rings(tmp_path, capsys):
