@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= out/paper_example
 
-.PHONY: demo test bench clean
+.PHONY: demo test test-core bench clean
 
 $(BIN)/.installed: pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -18,6 +18,12 @@ demo: $(BIN)/.installed
 test: $(BIN)/.installed
 	$(BIN)/python -m pytest -q
 
+# tests/core in a virtual environment without Drake (numpy, scipy, pytest, pyyaml only).
+test-core:
+	$(PYTHON) -m venv .venv-core
+	.venv-core/bin/python -m pip install --quiet -c constraints.txt numpy scipy pytest hypothesis pyyaml
+	PYTHONPATH=. .venv-core/bin/python -m pytest -q -p no:cacheprovider tests/core
+
 bench: $(BIN)/.installed
 	$(BIN)/python bench/lzb_chains.py
 	$(BIN)/python bench/contact_eval.py
@@ -26,4 +32,4 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/target_floor.py
 
 clean:
-	rm -rf $(VENV) out
+	rm -rf $(VENV) .venv-core out

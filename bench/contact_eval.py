@@ -11,9 +11,9 @@ import time
 import numpy as np
 from pydrake.systems.analysis import Simulator
 
-from drake_dock.contact_system import STICK
+from drake_dock.systems.contact_system import STICK
 from drake_dock.core.constraints import solve_given_modes
-from drake_dock.small_scenes import stool
+from drake_dock.studies.small_scenes import stool
 
 
 def per_call(fn, repeats):

@@ -1,7 +1,7 @@
 """Work-precision of the LZB solver on ball chains.
 
 For each chain case, prints the error of v_plus against the continuous limit of the chain
-(`drake_dock.lzb_limit`, integrated in time by scipy's DOP853 at rtol 1e-12) and the
+(`drake_dock.core.lzb.limit`, integrated in time by scipy's DOP853 at rtol 1e-12) and the
 wall time (best of several runs, side by side in this run) of
 - `solve_lzb` (adaptive 8th order, located events) at several rtol, and
 - `solve_lzb_fixed_step` (the same equations, explicit Euler in fixed impulse steps dP, phase
@@ -15,9 +15,9 @@ import time
 
 import numpy as np
 
-from drake_dock.impact import check_inputs, per_couple, solve_lzb
-from drake_dock.impact_problem import ImpactProblem
-from drake_dock.lzb_limit import continuous_limit_chain
+from drake_dock.core.lzb.solve import check_inputs, per_couple, solve_lzb
+from drake_dock.core.lzb.problem import ImpactProblem
+from drake_dock.core.lzb.limit import continuous_limit_chain
 
 E_GRID = (0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0)
 

@@ -20,7 +20,7 @@ from drake_dock.docking.diagram import build_docking_diagram
 from drake_dock.docking.plant import add_docking_plant, set_initial_state
 from drake_dock.docking.scene import initial_state
 from drake_dock.docking.simulate import simulate
-from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 
 
 def free_flight(scenario, state, t_end):

@@ -26,12 +26,12 @@ import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 from pydrake.systems.framework import LeafSystem
 
-from drake_dock.docking.compliant import (CompliantConfig, hunt_crossley_dissipation,
+from drake_dock.studies.compliant import (CompliantConfig, hunt_crossley_dissipation,
                                           run_compliant)
 from drake_dock.docking.scene import initial_state
 from drake_dock.docking.simulate import simulate
-from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.study import METRICS, rigid_metrics
+from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.studies.speed_accuracy import METRICS, rigid_metrics
 
 sys.path.insert(0, str(Path(__file__).parent))
 from paper_example import free_flight  # noqa: E402  (a sibling bench script)

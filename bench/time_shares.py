@@ -10,8 +10,8 @@ import time
 import numpy as np
 
 from drake_dock.run import time_shares_line
-from drake_dock.small_scenes import G, disk_on_incline, stool
-from drake_dock.stability import SmallRun
+from drake_dock.studies.small_scenes import G, disk_on_incline, stool
+from drake_dock.studies.stability import SmallRun
 
 
 def small(name, sc, X, V, t_end):
@@ -25,7 +25,7 @@ def small(name, sc, X, V, t_end):
 
 def main():
     from drake_dock.docking.simulate import simulate
-    from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
     r = simulate(load_scenario(PAPER_EXAMPLE))
     print(f"paper example (12 pairs): {time_shares_line(r.timing)}; wall {r.wall_time:.3f} s")
     sc = stool()

@@ -1,7 +1,14 @@
 """drake_dock: capture-phase docking contact between two APDS-equipped spacecraft, after Zhao,
 Liu and Chen (2016), on Drake.
 
-Generic mathematics lives in `drake_dock.core` (no Drake) and `drake_dock.impact` (LZB, plain
-numpy); the docking scene in `drake_dock.docking`; the Drake boundary in `drake_dock.run`.
+Layers, each importing only the ones below it:
+- `drake_dock.core`: the paper's mathematics (patches, seeking, couples, constraints, the hybrid
+  rules of a pair, LZB in `core.lzb`); numpy and scipy only.
+- `drake_dock.systems`: the Drake boundary (the contact LeafSystem, the simulator, witness step
+  control).
+- `drake_dock.docking`: the docking scene (scenario, APDS geometry, plant, diagram, outputs).
+- `drake_dock.studies`: small scenes, the compliant baseline, the speed-accuracy and stability
+  studies.
+- `drake_dock.run` and `drake_dock.cli` on top.
 """
 __version__ = "0.1.0"

@@ -5,7 +5,7 @@ range), found before anything is simulated, ``--out`` included; 3 numerical fail
 message names the time and the couples). Any other error is reported in one paragraph too
 (exit 3, "internal error"), never as a traceback. On failure no output directory is written, or
 the previous complete one is left untouched. ``--out`` must be a new path, an empty directory
-or a previous drake_dock output (`drake_dock.output.check_destination`).
+or a previous drake_dock output (`drake_dock.docking.output.check_destination`).
 """
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ import warnings
 
 from drake_dock import __version__
 from drake_dock.errors import DrakeDockError, InputError
-from drake_dock.scenario import PAPER_EXAMPLE
+from drake_dock.docking.scenario import PAPER_EXAMPLE
 
 
 class ProgressBar:
@@ -92,9 +92,9 @@ def main(argv=None) -> int:
     if args.command == "study":
         return _study(args)
     # Imported here so that `--help` stays fast.
-    from drake_dock.output import check_destination
+    from drake_dock.docking.output import check_destination
     from drake_dock.run import format_summary, run
-    from drake_dock.scenario import load_scenario, validate
+    from drake_dock.docking.scenario import load_scenario, validate
     bar = None if args.no_progress else ProgressBar()
 
     def work():
@@ -148,18 +148,18 @@ def _failed(code, kind, e, caught, finish) -> int:
 
 
 def _study(args) -> int:
-    from drake_dock.output import check_destination
-    from drake_dock.scenario import load_scenario
+    from drake_dock.docking.output import check_destination
+    from drake_dock.docking.scenario import load_scenario
     if args.which == "stability":
-        from drake_dock.stability import StabilityPlan as Plan
-        from drake_dock.stability import run_stability as run_plan
-        from drake_dock.stability import summary_lines as lines
-        from drake_dock.stability import write_stability as write
+        from drake_dock.studies.stability import StabilityPlan as Plan
+        from drake_dock.studies.stability import run_stability as run_plan
+        from drake_dock.studies.stability import summary_lines as lines
+        from drake_dock.studies.stability import write_stability as write
     else:
-        from drake_dock.study import StudyPlan as Plan
-        from drake_dock.study import run_study as run_plan
-        from drake_dock.study import speedup_lines as lines
-        from drake_dock.study import write_study as write
+        from drake_dock.studies.speed_accuracy import StudyPlan as Plan
+        from drake_dock.studies.speed_accuracy import run_study as run_plan
+        from drake_dock.studies.speed_accuracy import speedup_lines as lines
+        from drake_dock.studies.speed_accuracy import write_study as write
 
     def work():
         check_destination(args.out)

@@ -2,8 +2,8 @@
 ``timeseries.npz``, ``summary.json``, the figures (PNG) and ``replay.html``.
 
 A failed run (bad input, numerical failure) leaves no directory, or the previous complete one
-untouched (`drake_dock.output.atomic_directory`). The destination is checked before anything is
-simulated (`drake_dock.output.check_destination`): only a new path, an empty directory or a
+untouched (`drake_dock.docking.output.atomic_directory`). The destination is checked before anything is
+simulated (`drake_dock.docking.output.check_destination`): only a new path, an empty directory or a
 previous drake_dock output is replaced.
 """
 from __future__ import annotations
@@ -19,8 +19,8 @@ from drake_dock.docking.results import (momenta, momentum_reference_point, relat
                                         timeseries)
 from drake_dock.docking.simulate import simulate
 from drake_dock.errors import NumericalError
-from drake_dock.figures import initial_configuration_figure, run_figures
-from drake_dock.output import atomic_directory, check_destination
+from drake_dock.docking.figures import initial_configuration_figure, run_figures
+from drake_dock.docking.output import atomic_directory, check_destination
 
 
 def _npz_bytes(arrays: dict) -> bytes:

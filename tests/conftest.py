@@ -1,14 +1,14 @@
+"""Shared fixtures. Imports are inside the fixtures so that tests/core collects without Drake."""
 import pytest
-
-from drake_dock.docking.apds import ApdsGeometry
-from drake_dock.scenario import load_scenario
 
 
 @pytest.fixture(scope="session")
 def paper_scenario():
+    from drake_dock.docking.scenario import load_scenario
     return load_scenario()
 
 
 @pytest.fixture(scope="session")
 def geom():
+    from drake_dock.docking.apds import ApdsGeometry
     return ApdsGeometry().validate()

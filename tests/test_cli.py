@@ -7,7 +7,7 @@ import sys
 import pytest
 from pathlib import Path
 
-from drake_dock.output import MARKER, atomic_directory
+from drake_dock.docking.output import MARKER, atomic_directory
 
 EXE = [sys.executable, "-m", "drake_dock.cli"]
 

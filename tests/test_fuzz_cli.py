@@ -20,8 +20,8 @@ from hypothesis import strategies as st
 
 from drake_dock.cli import main
 from drake_dock.errors import InputError
-from drake_dock.output import MARKER
-from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.output import MARKER
+from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 
 PAPER = yaml.safe_load(PAPER_EXAMPLE.read_text())
 TEXT = yaml.safe_dump(PAPER)          # without comments: every byte is content

@@ -19,7 +19,7 @@ from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 from pydrake.systems.framework import (DiagramBuilder, EventStatus, LeafSystem, PublishEvent,
                                        WitnessFunctionDirection)
 
-from drake_dock.contact_system import ContactLaw, ContactOptions, ContactPair, RigidContactSystem
+from drake_dock.systems.contact_system import ContactLaw, ContactOptions, ContactPair, RigidContactSystem
 from drake_dock.docking.plant import DockingPlant, StewartDamperPower, make_docking_plant
 from drake_dock.docking.scene import apds_pairs
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from drake_dock.contact_system import COUPLE_SLICES
+from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.plant import APDS_NAMES, BODY_NAMES, stewart_potential
 
 

@@ -21,13 +21,13 @@ import numpy as np
 from pydrake.systems.analysis import (ApplySimulatorConfig, Simulator, SimulatorConfig,
                                       SimulatorStatus)
 
-from drake_dock.contact_system import CONTACT, COUPLE_OUTPUT_SIZE, FAR, ContactModes
+from drake_dock.systems.contact_system import CONTACT, COUPLE_OUTPUT_SIZE, FAR, ContactModes
 from drake_dock.docking.diagram import DockingDiagram, build_docking_diagram
 from drake_dock.docking.outcome import OutcomeWatch, progress_fraction
 from drake_dock.docking.plant import set_initial_state
 from drake_dock.docking.scene import InitialState, initial_state
 from drake_dock.errors import DrakeDockError, NumericalError
-from drake_dock.stepping import WitnessApproach
+from drake_dock.systems.stepping import WitnessApproach
 
 STEP, PRE_IMPACT, POST_IMPACT = 0, 1, 2
 
@@ -159,7 +159,7 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
     ``progress(t, t_end, fraction)`` is called after each step. Raises the contact system's typed errors (`NumericalError`), and any other
     failure of the integration as a `NumericalError` with the time and the couples in play.
     ``witness_approach`` shortens the steps before predicted witness zeros
-    (`drake_dock.stepping.WitnessApproach`); off, Drake's plain isolation is used."""
+    (`drake_dock.systems.stepping.WitnessApproach`); off, Drake's plain isolation is used."""
     with _numerical_failure("the initial placement", lambda: (0.0, ())):
         state = state or initial_state(scenario)
         dd = dd or build_docking_diagram(scenario)

@@ -9,7 +9,7 @@ import yaml
 from drake_dock.docking.scene import (CHASER_APDS, TARGET_APDS, apds_pairs, contact_approach,
                                       initial_state, pair_couples)
 from drake_dock.errors import InputError
-from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 
 OFF_AXIS = dict(lateral_offset=[0.02, -0.01], tilt_deg=[1.0, 0.5], lateral_velocity=[0.01, 0.0],
                 angular_velocity_deg_s=[0.1, -0.2, 0.3], chaser_speed=0.1)

@@ -10,9 +10,9 @@ from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
 
-from drake_dock.contact_system import COUPLE_SLICES, ContactOptions
+from drake_dock.systems.contact_system import COUPLE_SLICES, ContactOptions
 from drake_dock.core.constraints import PainleveError
-from drake_dock.small_scenes import G, disk_on_incline, painleve_rod, rod_on_edge, stool
+from drake_dock.studies.small_scenes import G, disk_on_incline, painleve_rod, rod_on_edge, stool
 
 ACC = 1e-10
 
@@ -356,7 +356,7 @@ def test_parallel_edges_in_contact_raise_typed_error():
 def test_drift_is_measured_and_bounded():
     """The projection of the integrated couple stays at round-off along a rolling run, and a
     drift above drift_tol raises DriftError naming the couple."""
-    from drake_dock.contact_system import DriftError
+    from drake_dock.systems.contact_system import DriftError
     sc = disk_on_incline(THETA, mu=0.3)
     r = sc.params["radius"]
     sim, root, ctx = start(sc.system, lambda c: sc.set_state(

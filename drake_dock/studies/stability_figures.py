@@ -1,4 +1,4 @@
-"""One figure per case of `drake_dock.stability` (PNG, matplotlib Agg)."""
+"""One figure per case of `drake_dock.studies.stability` (PNG, matplotlib Agg)."""
 import math
 
 import numpy as np
@@ -81,7 +81,7 @@ def high_friction_figure(c, path):
     ok = [r for r in c["rod"] if r["error"] is None]
     bad = [r for r in c["rod"] if r["error"] is not None]
     mu = np.linspace(0, max(r["mu"] for r in c["rod"]), 400)
-    from drake_dock.stability import painleve_closed_form
+    from drake_dock.studies.stability import painleve_closed_form
     lam = [painleve_closed_form(m)[0] for m in mu]
     ax.plot(mu, lam, "b-", lw=1, label="closed form (planar)")
     ax.plot([r["mu"] for r in ok], [r["lambda_n"] for r in ok], "ko", label="drake_dock")

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 
-from drake_dock.contact_system import ContactOptions
-from drake_dock.small_scenes import G, disk_on_incline
-from drake_dock.stepping import WitnessApproach
+from drake_dock.systems.contact_system import ContactOptions
+from drake_dock.studies.small_scenes import G, disk_on_incline
+from drake_dock.systems.stepping import WitnessApproach
 
 H, E, ACC, MAX_STEP = 0.05, 0.5, 1e-8, 0.01
 
@@ -49,7 +49,7 @@ def test_same_impact_times_with_fewer_evaluations():
 
 
 def test_lead_jet_is_the_first_root_of_the_taylor_parabola():
-    from drake_dock.stepping import _lead_jet
+    from drake_dock.systems.stepping import _lead_jet
     # w = 1 - 3 h + 2 h^2 = (1 - h)(1 - 2 h): first zero at h = 1/2.
     assert _lead_jet(1.0, -3.0, 4.0) == pytest.approx(0.5, rel=1e-15)
     # Ballistic gap w = 0.01 + 0.5 h - g h^2 / 2: the positive root.

@@ -11,12 +11,12 @@ import pytest
 from pydrake.systems.analysis import Simulator
 from scipy.integrate import solve_ivp
 
-from drake_dock.docking.compliant import (CompliantConfig, build_compliant_diagram,
+from drake_dock.studies.compliant import (CompliantConfig, build_compliant_diagram,
                                           hunt_crossley_dissipation)
 from drake_dock.docking.plant import set_initial_state
 from drake_dock.docking.scene import initial_state
-from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.study import METRICS, Point, converged_points, converged_speedups
+from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.studies.speed_accuracy import METRICS, Point, converged_points, converged_speedups
 
 
 @pytest.fixture(scope="module")

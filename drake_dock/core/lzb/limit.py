@@ -1,5 +1,5 @@
 """The continuous-time limit of the LZB restitution laws on a chain of balls: an independent
-reference for `drake_dock.impact.solve_lzb`, integrated in physical time by scipy's DOP853.
+reference for `drake_dock.core.lzb.solve.solve_lzb`, integrated in physical time by scipy's DOP853.
 
 Balls 0..n-1 move on a line, ball j behind ball j + 1; contact j between them has the approach
 speed a_j = v_j - v_(j+1) and an equivalent deformation s_j >= 0 carrying the force

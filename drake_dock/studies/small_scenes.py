@@ -17,7 +17,7 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import FixedOffsetFrame, RotationalInertia, SpatialInertia
 
-from drake_dock.contact_system import ContactLaw, ContactOptions, ContactPair, RigidContactSystem
+from drake_dock.systems.contact_system import ContactLaw, ContactOptions, ContactPair, RigidContactSystem
 from drake_dock.core.patches import Circle, PlaneRect, Segment
 
 G = 9.81

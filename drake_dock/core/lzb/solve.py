@@ -22,7 +22,7 @@ Phases
 Each couple has an effective indentation x_j >= 0 and a phase. The configuration is frozen,
 so there is no gap: a couple whose indentation is zero is unloaded, and it loads again as soon
 as it approaches again (u_n < 0). This is the continuous-time limit of LZB that Siconos's
-`MultipleImpact` also converges to; `drake_dock.lzb_limit` integrates it on ball chains in
+`MultipleImpact` also converges to; `drake_dock.core.lzb.limit` integrates it on ball chains in
 physical time, as the tests' reference.
 
 - Compression: dx/dtau = -u_n (x does not fall below zero while unloaded).
@@ -79,7 +79,7 @@ from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
 from drake_dock.errors import NumericalError
-from drake_dock.impact_problem import ImpactEvent, ImpactProblem
+from drake_dock.core.lzb.problem import ImpactEvent, ImpactProblem
 
 LAWS = ("paper", "mono", "bi")
 _INSIDE = np.arange(1, 32) / 32.0   # where a step's dense output is sampled for events

@@ -40,8 +40,8 @@ from pathlib import Path
 
 import numpy as np
 
-from drake_dock.contact_system import COUPLE_SLICES
-from drake_dock.docking.compliant import (CompliantConfig, build_compliant_diagram,
+from drake_dock.systems.contact_system import COUPLE_SLICES
+from drake_dock.studies.compliant import (CompliantConfig, build_compliant_diagram,
                                           hunt_crossley_dissipation, run_compliant)
 from drake_dock.docking.scene import CHASER_APDS
 from drake_dock.docking.simulate import simulate
@@ -374,7 +374,7 @@ def work_precision_figure(result, path):
 
 def write_study(result, out_dir):
     """chart, CSV and the printed lines, atomically."""
-    from drake_dock.output import atomic_directory
+    from drake_dock.docking.output import atomic_directory
     with atomic_directory(out_dir, kind="study speed-accuracy") as tmp:
         (tmp / "points.csv").write_text(points_csv(result["points"]))
         work_precision_figure(result, tmp / "work_precision.png")

@@ -15,7 +15,7 @@ from pydrake.common.yaml import yaml_load_typed
 from drake_dock.docking.apds import ApdsGeometry
 from drake_dock.errors import InputError
 
-MODELS_DIR = Path(__file__).resolve().parent / "models"   # package data; ./models links here
+MODELS_DIR = Path(__file__).resolve().parent.parent / "models"   # package data; ./models links here
 PAPER_EXAMPLE = MODELS_DIR / "paper_example.yaml"
 
 

@@ -62,7 +62,7 @@ from drake_dock.core.patches import posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.core.tracking import SingularCoupleError
 from drake_dock.errors import InputError, NumericalError, SeekingError
-from drake_dock.impact import solve_lzb
+from drake_dock.core.lzb.solve import solve_lzb
 
 FAR, TRACKED, CONTACT = 0, 1, 2
 FAR_WITNESS = "far pairs clearance"   # the one witness of all far pairs (`_w_clear`)
@@ -690,7 +690,7 @@ class RigidContactSystem(LeafSystem):
 
     def witness_values(self, context) -> dict:
         """The values of the witnesses `DoGetWitnessFunctions` returns now, by description
-        (used by `drake_dock.stepping.WitnessApproach` to predict their zeros)."""
+        (used by `drake_dock.systems.stepping.WitnessApproach` to predict their zeros)."""
         out = {}
         pairs = self.get_modes(context).pairs
         if any(st.status == FAR for st in pairs):
@@ -708,7 +708,7 @@ class RigidContactSystem(LeafSystem):
 
     def witness_rates(self, context) -> dict:
         """Time derivatives of the gap witnesses of the tracked couples, by description:
-        g' = v_n (for `drake_dock.stepping.WitnessApproach`)."""
+        g' = v_n (for `drake_dock.systems.stepping.WitnessApproach`)."""
         out = {}
         E = None
         for i, st in enumerate(self.get_modes(context).pairs):

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from drake_dock.impact import solve_lzb
-from drake_dock.lzb_limit import continuous_limit_chain
+from drake_dock.core.lzb.solve import solve_lzb
+from drake_dock.core.lzb.limit import continuous_limit_chain
 
 
 def chain(n):
@@ -69,7 +69,7 @@ SLOW = [(3, 1.5), (4, 1.5)]
     *c, marks=pytest.mark.skipif(not os.environ.get("DRAKE_DOCK_SLOW"), reason="slow"))
     for c in SLOW])
 def test_chain_matches_continuous_limit_over_e(k, eta, law):
-    """Every law follows its continuous limit (drake_dock.lzb_limit, integrated in time with
+    """Every law follows its continuous limit (drake_dock.core.lzb.limit, integrated in time with
     scipy) to 1e-8 at rtol 1e-10 over the restitution grid, re-compressions and repeated
     impacts within one multiple impact included."""
     masses, K = CHAINS[k]
@@ -347,7 +347,7 @@ def test_benchmark_script_runs_quick():
     import subprocess
     import sys
     from pathlib import Path
-    script = Path(__file__).resolve().parent.parent / "bench" / "lzb_chains.py"
+    script = Path(__file__).resolve().parents[2] / "bench" / "lzb_chains.py"
     r = subprocess.run([sys.executable, str(script), "--quick"], capture_output=True, text=True,
                        timeout=300)
     assert r.returncode == 0, r.stderr

@@ -10,7 +10,7 @@ drake_dock's documented behaviour, a figure and the data it is drawn from.
 (b) ``stiffness_ratio``: LZB's stiffness-ratio effect. Three equal balls, the first hitting the
     two at rest, the two contacts' stiffness ratio K2/K1 from 1e-3 to 1e3 (elastic, Hertz
     eta = 1.5): LZB's post-impact velocities against the compliant chain integrated in time
-    (`drake_dock.lzb_limit.continuous_limit_chain`), and the cost of each.
+    (`drake_dock.core.lzb.limit.continuous_limit_chain`), and the cost of each.
 (c) ``high_friction``: Painleve's rod (`small_scenes.painleve_rod`, tip sliding at 1 m/s, 30 deg)
     over mu: lambda_n against the planar closed form below the critical mu_c, a
     `PainleveError` naming the couple and the time above it; and the docking example at higher
@@ -32,13 +32,13 @@ from pathlib import Path
 import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 
-from drake_dock.contact_system import COUPLE_SLICES, ContactOptions, ZenoError
+from drake_dock.systems.contact_system import COUPLE_SLICES, ContactOptions, ZenoError
 from drake_dock.core.constraints import PainleveError
 from drake_dock.errors import DrakeDockError, NumericalError
-from drake_dock.impact import solve_lzb
-from drake_dock.lzb_limit import continuous_limit_chain
-from drake_dock.small_scenes import G, disk_on_incline, painleve_rod
-from drake_dock.stepping import WitnessApproach
+from drake_dock.core.lzb.solve import solve_lzb
+from drake_dock.core.lzb.limit import continuous_limit_chain
+from drake_dock.studies.small_scenes import G, disk_on_incline, painleve_rod
+from drake_dock.systems.stepping import WitnessApproach
 
 SAWTOOTH = 0.05
 
@@ -95,11 +95,11 @@ RIGID_STEP_ACCURACY = 1e-8
 
 
 def step_size_case(scenario, *, output_steps, compliant_steps, stiffnesses, log=print) -> dict:
-    from drake_dock.docking.compliant import (CompliantConfig, hunt_crossley_dissipation,
+    from drake_dock.studies.compliant import (CompliantConfig, hunt_crossley_dissipation,
                                               run_compliant)
     from drake_dock.docking.scene import initial_state
     from drake_dock.docking.simulate import simulate
-    from drake_dock.study import rigid_chaser_force
+    from drake_dock.studies.speed_accuracy import rigid_chaser_force
     state = initial_state(scenario)
     rigid = []
     for H in output_steps:
@@ -386,8 +386,8 @@ def summary_lines(res) -> list:
 
 def write_stability(res, out_dir):
     """stability.json, summary.txt and one figure per case, atomically."""
-    from drake_dock.output import atomic_directory
-    from drake_dock.stability_figures import stability_figures
+    from drake_dock.docking.output import atomic_directory
+    from drake_dock.studies.stability_figures import stability_figures
     with atomic_directory(out_dir, kind="study stability") as tmp:
         (tmp / "stability.json").write_text(json.dumps(res, indent=1, default=_json))
         (tmp / "summary.txt").write_text("\n".join(summary_lines(res)) + "\n")

@@ -3,7 +3,7 @@ import pytest
 
 from drake_dock.docking.apds import ApdsGeometry
 from drake_dock.errors import InputError
-from drake_dock.scenario import load_scenario
+from drake_dock.docking.scenario import load_scenario
 
 
 def _fails(data, field):

@@ -1,6 +1,6 @@
 """The state machine of one LZB multiple impact in contact space (Sect. 6): the phases of each
 couple, the force rates, the right-hand side in the time-like parameter tau and the phase
-events. The rules are stated in `drake_dock.impact`'s docstring; `solve_lzb` drives this."""
+events. The rules are stated in `drake_dock.core.lzb.solve`'s docstring; `solve_lzb` drives this."""
 from __future__ import annotations
 
 import dataclasses

@@ -9,7 +9,7 @@ import pytest
 
 from drake_dock.cli import main
 from drake_dock.errors import InputError, NumericalError
-from drake_dock.output import MARKER, atomic_directory, check_destination
+from drake_dock.docking.output import MARKER, atomic_directory, check_destination
 
 BOOM = "simulated although the destination is refused"
 
@@ -20,8 +20,8 @@ def no_simulation(monkeypatch):
     def boom(*args, **kwargs):
         raise AssertionError(BOOM)
     monkeypatch.setattr("drake_dock.run.simulate", boom)
-    monkeypatch.setattr("drake_dock.study.run_study", boom)
-    monkeypatch.setattr("drake_dock.stability.run_stability", boom)
+    monkeypatch.setattr("drake_dock.studies.speed_accuracy.run_study", boom)
+    monkeypatch.setattr("drake_dock.studies.stability.run_stability", boom)
 
 
 def _refused(capsys, argv, path):

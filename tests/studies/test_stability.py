@@ -1,4 +1,4 @@
-"""Stability where methods fail (`drake_dock.stability`): each case against its closed form or an
+"""Stability where methods fail (`drake_dock.studies.stability`): each case against its closed form or an
 independent reference, and the `drake-dock study stability --quick` command."""
 import json
 import math
@@ -8,10 +8,10 @@ import sys
 import numpy as np
 import pytest
 
-from drake_dock import stability as S
-from drake_dock.contact_system import ZenoError
-from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.small_scenes import G, painleve_rod, stool
+from drake_dock.studies import stability as S
+from drake_dock.systems.contact_system import ZenoError
+from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.studies.small_scenes import G, painleve_rod, stool
 
 
 def test_sawtooth_index_closed_forms():
@@ -88,8 +88,8 @@ def test_zeno_guard_counts_and_error_when_off():
 
 
 def test_zeno_error_is_typed():
-    from drake_dock.contact_system import ContactOptions
-    from drake_dock.small_scenes import disk_on_incline
+    from drake_dock.systems.contact_system import ContactOptions
+    from drake_dock.studies.small_scenes import disk_on_incline
     sc = disk_on_incline(0.0, restitution=0.5,
                          options=ContactOptions(zeno_speed=0.0, max_impacts=3))
     r = sc.params["radius"]

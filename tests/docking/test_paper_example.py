@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation
 
 from drake_dock.core.patches import posed
 from drake_dock.docking.scene import apds_pairs
-from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 
 EXE = [sys.executable, "-m", "drake_dock.cli", "run", "--no-progress"]
 

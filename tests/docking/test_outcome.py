@@ -10,7 +10,7 @@ import yaml
 
 from drake_dock.cli import main
 from drake_dock.docking.outcome import JAM_DISTANCE, OutcomeWatch, progress_fraction
-from drake_dock.scenario import PAPER_EXAMPLE
+from drake_dock.docking.scenario import PAPER_EXAMPLE
 
 
 def feed(watch, ts, ds, contact):

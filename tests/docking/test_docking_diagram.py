@@ -14,7 +14,7 @@ def axisymmetric_scenario():
     chaser, I = (40211, 6402, 40242), is not: see docs/model.md). Only then are the three
     couples' forces equal by symmetry."""
     import yaml
-    from drake_dock.scenario import PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
     data = yaml.safe_load(PAPER_EXAMPLE.read_text())
     data["bodies"]["target"]["inertia"] = [778.0, 778.0, 829.0]
     data["bodies"]["chaser"]["inertia"] = [40226.5, 40226.5, 6402.0]

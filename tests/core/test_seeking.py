@@ -1,0 +1,54 @@
+"""The seek's building blocks against independent constructions: the batched local grids
+against numpy's meshgrid, the Newton step against the floored eigen-decomposition."""
+import math
+
+import numpy as np
+import pytest
+
+from drake_dock.core.patches import Circle, Cone
+from drake_dock.core.seeking import _descent_step, _local_grids
+
+
+@pytest.mark.parametrize("patch", [Cone(0.6, math.radians(45), (0.1, 1.0), (0.0, 0.2)),
+                                   Circle(0.5, 0.1)], ids=["cone", "circle"])
+def test_local_grids_match_meshgrid(patch):
+    rng = np.random.default_rng(1)
+    centres = rng.uniform(patch.lower, patch.upper, size=(4, patch.dim))
+    centres[0] = patch.lower            # clipped at the lower ends (or wrapped)
+    half = 0.3 * patch.span
+    got = _local_grids(patch, centres, half, 7)
+    for c, g in zip(centres, got):
+        axes = []
+        for k in range(patch.dim):
+            lo, hi = c[k] - half[k], c[k] + half[k]
+            if not patch.periodic[k]:
+                lo, hi = max(lo, patch.lower[k]), min(hi, patch.upper[k])
+            axes.append(np.linspace(lo, hi, 7))
+        mesh = np.meshgrid(*axes, indexing="ij")
+        want = patch.wrap(np.stack([m.ravel() for m in mesh], axis=-1))
+        np.testing.assert_allclose(g, want, rtol=0, atol=1e-15)
+
+
+def _floored_eigen_step(H, g):
+    w, V = np.linalg.eigh(H)
+    w = np.maximum(np.abs(w), 1e-10 * max(1.0, np.abs(w).max()))
+    return -V @ ((V.T @ g) / w)
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4])
+def test_descent_step_is_the_floored_eigen_step(n):
+    rng = np.random.default_rng(n)
+    for case in range(30):
+        A = rng.normal(size=(n, n))
+        if case % 3 == 0:        # positive definite
+            H = A @ A.T + 0.1 * np.eye(n)
+        elif case % 3 == 1:      # indefinite
+            H = A + A.T
+        else:                    # nearly singular: eigenvalues 1 .. 1e-13
+            Q, _ = np.linalg.qr(A)
+            H = Q @ np.diag(np.logspace(0, -13, n)) @ Q.T
+        g = rng.normal(size=n)
+        want = _floored_eigen_step(H, g)
+        got = np.array(_descent_step(H.tolist(), g.tolist()))
+        np.testing.assert_allclose(got, want, rtol=1e-7, atol=1e-12 * np.abs(want).max())
+        assert got @ g < 0.0     # a descent direction

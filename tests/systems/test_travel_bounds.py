@@ -1,0 +1,53 @@
+"""The far pairs' travel bound against the actual displacement of every point of the patch."""
+import math
+
+import numpy as np
+import pytest
+
+from drake_dock.studies.small_scenes import stool
+from drake_dock.systems.contact_system import FAR, PairState
+
+
+def _random_rotation(rng, angle=None):
+    q = rng.normal(size=4)
+    if angle is not None:
+        axis = q[1:] / np.linalg.norm(q[1:])
+        q = np.concatenate([[math.cos(angle / 2)], math.sin(angle / 2) * axis])
+    w, x, y, z = q / np.linalg.norm(q)
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def test_far_pair_travel_bound_covers_every_point_of_the_patch():
+    """The bound of each far pair (all pairs at once) is at least the largest displacement,
+    relative to frame 2, of the points of patch 1 since the reference pose; a pair never
+    sought has an infinite bound."""
+    system = stool().system
+    rng = np.random.default_rng(7)
+    k = len(system.pairs)
+    for trial in range(20):
+        poses0 = [(_random_rotation(rng), rng.normal(size=3)) for _ in system._frames]
+        scale = 10.0 ** rng.uniform(-4, 0)
+        poses1 = [(_random_rotation(rng, scale * rng.uniform(0, 1)) @ R, p + scale
+                   * rng.normal(size=3)) for R, p in poses0]
+        states = []
+        for i in range(k):
+            a, b = system._fidx[i]
+            (R1, p1), (R2, p2) = poses0[a], poses0[b]
+            states.append(PairState(FAR, ref_X21=(R2.T @ R1, R2.T @ (p1 - p2))))
+        bounds = system._travel_bounds(list(range(k)), poses1, states)
+        for i, pair in enumerate(system.pairs):
+            r = pair.patch1.position(pair.patch1.grid(61))
+            a, b = system._fidx[i]
+            moved = []
+            for poses in (poses0, poses1):
+                (R1, p1), (R2, p2) = poses[a], poses[b]
+                moved.append((r @ R1.T + p1 - p2) @ R2)      # points in frame 2
+            actual = np.linalg.norm(moved[1] - moved[0], axis=1).max()
+            assert actual <= bounds[i]
+            assert bounds[i] <= 3.0 * actual + 1e-12     # and not vacuous
+            assert bounds[i] == pytest.approx(system._travel_bound(i, poses1, states[i]),
+                                              rel=1e-14)
+    states[1] = PairState(FAR)
+    assert math.isinf(system._travel_bounds([0, 1, 2], poses1, states)[1])

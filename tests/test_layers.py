@@ -1,0 +1,161 @@
+"""The package's shape, read from its source with `ast` (nothing is imported): layers import only
+downwards, no import circles, no private name imported across modules, no module over 500 lines,
+no class over 300 lines, and tests/core reaches no Drake module through any chain of imports."""
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "drake_dock"
+
+# A module may import its own layer or any layer below it (errors and the version at the bottom).
+LAYERS = {"errors": 0, "__init__": 0, "core": 1, "systems": 2, "docking": 3, "studies": 4,
+          "campaign": 5, "run": 6, "cli": 7, "__main__": 8}
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def _modules():
+    return {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def _imports(path: Path, package: str):
+    """(imported module, [names]) for every import in the file, relative imports resolved."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                yield a.name, []
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[:len(package.split(".")) - node.level + 1]
+                mod = ".".join(base + ([node.module] if node.module else []))
+            else:
+                mod = node.module
+            yield mod, [a.name for a in node.names]
+
+
+def _layer(module: str) -> int:
+    parts = module.split(".")
+    key = parts[1] if len(parts) > 1 else "__init__"
+    return LAYERS[key]
+
+
+def _internal_edges():
+    mods = _modules()
+    edges = {}
+    for name, path in mods.items():
+        package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+        targets = set()
+        for mod, names in _imports(path, package):
+            for cand in [f"{mod}.{n}" for n in names] + [mod]:
+                if cand in mods and cand != name:
+                    targets.add(cand)
+                    break
+        edges[name] = targets
+    return edges
+
+
+def test_every_module_has_a_layer():
+    for name in _modules():
+        _layer(name)
+
+
+def test_imports_only_go_down():
+    bad = [(a, b) for a, bs in _internal_edges().items() for b in bs if _layer(b) > _layer(a)]
+    assert not bad, f"imports going up a layer: {bad}"
+
+
+def test_no_import_circles():
+    edges = _internal_edges()
+    state = {}
+
+    def visit(node, stack):
+        state[node] = 1
+        for nxt in edges[node]:
+            if state.get(nxt) == 1:
+                raise AssertionError("import circle: " + " -> ".join(stack + [node, nxt]))
+            if nxt not in state:
+                visit(nxt, stack + [node])
+        state[node] = 2
+
+    for node in edges:
+        if node not in state:
+            visit(node, [])
+
+
+def test_no_private_name_imported_across_modules():
+    mods = _modules()
+    bad = []
+    for name, path in mods.items():
+        package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+        for mod, names in _imports(path, package):
+            if mod and mod.startswith("drake_dock"):
+                bad += [(name, mod, n) for n in names if n.startswith("_") and n != "__version__"]
+    assert not bad, bad
+
+
+def test_module_and_class_sizes():
+    for name, path in _modules().items():
+        text = path.read_text()
+        assert text.count("\n") <= 500, f"{name}: {text.count(chr(10))} lines"
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.ClassDef):
+                size = node.end_lineno - node.lineno + 1
+                assert size < 300, f"{name}.{node.name}: {size} lines"
+
+
+def _reachable(start_files):
+    """Every module (internal or external top-level name) reachable from the files' imports."""
+    mods = _modules()
+    seen, todo, external = set(), [], set()
+
+    def add(path, package):
+        for mod, names in _imports(path, package):
+            hit = None
+            for cand in [f"{mod}.{n}" for n in names] + [mod]:
+                if cand in mods:
+                    hit = cand
+                    break
+            if hit is None:
+                external.add(mod.split(".")[0])
+                continue
+            parts = hit.split(".")       # importing a.b.c runs a/__init__ and a.b/__init__
+            for k in range(1, len(parts) + 1):
+                m = ".".join(parts[:k])
+                if m in mods and m not in seen:
+                    seen.add(m)
+                    todo.append(m)
+
+    for f in start_files:
+        add(f, "tests")
+    while todo:
+        m = todo.pop()
+        p = mods[m]
+        add(p, m if p.name == "__init__.py" else m.rsplit(".", 1)[0])
+    return seen, external
+
+
+def test_core_tests_reach_no_drake():
+    files = sorted((ROOT / "tests" / "core").glob("*.py"))    # conftest imports in fixtures
+    seen, external = _reachable(files)
+    assert "pydrake" not in external, sorted(m for m in seen)
+    assert not [m for m in seen if m.split(".")[1:2] and _layer(m) > LAYERS["docking"]]
+
+
+@pytest.mark.parametrize("layer", ["core"])
+def test_core_modules_use_numpy_and_scipy_only(layer):
+    allowed = {"numpy", "scipy", "numba", "__future__", "dataclasses", "math", "functools",
+               "itertools", "enum", "typing", "collections", "contextlib", "time", "copy"}
+    for name, path in _modules().items():
+        if name.split(".")[1:2] == [layer]:
+            package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+            for mod, _ in _imports(path, package):
+                top = mod.split(".")[0]
+                assert top == "drake_dock" or top in allowed, f"{name} imports {mod}"
