@@ -19,7 +19,7 @@ from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 from pydrake.systems.framework import (DiagramBuilder, EventStatus, LeafSystem, PublishEvent,
                                        WitnessFunctionDirection)
 
-from drake_dock.systems.contact_system import ContactLaw, ContactOptions, ContactPair, RigidContactSystem
+from drake_dock.systems.contact_system import ContactOptions, ContactPair, RigidContactSystem
 from drake_dock.docking.plant import DockingPlant, StewartDamperPower, make_docking_plant
 from drake_dock.docking.scene import apds_pairs
 
@@ -71,12 +71,6 @@ class CaptureMonitor(LeafSystem):
         return {"capture": self.distance(context) - self.capture_distance}
 
 
-def contact_law(scenario) -> ContactLaw:
-    c = scenario.contact
-    return ContactLaw(mu=c.mu, mu_s=c.mu_s, restitution=c.restitution, stiffness=c.stiffness,
-                      eta=c.eta)
-
-
 def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagram:
     builder = DiagramBuilder()
     scene_graph = builder.AddSystem(SceneGraph())
@@ -91,7 +85,7 @@ def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagra
         options = ContactOptions(impact_rtol=min(1e-8, max(1e-12,
                                                            1e-2 * scenario.simulation.accuracy)))
     contact = builder.AddSystem(RigidContactSystem(
-        dp.plant, pairs, contact_law(scenario), options,
+        dp.plant, pairs, scenario.contact, options,
         wrench_bodies=("chaser",),
         extra_powers=[("stewart_damper_work", StewartDamperPower(dp))],
         energy_scale=0.5 * scenario.bodies.chaser.mass * scenario.initial.chaser_speed ** 2

@@ -6,12 +6,14 @@ value and the allowed range. Unknown keys are errors too (named with their full 
 
 import dataclasses
 import math
+import types
 import typing
 from pathlib import Path
 
 import yaml
 from pydrake.common.yaml import yaml_load_typed
 
+from drake_dock.core.contact_law import ContactLaw
 from drake_dock.docking.apds import ApdsGeometry
 from drake_dock.errors import InputError
 
@@ -50,19 +52,6 @@ class StewartParams:
     force_damping: list[float] = dataclasses.field(default_factory=lambda: [520.0, 0.0, 532.0])
     torque_stiffness: list[float] = dataclasses.field(default_factory=lambda: [105., 105., 938.])
     torque_damping: list[float] = dataclasses.field(default_factory=lambda: [10.0, 10.0, 520.0])
-
-
-@dataclasses.dataclass
-class ContactParams:
-    """Contact parameters the paper does not give (docs/model.md): friction mu (sliding) and
-    mu_s (static), energetic restitution e, and the LZB stiffness K and exponent eta of Eq. (28),
-    equal for all couples."""
-
-    mu: float = 0.1
-    mu_s: float = 0.1
-    restitution: float = 0.1
-    stiffness: float = 1.0e9
-    eta: float = 1.5
 
 
 @dataclasses.dataclass
@@ -114,7 +103,7 @@ class Scenario:
     bodies: Bodies = dataclasses.field(default_factory=Bodies)
     stewart: StewartParams = dataclasses.field(default_factory=StewartParams)
     chaser_apds_offset: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 1.9])
-    contact: ContactParams = dataclasses.field(default_factory=ContactParams)
+    contact: ContactLaw = dataclasses.field(default_factory=ContactLaw)
     initial: InitialCondition = dataclasses.field(default_factory=InitialCondition)
     simulation: SimulationParams = dataclasses.field(default_factory=SimulationParams)
 
@@ -153,6 +142,9 @@ def _check_raw(node, schema, path):
         (item,) = typing.get_args(schema)
         for k, x in enumerate(node):
             _check_raw(x, item, f"{where}[{k}].")
+    elif typing.get_origin(schema) is types.UnionType and node is not None:
+        (item,) = [a for a in typing.get_args(schema) if a is not type(None)]   # X | None
+        _check_raw(node, item, path)
 
 
 def _finite(field, v):
@@ -208,16 +200,7 @@ def validate(s: Scenario) -> Scenario:
             _nonnegative(f"stewart.{name}[{k}]", x)
     _mounted_ahead("stewart.p_TA", s.stewart.p_TA, "target")
     _mounted_ahead("chaser_apds_offset", s.chaser_apds_offset, "chaser")
-    c = s.contact
-    _nonnegative("contact.mu", c.mu)
-    _nonnegative("contact.mu_s", c.mu_s)
-    if c.mu_s < c.mu:
-        raise InputError("contact.mu_s", c.mu_s, f">= contact.mu = {c.mu!r}",
-                         "static friction below sliding friction")
-    if _finite("contact.restitution", c.restitution) < 0 or c.restitution > 1:
-        raise InputError("contact.restitution", c.restitution, "0 <= e <= 1")
-    _positive("contact.stiffness", c.stiffness)
-    _positive("contact.eta", c.eta)
+    s.contact.validate("contact")
     ic = s.initial
     if not -60.0 < _finite("initial.target_yaw_deg", ic.target_yaw_deg) < 60.0:
         raise InputError("initial.target_yaw_deg", ic.target_yaw_deg, "-60 < yaw < 60 deg")

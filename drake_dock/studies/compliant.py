@@ -148,7 +148,7 @@ def apds_pieces(g, cfg: CompliantConfig) -> list:
 def _properties(scenario, cfg: CompliantConfig) -> ProximityProperties:
     c = scenario.contact
     props = ProximityProperties()
-    friction = CoulombFriction(c.mu_s, c.mu)
+    friction = CoulombFriction(c.static_mu, c.mu)
     if cfg.model == "hydroelastic":
         AddContactMaterial(cfg.dissipation, None, friction, props)
         AddCompliantHydroelasticProperties(cfg.thickness, cfg.stiffness, props)

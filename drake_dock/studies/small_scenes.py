@@ -17,7 +17,8 @@ from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import FixedOffsetFrame, RotationalInertia, SpatialInertia
 
-from drake_dock.systems.contact_system import ContactLaw, ContactOptions, ContactPair, RigidContactSystem
+from drake_dock.core.contact_law import ContactLaw
+from drake_dock.systems.contact_system import ContactOptions, ContactPair, RigidContactSystem
 from drake_dock.core.patches import Circle, PlaneRect, Segment
 
 G = 9.81
@@ -72,7 +73,7 @@ def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restituti
                                                           restitution=restitution), options)
     return SmallScene(plant, system, body, dict(theta=theta, mass=mass, radius=radius,
                                                 I_axle=I_ax, mu=mu,
-                                                mu_s=mu if mu_s is None else mu_s))
+                                                mu_s=system.law.static_mu))
 
 
 def rod_on_edge(*, mass=1.5, half_length=0.4, mu=0.2, mu_s=None, wrench=True,
@@ -91,10 +92,10 @@ def rod_on_edge(*, mass=1.5, half_length=0.4, mu=0.2, mu_s=None, wrench=True,
     # n = sigma t1 x t2 must point up, from the edge (body 2) to the rod (body 1): y x x = -z.
     pair = ContactPair("rod_edge", "CC", body.body_frame(), rod, plant.world_frame(), edge,
                        sigma=-1.0)
-    system = RigidContactSystem(plant, [pair], ContactLaw(mu=mu, mu_s=mu_s), options,
-                                wrench_bodies=("rod",) if wrench else ())
+    system = RigidContactSystem(plant, [pair], ContactLaw(mu=mu, mu_s=mu_s, restitution=0.0),
+                                options, wrench_bodies=("rod",) if wrench else ())
     return SmallScene(plant, system, body, dict(mass=mass, mu=mu,
-                                                mu_s=mu if mu_s is None else mu_s))
+                                                mu_s=system.law.static_mu))
 
 
 def painleve_rod(theta, *, mass=1.0, half_length=0.5, tip_radius=0.01, mu=1.0,
@@ -113,7 +114,7 @@ def painleve_rod(theta, *, mass=1.0, half_length=0.5, tip_radius=0.01, mu=1.0,
     plane = PlaneRect([-50.0, -5.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], size=(100.0, 10.0))
     pair = ContactPair("tip_plane", "CS", tip, Circle(tip_radius), plant.world_frame(), plane,
                        sigma=1.0)
-    system = RigidContactSystem(plant, [pair], ContactLaw(mu=mu), options)
+    system = RigidContactSystem(plant, [pair], ContactLaw(mu=mu, restitution=0.0), options)
     return SmallScene(plant, system, body, dict(theta=theta, mass=mass, l=l, I=I,
                                                 rho=tip_radius, mu=mu))
 

@@ -97,6 +97,14 @@ def test_paper_example_loads_tables():
     assert s.stewart.force_stiffness == [938.0, 71400.0, 947.0]
 
 
+def test_contact_static_friction_defaults_to_sliding_friction():
+    """contact.mu_s may be left out (it is then mu); a non-number is named by its field."""
+    s = load_scenario(data="contact: {mu: 0.3}")
+    assert s.contact.mu_s is None and s.contact.static_mu == 0.3
+    _fails("contact: {mu_s: fast}", "contact.mu_s")
+    _fails("contact: {impact_law: elastic}", "contact.impact_law")
+
+
 # Physical consistency -----------------------------------------------------------------------
 # case: (scenario, the field named, what else the message names)
 PHYSICAL = {
