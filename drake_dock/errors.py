@@ -39,3 +39,25 @@ class NumericalError(DrakeDockError, RuntimeError):
 
 class SeekingError(NumericalError):
     """The closest couple of a pair could not be found (Newton did not converge)."""
+
+
+class DriftError(NumericalError):
+    """The integrated couple drifted from the closest-point conditions beyond tolerance."""
+
+
+class ZenoError(NumericalError):
+    """More impacts than ``max_impacts``: an impact sequence that does not end."""
+
+
+class PainleveError(NumericalError):
+    """No consistent contact mode, or several (Painleve inconsistency or indeterminacy)."""
+
+
+class SingularContactError(NumericalError):
+    """The constraint equations of the contact set are singular (redundant or degenerate
+    contact Jacobian); the rigid model cannot distribute the contact forces."""
+
+
+class SingularCoupleError(NumericalError):
+    """The tracking Jacobian J of a couple is singular (Eq. 39 fails or the couple is not
+    isolated): the couple must end, be handed over or be re-sought."""

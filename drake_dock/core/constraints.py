@@ -35,20 +35,11 @@ import math
 
 import numpy as np
 
-from drake_dock.errors import NumericalError
+from drake_dock.errors import NumericalError, PainleveError, SingularContactError
 
 STICK, SLIDE, DETACH = "stick", "slide", "detach"
 MAX_ENUMERATED = 8
 TIE_RTOL = 1e-6     # consistency accepted at a transition when none holds at rtol
-
-
-class PainleveError(NumericalError):
-    """No consistent contact mode, or several (Painleve inconsistency or indeterminacy)."""
-
-
-class SingularContactError(NumericalError):
-    """The constraint equations of the contact set are singular (redundant or degenerate
-    contact Jacobian); the rigid model cannot distribute the contact forces."""
 
 
 @dataclasses.dataclass

@@ -15,12 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from drake_dock.core.couple import evaluate_couple
-from drake_dock.errors import NumericalError
-
-
-class SingularCoupleError(NumericalError):
-    """The tracking Jacobian J of a couple is singular (Eq. 39 fails or the couple is not
-    isolated): the couple must end, be handed over or be re-sought."""
+from drake_dock.errors import SingularCoupleError
 
 
 def couple_rate(P1, P2, u1, u2, twist1, twist2, *, kind=None, conditioning_min=1e-10,
