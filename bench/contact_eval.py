@@ -11,8 +11,8 @@ import time
 import numpy as np
 from pydrake.systems.analysis import Simulator
 
-from drake_dock.systems.contact_system import STICK
-from drake_dock.core.constraints import solve_given_modes
+from drake_dock.core.constraints import STICK, solve_given_modes
+from drake_dock.core.hybrid import Mode
 from drake_dock.studies.small_scenes import stool
 
 
@@ -41,8 +41,8 @@ def main():
     sim.Initialize()
     sim.AdvanceTo(0.01)
     modes = sys_.get_modes(ctx)
-    active = [p.status for p in modes.pairs]
-    assert active == [2, 2, 2], active
+    active = [p.mode for p in modes.pairs]
+    assert active == [Mode.STICKING] * 3, active
     k = [0]
 
     def full():
@@ -60,26 +60,27 @@ def main():
     E = sys_.eval(ctx)
     x = ctx.get_continuous_state_vector().CopyToVector()
     q, v = x[:sys_.nq], x[sys_.nq:sys_.nq + sys_.nv]
-    sctx = sys_._set_scratch(q, v)
-    poses, twists = sys_._frame_kinematics(sctx)
+    ev = sys_.evaluator
+    sctx = ev.set_scratch(q, v)
+    poses, twists = ev.frame_kinematics(sctx)
     u = x[sys_.nq + sys_.nv:sys_.ie]
 
     def couples():
         for i, st in enumerate(modes.pairs):
-            sys_._couple(i, u[sys_._uoff[i]:sys_._uoff[i + 1]], poses, twists, st.sigma, 0.0)
+            ev.couple(i, u[ev.couple_slice(i)], poses, twists, st.sigma, 0.0)
 
-    evs = [sys_._couple(i, u[sys_._uoff[i]:sys_._uoff[i + 1]], poses, twists, st.sigma, 0.0)
+    evs = [ev.couple(i, u[ev.couple_slice(i)], poses, twists, st.sigma, 0.0)
            for i, st in enumerate(modes.pairs)]
 
     def rows():
-        return [sys_._row(i, evs[i], poses, sctx) for i in range(3)]
+        return [ev.row(i, evs[i], poses, sctx) for i in range(3)]
 
     R = rows()
 
     def free():
-        sys_._free_acceleration(ctx, sctx, v)
+        ev.free_acceleration(sctx, v, (None, []))
 
-    M, Minv, a0, _, _ = sys_._free_acceleration(ctx, sctx, v)
+    M, Minv, a0, _, _ = ev.free_acceleration(sctx, v, (None, []))
 
     def solve():
         solve_given_modes(Minv, a0, R, [STICK] * 3, [None] * 3, omega=20.0)
@@ -87,7 +88,7 @@ def main():
     n = a.repeats
     t_full = per_call(full, n)
     t_plant = per_call(plant_only, n)
-    parts = {"frame kinematics": per_call(lambda: sys_._frame_kinematics(sctx), n),
+    parts = {"frame kinematics": per_call(lambda: ev.frame_kinematics(sctx), n),
              "3 couples (Eq. 47, frame, bias)": per_call(couples, n),
              "3 rows W (Drake Jacobians)": per_call(rows, n),
              "M, free acceleration": per_call(free, n),

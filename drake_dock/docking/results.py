@@ -2,8 +2,9 @@
 
 Field layout: t[N]; body_names[3]; p_WB[N,3,3], R_WB[N,3,3,3], v_WB[N,3,3], w_WB[N,3,3]
 (mass centres, world frame); apds_names[2]; p_WA[N,2,3], R_WA[N,2,3,3] (ring centre, e3 along the
-axis towards the other APDS); couple_names[12]; status[N,12] (0 far, 1 tracked, 2 sliding,
-3 sticking); active[N,12] (tracked or in contact); gap[N,12]; lambda_n[N,12]; lambda_t[N,12,2];
+axis towards the other APDS); couple_names[12]; status[N,12] (the pair's `Mode`: 0 far,
+1 tracked, 2 sliding, 3 sticking); active[N,12] (tracked or in contact); gap[N,12];
+lambda_n[N,12]; lambda_t[N,12,2];
 u[N,12,3] (couple parameters, unused entries 0); p1_W[N,12,3], p2_W[N,12,3]; sample_kind[N]
 (0 step end, 1 just before an impact, 2 just after); ring_distance[N]; energy[N,k] with
 energy_names[k]; impact_t[M], impact_couples[M,12] (bool), impact_normal_impulse[M,12],
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from drake_dock.core.hybrid import Mode
 from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.plant import APDS_NAMES, BODY_NAMES, stewart_potential
 
@@ -58,7 +60,7 @@ def timeseries(result) -> dict:
     return dict(
         t=np.asarray(rec.t), body_names=np.array(BODY_NAMES), p_WB=p_WB, R_WB=R_WB, v_WB=v_WB,
         w_WB=w_WB, apds_names=np.array(APDS_NAMES), p_WA=p_WA, R_WA=R_WA,
-        couple_names=np.array(names), status=status, active=status >= 1,
+        couple_names=np.array(names), status=status, active=status >= Mode.TRACKED,
         gap=C[:, :, S["gap"]][..., 0], lambda_n=C[:, :, S["lambda_n"]][..., 0],
         lambda_t=C[:, :, S["lambda_t"]], u=C[:, :, S["u"]], p1_W=C[:, :, S["p1"]],
         p2_W=C[:, :, S["p2"]], sample_kind=np.asarray(rec.kind, dtype=np.int8),

@@ -21,7 +21,8 @@ import numpy as np
 from pydrake.systems.analysis import (ApplySimulatorConfig, Simulator, SimulatorConfig,
                                       SimulatorStatus)
 
-from drake_dock.systems.contact_system import CONTACT, COUPLE_OUTPUT_SIZE, FAR, ContactModes
+from drake_dock.core.hybrid import Mode
+from drake_dock.systems.contact_system import COUPLE_OUTPUT_SIZE, ContactModes
 from drake_dock.docking.diagram import DockingDiagram, build_docking_diagram
 from drake_dock.docking.outcome import OutcomeWatch, progress_fraction
 from drake_dock.docking.plant import set_initial_state
@@ -146,7 +147,7 @@ def _couples_in_play(dd: DockingDiagram, root) -> list:
     """The pairs tracked or in contact (not far) in the root context's state."""
     try:
         modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
-        return [p.name for p, st in zip(dd.contact.pairs, modes.pairs) if st.status != FAR]
+        return [p.name for p, st in zip(dd.contact.pairs, modes.pairs) if st.mode != Mode.FAR]
     except Exception:  # noqa: BLE001 - only a detail of an error report
         return []
 
@@ -184,7 +185,7 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
         if progress is not None:
             progress(t, t_end, progress_fraction(t, t_end, d, watch.d_start, sp.capture_distance))
         modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
-        end = watch.update(t, d, any(st.status == CONTACT for st in modes.pairs))
+        end = watch.update(t, d, any(st.mode.in_contact for st in modes.pairs))
         if end is not None:
             ended.append(end)
             return EventStatus.ReachedTermination(dd.capture, end[0])

@@ -32,8 +32,9 @@ from pathlib import Path
 import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 
-from drake_dock.systems.contact_system import COUPLE_SLICES, ContactOptions, ZenoError
-from drake_dock.core.constraints import PainleveError
+from drake_dock.core.hybrid import Mode
+from drake_dock.errors import PainleveError, ZenoError
+from drake_dock.systems.contact_system import COUPLE_SLICES, ContactOptions
 from drake_dock.errors import DrakeDockError, NumericalError
 from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.core.lzb.limit import continuous_limit_chain
@@ -229,8 +230,8 @@ def high_friction_case(mus, *, scenario=None, docking_mus=(), log=print) -> dict
                 C = np.asarray(r.record.couples)
                 st = C[:, :, COUPLE_SLICES["status"]]
                 docking.append(dict(mu=mu, captured=r.captured, capture_time=r.capture_time,
-                                    impacts=len(r.impacts), sticking_samples=int((st == 3).sum()),
-                                    sliding_samples=int((st == 2).sum()), error=None))
+                                    impacts=len(r.impacts), sticking_samples=int((st == Mode.STICKING).sum()),
+                                    sliding_samples=int((st == Mode.SLIDING).sum()), error=None))
             except DrakeDockError as e:
                 docking.append(dict(mu=mu, captured=False, error=str(e).splitlines()[0]))
             log(f"  (c) docking mu = {mu}: {docking[-1]}")

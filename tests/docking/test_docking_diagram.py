@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 
+from drake_dock.core.hybrid import Mode
 from drake_dock.docking.diagram import build_docking_diagram
 from drake_dock.docking.plant import body_momenta, set_initial_state
 from drake_dock.docking.scene import initial_state
@@ -43,7 +44,7 @@ def first_impact(axisymmetric_scenario):
         return body_momenta(dd.dp, pc)
 
     before = momenta()
-    modes0 = [p.status for p in dd.contact.get_modes(ctx).pairs]
+    modes0 = [p.mode for p in dd.contact.get_modes(ctx).pairs]
     sim.AdvanceTo(s.initial.approach_travel / s.initial.chaser_speed + 2e-3)
     return dict(dd=dd, ctx=ctx, state=state, before=before, after=momenta(), modes0=modes0)
 
@@ -60,7 +61,7 @@ def test_three_symmetric_couples_impact_at_declared_travel(first_impact, axisymm
     assert P.min() > 0
     np.testing.assert_allclose(P, P.mean(), rtol=1e-6)      # 3-fold symmetry
     # Only the pairs near contact are tracked; the ring-surface pairs stay far.
-    tracked = [p.name for p, st in zip(dd.contact.pairs, first_impact["modes0"]) if st == 1]
+    tracked = [p.name for p, st in zip(dd.contact.pairs, first_impact["modes0"]) if st == Mode.TRACKED]
     assert set(state.closing_pairs) <= set(tracked)
     assert all(n.startswith("cc_") for n in tracked)
 

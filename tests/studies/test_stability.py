@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from drake_dock.studies import stability as S
-from drake_dock.systems.contact_system import ZenoError
+from drake_dock.errors import ZenoError
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.small_scenes import G, painleve_rod, stool
 

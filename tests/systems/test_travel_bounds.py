@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from drake_dock.studies.small_scenes import stool
-from drake_dock.systems.contact_system import FAR, PairState
+from drake_dock.core.hybrid import Mode
+from drake_dock.systems.contact_system import PairState
 
 
 def _random_rotation(rng, angle=None):
@@ -27,19 +28,20 @@ def test_far_pair_travel_bound_covers_every_point_of_the_patch():
     rng = np.random.default_rng(7)
     k = len(system.pairs)
     for trial in range(20):
-        poses0 = [(_random_rotation(rng), rng.normal(size=3)) for _ in system._frames]
+        poses0 = [(_random_rotation(rng), rng.normal(size=3)) for _ in system.evaluator.frames]
         scale = 10.0 ** rng.uniform(-4, 0)
         poses1 = [(_random_rotation(rng, scale * rng.uniform(0, 1)) @ R, p + scale
                    * rng.normal(size=3)) for R, p in poses0]
         states = []
         for i in range(k):
-            a, b = system._fidx[i]
+            a, b = system.evaluator.fidx[i]
             (R1, p1), (R2, p2) = poses0[a], poses0[b]
-            states.append(PairState(FAR, ref_X21=(R2.T @ R1, R2.T @ (p1 - p2))))
-        bounds = system._travel_bounds(list(range(k)), poses1, states)
+            states.append(PairState(Mode.FAR, ref_X21=(R2.T @ R1, R2.T @ (p1 - p2))))
+        far = system.evaluator.far
+        bounds = far.bounds(list(range(k)), poses1, states)
         for i, pair in enumerate(system.pairs):
             r = pair.patch1.position(pair.patch1.grid(61))
-            a, b = system._fidx[i]
+            a, b = system.evaluator.fidx[i]
             moved = []
             for poses in (poses0, poses1):
                 (R1, p1), (R2, p2) = poses[a], poses[b]
@@ -47,7 +49,7 @@ def test_far_pair_travel_bound_covers_every_point_of_the_patch():
             actual = np.linalg.norm(moved[1] - moved[0], axis=1).max()
             assert actual <= bounds[i]
             assert bounds[i] <= 3.0 * actual + 1e-12     # and not vacuous
-            assert bounds[i] == pytest.approx(system._travel_bound(i, poses1, states[i]),
+            assert bounds[i] == pytest.approx(far.bound(i, poses1, states[i]),
                                               rel=1e-14)
-    states[1] = PairState(FAR)
-    assert math.isinf(system._travel_bounds([0, 1, 2], poses1, states)[1])
+    states[1] = PairState(Mode.FAR)
+    assert math.isinf(far.bounds([0, 1, 2], poses1, states)[1])

@@ -1,0 +1,126 @@
+"""The contact system's data: the declared pairs, the options, the per-pair state (its `Mode`),
+the abstract state, one evaluation, and the layout of each couple's output port."""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from drake_dock.core.contact_law import ContactLaw
+from drake_dock.core.hybrid import Mode
+
+__all__ = ["COUPLE_FIELDS", "COUPLE_OUTPUT_SIZE", "COUPLE_SLICES", "ContactLaw", "ContactModes",
+           "ContactOptions", "ContactPair", "Evaluation", "PairState"]
+
+# Layout of each couple's output port; "status" is the pair's `Mode` (0 far, 1 tracked,
+# 2 sliding, 3 sticking).
+COUPLE_FIELDS = (("status", 1), ("gap", 1), ("vn", 1), ("lambda_n", 1), ("lambda_t", 2),
+                 ("vt", 2), ("u", 3), ("p1", 3), ("p2", 3), ("frame", 9))
+COUPLE_SLICES = {}
+_offset = 0
+for _name, _size in COUPLE_FIELDS:
+    COUPLE_SLICES[_name] = slice(_offset, _offset + _size)
+    _offset += _size
+COUPLE_OUTPUT_SIZE = _offset
+
+
+@dataclasses.dataclass
+class ContactPair:
+    """A declared pair: ``patch1`` (a curve) on ``frame1``, ``patch2`` (a curve for "CC", a
+    surface for "CS") on ``frame2``; the couple's normal points from body 2 to body 1.
+    ``sigma`` (+-1) fixes the orientation of n (Definition 2) when the scene knows it (a body
+    that starts resting on a plane); by default it is taken when the pair becomes potential,
+    from the side the patches are on."""
+
+    name: str
+    kind: str
+    frame1: object
+    patch1: object
+    frame2: object
+    patch2: object
+    sigma: float | None = None
+
+
+@dataclasses.dataclass
+class ContactOptions:
+    baumgarte: float = 20.0          # omega (rad/s) of the constraint stabilisation
+    drift_feedback: float = 50.0     # 1/s, feedback of the couple projection into u*
+    drift_tol: float = 1e-3          # largest projection step, relative to the domain span
+    track_distance: float = 0.02     # m: nearer interior isolated couples are tracked
+    reseek_floor: float = 1e-4       # m: smallest relative travel between two re-seeks
+    reseek_early: float = 0.9        # far pairs are sought again at the first step start where
+                                     # this fraction of their clearance is used (0: never)
+    conditioning_min: float = 1e-6   # |det J| / prod(row norms) below which J is singular
+    v_slip: float = 1e-6             # m/s: a couple slower than this may stick
+    zeno_speed: float = 1e-3         # m/s: the Zeno guard (`drake_dock.core.hybrid`)
+    impact_gap_tol: float = 1e-8     # m: couples this near join an impact
+    impact_rtol: float = 1e-10       # LZB's impulse-domain integration (`solve_lzb`); the
+                                     # docking diagram sets 1e-2 x the simulation accuracy
+    seek_rtol: float = 1e-7          # a seek's Newton ends when a step shortens the distance
+                                     # by less than this fraction, for pairs farther than
+                                     # track_distance (`seek_couple`): their distance only sets
+                                     # the clearance, which keeps track_distance / 2 in hand
+    max_impacts: int = 10000
+
+
+@dataclasses.dataclass
+class PairState:
+    mode: Mode = Mode.FAR
+    sigma: float = 1.0
+    slide_dir: np.ndarray | None = None   # unit sliding direction (SLIDING)
+    clearance: float = 0.0                # relative travel left before a seek (FAR)
+    ref_X21: tuple | None = None          # pose of frame 1 in frame 2 at the last seek
+    distance: float = math.inf            # distance at the last seek
+
+    def track(self):
+        """Enters TRACKED (from contact: the couple separates, or is left out of an impact)."""
+        self.mode, self.slide_dir = Mode.TRACKED, None
+
+
+@dataclasses.dataclass
+class ContactModes:
+    """The abstract state: per pair its `PairState`, and the impact log."""
+
+    pairs: list
+    impacts: list = dataclasses.field(default_factory=list)   # dicts: t, couples, impulses
+    impact_loss: float = 0.0
+    mode_changes: int = 0
+
+    def __deepcopy__(self, memo):
+        """Copies that events may change: the pair states are copied (their arrays are
+        replaced, never written in place); the impact log's entries are never changed once
+        logged, so the log is copied as a list of the same entries (Drake clones the abstract
+        state at every event)."""
+        return ContactModes([dataclasses.replace(st) for st in self.pairs], list(self.impacts),
+                            self.impact_loss, self.mode_changes)
+
+
+@dataclasses.dataclass
+class Evaluation:
+    """One evaluation of the contact dynamics at a context (`drake_dock.systems.evaluation`)."""
+
+    q: np.ndarray
+    v: np.ndarray
+    qdot: np.ndarray
+    vdot: np.ndarray
+    udot: np.ndarray
+    evals: list            # CoupleEval or None (far) per pair
+    lam_n: np.ndarray
+    lam_t: np.ndarray
+    contact_force: np.ndarray
+    friction_power: float
+    applied_power: float
+    external_power: float
+    bound: np.ndarray      # relative travel bound per far pair (NaN until asked)
+    witness: dict          # witness values computed at this evaluation, by (pair, kind)
+    poses: list
+    extra_power: np.ndarray
+    modes: object = None   # the ContactModes this evaluation was made with
+    xdot: np.ndarray = None  # the state's time derivative
+
+    def under(self, modes) -> Evaluation:
+        """This evaluation under other modes that differ only in far-pair data (a far pair
+        sought again at a step start): fresh travel bounds and witness values."""
+        return dataclasses.replace(self, modes=modes, witness={},
+                                   bound=np.full(len(self.bound), np.nan))

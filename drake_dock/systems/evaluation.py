@@ -1,0 +1,221 @@
+"""One evaluation of the contact dynamics, with the MultibodyPlant as calculator on a scratch
+context: the frames' poses and twists, the couples (Eq. 47), the contact rows W (Eq. 11) from
+Drake's Jacobians, the free acceleration, and the constraint forces of the contact set's modes
+(Eq. 48-52)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
+
+from drake_dock.core.constraints import SLIDE, STICK, ContactRow, solve_given_modes
+from drake_dock.core.couple import evaluate_couple, float_pose, float_vec
+from drake_dock.core.hybrid import Mode
+from drake_dock.errors import DriftError
+from drake_dock.systems.contact_types import Evaluation
+from drake_dock.systems.far_pairs import FarPairs
+
+KV = JacobianWrtVariable.kV
+
+
+def frame_list(pairs):
+    """The distinct frames of the pairs, and per pair the indices of its two frames."""
+    frames = []
+    for p in pairs:
+        for f in (p.frame1, p.frame2):
+            if all(f is not g for g in frames):
+                frames.append(f)
+    index = [(next(i for i, g in enumerate(frames) if g is p.frame1),
+              next(i for i, g in enumerate(frames) if g is p.frame2)) for p in pairs]
+    return frames, index
+
+
+class PlantEvaluator:
+    """The contact dynamics of ``pairs`` for a finalized continuous-time ``plant``. The state is
+    x = [q, v, u*, energy integrals]; pair i's couple is u*[uoff[i]:uoff[i + 1]]. ``inputs``
+    arguments are (generalized force or None, [(body, world wrench [torque, force])])."""
+
+    def __init__(self, plant, pairs, law, options, extra_powers=(), energy_scale=1.0):
+        self.plant, self.pairs, self.law, self.options = plant, list(pairs), law, options
+        self.extra_powers = list(extra_powers)
+        self.energy_scale = energy_scale
+        self.mu_s = law.static_mu
+        self.ctx = plant.CreateDefaultContext()
+        self.nq, self.nv = plant.num_positions(), plant.num_velocities()
+        dims = [p.patch1.dim + p.patch2.dim for p in pairs]
+        self.uoff = np.concatenate([[0], np.cumsum(dims)]).astype(int)
+        self.nu = int(self.uoff[-1])
+        self.ie = self.nq + self.nv + self.nu       # start of the energy integrals in x
+        self.spans = [np.concatenate([p.patch1.span, p.patch2.span]) for p in pairs]
+        # Per pair, (lower, upper, span) of its bounded parameters (u = (u1, u2)), in floats
+        # for the domain-end witness.
+        self.bounded = [[(float(lo), float(hi), float(hi - lo)) if not per else None
+                         for lo, hi, per in zip(np.concatenate([p.patch1.lower, p.patch2.lower]),
+                                                np.concatenate([p.patch1.upper, p.patch2.upper]),
+                                                p.patch1.periodic + p.patch2.periodic)]
+                        for p in pairs]
+        self.frames, self.fidx = frame_list(pairs)
+        self.far = FarPairs(pairs, self.fidx)
+        self.evaluations = 0
+        self._zero_v = np.zeros(self.nv)         # never written
+        self._world = plant.world_frame()
+        self._no_forces = MultibodyForces(plant)  # never written
+        self._forces_fe = MultibodyForces(plant)
+        self._forces_in = MultibodyForces(plant)
+
+    def couple_slice(self, i) -> slice:
+        return slice(self.uoff[i], self.uoff[i + 1])
+
+    def set_scratch(self, q, v):
+        self.plant.SetPositions(self.ctx, q)
+        self.plant.SetVelocities(self.ctx, v)
+        return self.ctx
+
+    def frame_kinematics(self, ctx):
+        """The frames' world poses (R, p) and twists (w, v)."""
+        poses, twists = [], []
+        for f in self.frames:
+            X = f.CalcPoseInWorld(ctx)
+            V = f.CalcSpatialVelocityInWorld(ctx)
+            poses.append((X.rotation().matrix(), X.translation()))
+            twists.append((V.rotational(), V.translational()))
+        return poses, twists
+
+    def couple(self, i, u, poses, twists, sigma, time):
+        """Pair i's couple at u (Eq. 47); `DriftError` when its projection step exceeds
+        ``drift_tol`` of the domain span."""
+        p = self.pairs[i]
+        a, b = self.fidx[i]
+        ev = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
+                             twists[b], u, sigma)
+        rel = np.abs(ev.drift) / self.spans[i]
+        if rel.max() > self.options.drift_tol:
+            raise DriftError(f"couple drift {rel.max():.3e} of the domain span exceeds "
+                             f"drift_tol = {self.options.drift_tol:g}", time=time,
+                             couples=[p.name])
+        return ev
+
+    def row(self, i, ev, poses, ctx):
+        """W^3, W^1, W^2 (Eq. 11) from Drake's point Jacobians and the bias terms (Eq. 52)."""
+        p = self.pairs[i]
+        a, b = self.fidx[i]
+        world = self._world
+        R1, o1 = poses[a]
+        R2, o2 = poses[b]
+        s1, s2 = (ev.p1 - o1) @ R1, (ev.p2 - o2) @ R2     # the points in their frames
+        plant = self.plant
+        J = (plant.CalcJacobianTranslationalVelocity(ctx, KV, p.frame1, s1, world, world)
+             - plant.CalcJacobianTranslationalVelocity(ctx, KV, p.frame2, s2, world, world))
+        ab = (plant.CalcBiasTranslationalAcceleration(ctx, KV, p.frame1, s1, world, world)
+              - plant.CalcBiasTranslationalAcceleration(ctx, KV, p.frame2, s2, world, world))
+        D = np.array([ev.n, ev.ta, ev.tb]).T          # columns n, ta, tb
+        W = J.T @ D
+        b = D.T @ ab.ravel()
+        return ContactRow(p.name, W[:, 0], W[:, 1:], ev.bias_n + b[0], ev.bias_t + b[1:],
+                          ev.gap, ev.vn, ev.vt, self.law.mu, self.mu_s)
+
+    def free_acceleration(self, ctx, v, inputs):
+        """M, M^-1, a0 = M^-1 tau (every force but contact), and the power of the plant's
+        force elements and of the inputs. Drake's inverse dynamics at zero acceleration gives
+        C(q, v) v - tau for any set of forces."""
+        zero = self._zero_v
+        ID = self.plant.CalcInverseDynamics
+        bias = ID(ctx, zero, self._no_forces)
+        fe = self._forces_fe     # set, not added, by CalcForceElementsContribution
+        self.plant.CalcForceElementsContribution(ctx, fe)
+        tau_el = bias - ID(ctx, zero, fe)
+        tau_in = np.zeros(self.nv)
+        generalized, wrenches = inputs
+        if generalized is not None:
+            tau_in += generalized
+        wf = self._forces_in
+        for k, (body, w) in enumerate(wrenches):
+            if k == 0:
+                wf.SetZero()
+            body.AddInForce(ctx, np.zeros(3), SpatialForce(w[:3], w[3:]), self._world, wf)
+        if wrenches:
+            tau_in += bias - ID(ctx, zero, wf)
+        M = self.plant.CalcMassMatrix(ctx)
+        Minv = np.linalg.inv(M)
+        return M, Minv, Minv @ (tau_el + tau_in - bias), float(tau_el @ v), float(tau_in @ v)
+
+    def key(self, t, x, modes, inputs) -> tuple:
+        """Everything an evaluation depends on: time, the continuous state (the bodies' and the
+        tracked couples' u*; a far pair's u* and its far-pair data are not used), the modes of
+        the pairs that are not far, and the inputs."""
+        x = x[:self.ie].copy()
+        base = self.nq + self.nv
+        sig = []
+        for i, st in enumerate(modes.pairs):
+            if st.mode == Mode.FAR:
+                x[base + self.uoff[i]:base + self.uoff[i + 1]] = 0.0
+            else:
+                sig.append((i, st.mode, st.sigma, None if st.slide_dir is None
+                            else np.asarray(st.slide_dir, dtype=float).tobytes()))
+        generalized, wrenches = inputs
+        key = [t, x.tobytes(), tuple(sig)]
+        if generalized is not None:
+            key.append(generalized.tobytes())
+        key += [w.tobytes() for _, w in wrenches]
+        return tuple(key)
+
+    def evaluate(self, t, x, modes, inputs) -> Evaluation:
+        """The evaluation at time t, state x, `ContactModes` modes and inputs."""
+        self.evaluations += 1
+        q, v, u = x[:self.nq], x[self.nq:self.nq + self.nv], x[self.nq + self.nv:self.ie]
+        ctx = self.set_scratch(q, v)
+        poses, twists = self.frame_kinematics(ctx)
+        # The couples work in plain floats: the frames' poses and twists converted once.
+        fposes = [float_pose(X) for X in poses]
+        ftwists = [(float_vec(w), float_vec(v)) for w, v in twists]
+        k = len(self.pairs)
+        evals = [None] * k
+        udot = np.zeros(self.nu)
+        rows, row_pairs, smodes, dirs = [], [], [], []
+        for i, st in enumerate(modes.pairs):
+            sl = self.couple_slice(i)
+            if st.mode == Mode.FAR:
+                continue
+            ev = self.couple(i, u[sl], fposes, ftwists, st.sigma, t)
+            evals[i] = ev
+            udot[sl] = ev.udot + self.options.drift_feedback * ev.drift
+            if st.mode.in_contact:
+                rows.append(self.row(i, ev, poses, ctx))
+                row_pairs.append(i)
+                if st.mode == Mode.STICKING:
+                    smodes.append(STICK)
+                    dirs.append(None)
+                else:
+                    smodes.append(SLIDE)
+                    s = math.hypot(*ev.vt)
+                    dirs.append(ev.vt / s if s > self.options.v_slip or st.slide_dir is None
+                                else st.slide_dir)
+        M, Minv, a0, p_plant, p_in = self.free_acceleration(ctx, v, inputs)
+        sol = solve_given_modes(Minv, a0, rows, smodes, dirs, omega=self.options.baumgarte,
+                                time=t)
+        lam_n, lam_t = np.zeros(k), np.zeros((k, 2))
+        for j, i in enumerate(row_pairs):
+            lam_n[i], lam_t[i] = sol.lam_n[j], sol.lam_t[j]
+        qdot = self.plant.MapVelocityToQDot(ctx, v)
+        E = Evaluation(q, v, qdot, sol.vdot, udot, evals, lam_n, lam_t, sol.generalized_force,
+                       sol.power_lost_to_friction(rows), p_plant, p_in, np.full(k, np.nan), {},
+                       poses, np.array([f(q, v) for _, f in self.extra_powers], dtype=float),
+                       modes)
+        E.xdot = np.concatenate([qdot, E.vdot, udot, np.array(
+            [E.friction_power, E.applied_power, E.external_power, *E.extra_power])
+            / self.energy_scale])
+        return E
+
+    def bound(self, E, i, st):
+        """The travel bound of far pair i at the evaluation E, computed when a witness or an
+        output asks for it (derivative evaluations do not need it): all far pairs' at once."""
+        if math.isnan(E.bound[i]):
+            pairs = E.modes.pairs
+            if pairs[i] is not st:      # not E's own state of pair i
+                return self.far.bound(i, E.poses, st)
+            idx = [k for k, sk in enumerate(pairs)
+                   if sk.mode == Mode.FAR and math.isnan(E.bound[k])]
+            E.bound[idx] = self.far.bounds(idx, E.poses, pairs)
+        return E.bound[i]

@@ -1,0 +1,74 @@
+"""The far pairs' travel bound (Sect. 5.1): a conservative bound of the travel of patch 1
+relative to frame 2 since the pair's last seek, compared with its clearance."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def bounding_sphere(patch, n=41):
+    """(c, r): a sphere, in the patch's frame, that holds the patch."""
+    pts = patch.position(patch.grid(n))
+    c = 0.5 * (pts.min(axis=0) + pts.max(axis=0))
+    r = float(np.linalg.norm(pts - c, axis=1).max())
+    return c, 1.02 * r + 1e-9
+
+
+def relative_pose(pose1, pose2):
+    """X21 = (R2^T R1, R2^T (p1 - p2)): the pose of frame 1 in frame 2."""
+    (R1, p1), (R2, p2) = pose1, pose2
+    return R2.T @ R1, R2.T @ (p1 - p2)
+
+
+def travel_bounds(X21, X21_ref, centres, radii):
+    """|delta(X21 c1)| + |delta R21|_2 r1 per pair, for the current and reference relative poses
+    (lists of (R21, p21)) and the bounding spheres (c1, r1) of the pairs' patches 1."""
+    R21 = np.array([R for R, _ in X21])
+    p21 = np.array([p for _, p in X21])
+    R0 = np.array([R for R, _ in X21_ref])
+    p0 = np.array([p for _, p in X21_ref])
+    lin = np.einsum("kij,kj->ki", R21 - R0, centres) + p21 - p0
+    # |R21 - R0|_2 = |R0^T R21 - I|_2 = 2 sin(theta / 2) = sqrt(3 - tr(R0^T R21)).
+    rot = np.sqrt(np.maximum(3.0 - np.einsum("kij,kij->k", R0, R21), 0.0))
+    return np.sqrt(np.einsum("ki,ki->k", lin, lin)) + rot * radii
+
+
+class FarPairs:
+    """The travel bounds of a system's far pairs: ``frame_index`` (frame 1, frame 2) per pair
+    and the bounding spheres of the pairs' patches 1."""
+
+    def __init__(self, pairs, frame_index):
+        self.frame_index = frame_index
+        spheres = [bounding_sphere(p.patch1) for p in pairs]
+        self.centres = np.array([c for c, _ in spheres]).reshape(-1, 3)
+        self.radii = np.array([r for _, r in spheres])
+
+    def reference(self, i, poses):
+        """The relative pose of pair i kept at a seek."""
+        a, b = self.frame_index[i]
+        return relative_pose(poses[a], poses[b])
+
+    def bounds(self, idx, poses, states):
+        """Travel bounds of the far pairs ``idx`` (their `PairState`s in ``states``) at
+        ``poses``, at once; inf for a pair never sought."""
+        out = np.full(len(idx), math.inf)
+        known = [k for k, i in enumerate(idx) if states[i].ref_X21 is not None]
+        if not known:
+            return out
+        ids = [idx[k] for k in known]
+        rel = {}
+        for i in ids:
+            ab = self.frame_index[i]
+            if ab not in rel:
+                rel[ab] = relative_pose(poses[ab[0]], poses[ab[1]])
+        out[known] = travel_bounds([rel[self.frame_index[i]] for i in ids],
+                                   [states[i].ref_X21 for i in ids], self.centres[ids],
+                                   self.radii[ids])
+        return out
+
+    def bound(self, i, poses, state):
+        """The travel bound of one far pair i in ``state``."""
+        states = [None] * len(self.frame_index)
+        states[i] = state
+        return float(self.bounds([i], poses, states)[0])

@@ -1,0 +1,46 @@
+"""Where a run's wall time goes: the contact system's parts, measured by a context manager."""
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+from time import perf_counter
+
+PARTS = ("seeking", "contact_dynamics", "impacts")
+
+
+@dataclasses.dataclass
+class Timing:
+    """Cumulative wall time (s) of the contact system's parts (reset with `reset`): seeking
+    (Sect. 5.1, the hierarchical grid and Newton, per pair with the number of seeks), contact
+    dynamics (every derivative evaluation: couple tracking, Eq. 47, the constraint forces) and
+    impacts (LZB and the mode selection at events). Only the declared pairs are ever searched."""
+
+    pairs: list
+    seeking: float = 0.0
+    contact_dynamics: float = 0.0
+    impacts: float = 0.0
+    seeks: dict = dataclasses.field(default_factory=dict)
+
+    def reset(self):
+        self.seeking = self.contact_dynamics = self.impacts = 0.0
+        self.seeks = {}
+
+    @contextlib.contextmanager
+    def measure(self, part: str):
+        """Adds the wall time of the ``with`` block to ``part`` (one of `PARTS`)."""
+        t0 = perf_counter()
+        try:
+            yield
+        finally:
+            setattr(self, part, getattr(self, part) + perf_counter() - t0)
+
+    def count_seek(self, pair: str):
+        self.seeks[pair] = self.seeks.get(pair, 0) + 1
+
+    def shares(self, wall_time: float) -> dict:
+        """The three parts and the rest (Drake's integrator, witnesses, logging) as fractions of
+        ``wall_time``, with the pairs declared and the seeks per pair."""
+        out = {k: getattr(self, k) / wall_time for k in PARTS}
+        out["other"] = max(0.0, 1.0 - sum(out.values()))
+        return {"wall_time": wall_time, "shares": out, "pairs_declared": len(self.pairs),
+                "seeks_per_pair": {n: self.seeks.get(n, 0) for n in self.pairs}}

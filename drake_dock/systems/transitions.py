@@ -1,0 +1,232 @@
+"""The contact system's events: every transition due at a state (module docstring of
+`drake_dock.systems.contact_system`), with the decisions made by `drake_dock.core.hybrid`."""
+from __future__ import annotations
+
+import copy
+import os
+
+import numpy as np
+
+from drake_dock.core import hybrid
+from drake_dock.core.constraints import select_modes
+from drake_dock.core.couple import closest_point_conditions, evaluate_couple
+from drake_dock.core.hybrid import Mode
+from drake_dock.core.lzb.solve import solve_lzb
+from drake_dock.core.patches import posed
+from drake_dock.core.seeking import seek_couple
+from drake_dock.errors import (InputError, NumericalError, SeekingError, SingularCoupleError,
+                               ZenoError)
+
+
+class Transitions:
+    """The transitions of the pairs of a `PlantEvaluator` ``ev``, timed into ``timing``."""
+
+    def __init__(self, ev, timing):
+        self.ev, self.timing = ev, timing
+        self.pairs, self.law, self.options = ev.pairs, ev.law, ev.options
+
+    def resolve(self, t, x, modes, inputs, current, early=1.0):
+        """All the transitions due at time t and state x from `ContactModes` ``modes``;
+        returns (x, modes). ``current()`` gives the evaluation at (t, x, modes). Far pairs are
+        sought again when their travel bound reaches ``early`` x their clearance."""
+        ev, opt = self.ev, self.options
+        modes = copy.deepcopy(modes)
+        modes.mode_changes += 1
+        q = x[:ev.nq]
+        v = x[ev.nq:ev.nq + ev.nv].copy()
+        u = x[ev.nq + ev.nv:ev.ie].copy()
+        ctx = ev.set_scratch(q, v)
+        poses, twists = ev.frame_kinematics(ctx)
+        initial = all(st.ref_X21 is None and st.mode == Mode.FAR for st in modes.pairs)
+        # 1. Seeking: at initialisation, for far pairs whose clearance is used up, and for
+        #    couples at a domain end or with a singular Jacobian.
+        for i, st in enumerate(modes.pairs):
+            sl = ev.couple_slice(i)
+            if initial or (st.mode == Mode.FAR
+                           and ev.far.bound(i, poses, st) >= early * st.clearance):
+                self.seek(i, poses, st, u, t, False, initial)
+                continue
+            if st.mode == Mode.FAR:
+                continue
+            p = self.pairs[i]
+            a, b = ev.fidx[i]
+            c = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
+                                twists[b], u[sl], st.sigma)
+            u[sl] = c.u
+            margin = np.concatenate([p.patch1.margin(c.u[:p.patch1.dim]),
+                                     p.patch2.margin(c.u[p.patch1.dim:])]) / ev.spans[i]
+            if c.conditioning <= opt.conditioning_min and st.mode.in_contact:
+                raise SingularCoupleError(
+                    f"the Jacobian of a couple in contact turned singular (Eq. 39 fails; "
+                    f"conditioning {c.conditioning:.2e})", time=t, couples=[p.name])
+            if margin.min() <= 0.0 or c.conditioning <= opt.conditioning_min:
+                self.seek(i, poses, st, u, t, st.mode.in_contact)
+        # 2. Impacts and 3. modes.
+        n_impacts = len(modes.impacts)
+        with self.timing.measure("impacts"):
+            v = self.impacts_and_modes(t, modes, ctx, q, v, u, inputs, current)
+        x_new = x.copy()
+        x_new[ev.nq:ev.nq + ev.nv] = v
+        x_new[ev.nq + ev.nv:ev.ie] = u
+        if len(modes.impacts) > n_impacts:
+            # The states just before and just after the impact (for loggers: a step-end
+            # sample is the state before; this event's result is not seen by any step end).
+            modes.impacts[-1].update(x_minus=x.copy(), x_plus=x_new.copy(),
+                                     pairs_plus=copy.deepcopy(modes.pairs),
+                                     impact_loss_plus=modes.impact_loss)
+        return x_new, modes
+
+    def seek(self, i, poses, st, u, time, was_contact, initial=False):
+        """Sect. 5.1 for pair i (its `PairState` st, its couple written into u), and the mode
+        that follows (`hybrid.after_seek`). At the initial seek a pair with a declared
+        ``sigma`` whose couple lies on the wrong side by more than ``impact_gap_tol`` is
+        refused: the bodies start interpenetrating."""
+        name = self.pairs[i].name
+        with self.timing.measure("seeking"):
+            try:
+                self._seek(i, poses, st, u, time, was_contact, initial)
+            finally:
+                self.timing.count_seek(name)
+
+    def _seek(self, i, poses, st, u, time, was_contact, initial):
+        ev, opt, p = self.ev, self.options, self.pairs[i]
+        a, b = ev.fidx[i]
+        try:
+            c = seek_couple(posed(p.patch1, *poses[a]), posed(p.patch2, *poses[b]),
+                            distance_rtol=opt.seek_rtol, rtol_beyond=opt.track_distance)
+        except SeekingError as e:
+            raise SeekingError(str(e), time=time, couples=[p.name]) from None
+        st.ref_X21 = ev.far.reference(i, poses)
+        st.distance = c.distance
+        _, _, cond = closest_point_conditions(p.kind, p.patch1, poses[a], p.patch2, poses[b],
+                                              c.u, conditioning=True)
+        usable = c.interior and cond > 10 * opt.conditioning_min     # interior and isolated
+        uc = c.u
+        crossing = False
+        if usable:
+            # Finish on the contact form (the distance's gradient is flat at a tangent touch).
+            for _ in range(20):
+                F, Fu = closest_point_conditions(p.kind, p.patch1, poses[a], p.patch2,
+                                                 poses[b], uc)
+                uc = uc - np.linalg.solve(Fu, F)
+                if np.abs(F).max() <= 1e-15 * (1.0 + np.abs(Fu).max()):
+                    break
+            gap = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
+                                  poses[b], (np.zeros(3),) * 2, uc, 1.0, project=False).gap
+            sigma = hybrid.couple_sigma(p.sigma, gap)
+            crossing = hybrid.patches_cross(gap, c.distance, sigma, opt.impact_gap_tol)
+            if initial and p.sigma is not None and (sigma * gap < -opt.impact_gap_tol or (
+                    crossing and c.distance <= opt.impact_gap_tol)):
+                # The scene declares the sides: a couple on the wrong side, or patches that
+                # intersect, is a body started inside another.
+                value = (f"signed gap {sigma * gap:.6g} m" if sigma * gap < 0.0
+                         else f"patches intersecting (distance {c.distance:.3g} m)")
+                raise InputError(f"initial state of pair {p.name}", value,
+                                 f"signed gap >= -impact_gap_tol = {-opt.impact_gap_tol:g} m",
+                                 "the bodies start interpenetrating")
+        u[ev.couple_slice(i)] = uc
+        mode, clearance = hybrid.after_seek(c.distance, usable, crossing, was_contact,
+                                            opt.track_distance, opt.reseek_floor)
+        if mode == Mode.TRACKED:
+            st.sigma = sigma
+        else:
+            st.clearance = clearance
+        st.mode, st.slide_dir = mode, None
+
+    def impacts_and_modes(self, t, modes, ctx, q, v, u, inputs, current):
+        """2. The LZB impact of the couples hit (Sect. 6) and 3. the modes of the contact set
+        (Eq. 48-52), then the velocity projection onto the new constraints; returns v."""
+        ev, opt = self.ev, self.options
+        states = modes.pairs
+        evs = {}
+
+        def evaluate_all(v):
+            ev.set_scratch(q, v)
+            ps, tw = ev.frame_kinematics(ctx)
+            for i, st in enumerate(states):
+                if st.mode != Mode.FAR:
+                    evs[i] = ev.couple(i, u[ev.couple_slice(i)], ps, tw, st.sigma, t)
+            return ps
+
+        def gaps_and_rates():
+            return ([evs[i].gap if i in evs else np.nan for i in range(len(states))],
+                    [evs[i].vn if i in evs else np.nan for i in range(len(states))])
+
+        # Modes the contact couples are leaving (their witness crossed zero).
+        leaving = {}
+        if any(st.mode.in_contact for st in states):
+            E = current()
+            leaving = {i: hybrid.modes_left(st.mode, E.lam_n[i], E.lam_t[i], ev.mu_s)
+                       for i, st in enumerate(states) if st.mode.in_contact}
+        poses = evaluate_all(v)
+        gap, vn = gaps_and_rates()
+        hit = hybrid.impact_hits([st.mode for st in states], gap, vn, opt.impact_gap_tol)
+        closed = []
+        if hit:
+            if len(modes.impacts) >= opt.max_impacts:
+                raise ZenoError(f"more than max_impacts = {opt.max_impacts} impacts",
+                                time=t, couples=[self.pairs[i].name for i in hit])
+            S = hybrid.impact_set(hit, [st.mode for st in states], vn)
+            v, vn_plus, approach = self.impact(t, modes, ctx, poses, evs, S, v)
+            for i, c in zip(S, hybrid.closed_after_impact(vn_plus, approach)):
+                if c:
+                    closed.append(i)       # closed at the end of the impact: in contact
+                else:
+                    states[i].track()      # separating
+            poses = evaluate_all(v)
+            gap, vn = gaps_and_rates()
+        new, cand = hybrid.contact_candidates([st.mode for st in states], gap, vn, bool(hit),
+                                              closed, opt.impact_gap_tol, opt.v_slip)
+        for st, m in zip(states, new):
+            if m != st.mode:
+                st.track()
+        ev.set_scratch(q, v)
+        rows = [ev.row(i, evs[i], poses, ctx) for i in cand]
+        M, Minv, a0, _, _ = ev.free_acceleration(ctx, v, inputs)
+        sol = select_modes(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
+                           avoid=[() if hit else leaving.get(i, ()) for i in cand])
+        cons = []
+        for j, i in enumerate(cand):
+            st = states[i]
+            st.mode = Mode.of_selection(sol.modes[j])
+            st.slide_dir = (np.asarray(sol.dirs[j], dtype=float) if st.mode == Mode.SLIDING
+                            else None)
+            if st.mode.in_contact:
+                cons.append(rows[j].Wn)
+                if st.mode == Mode.STICKING:
+                    cons += [rows[j].Wt[:, 0], rows[j].Wt[:, 1]]
+        if cons:
+            # The mode is entered at a witness's zero, located to within the integrator's
+            # accuracy; the residual relative velocity (below v_slip or the impact tolerance) is
+            # removed by the projection, and the energy it removes (of the order of the
+            # residual squared) is booked with the impacts.
+            v, removed = hybrid.project_velocity(M, Minv, np.column_stack(cons), v)
+            modes.impact_loss += removed
+        return v
+
+    def impact(self, t, modes, ctx, poses, evs, S, v):
+        """The LZB impact of the couples S (Sect. 6, with the Zeno guard), logged in
+        ``modes``; returns (v+, the couples' v_n+, the approach speed)."""
+        ev, opt, law = self.ev, self.options, self.law
+        rows = [ev.row(i, evs[i], poses, ctx) for i in S]
+        Wn = np.column_stack([r.Wn for r in rows])
+        Wt = np.column_stack([r.Wt for r in rows])
+        M = ev.plant.CalcMassMatrix(ctx)
+        approach = float(-min(r.vn for r in rows))
+        e = hybrid.zeno_restitution(approach, law.restitution, opt.zeno_speed)
+        try:
+            res = solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt, mu=law.mu,
+                            mu_s=ev.mu_s, law=law.impact_law, rtol=opt.impact_rtol)
+        except NumericalError as err:
+            if os.environ.get("DRAKE_DOCK_DUMP_LZB"):
+                np.savez(os.environ["DRAKE_DOCK_DUMP_LZB"], M=M, Wn=Wn, Wt=Wt, v=v, e=e)
+            raise NumericalError(f"{err} (approach speed {approach:.3e} m/s)", time=t,
+                                 couples=[self.pairs[i].name for i in S]) from None
+        lost = res.kinetic_energy_minus - res.kinetic_energy_plus
+        modes.impacts.append({"t": t, "couples": [self.pairs[i].name for i in S],
+                              "restitution": e,
+                              "normal_impulse": res.normal_impulse.tolist(),
+                              "tangential_impulse": res.tangential_impulse.tolist(),
+                              "energy_lost": lost})
+        modes.impact_loss += lost
+        return res.v_plus, Wn.T @ res.v_plus, approach
