@@ -80,9 +80,10 @@ def main(argv=None) -> int:
                        help="override simulation.duration (s)")
     run_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     study_p = sub.add_parser("study", help="run a study")
-    study_p.add_argument("which", choices=["speed-accuracy", "stability"],
+    study_p.add_argument("which", choices=["speed-accuracy", "stability", "conditions"],
                          help="speed-accuracy: drake_dock against Drake's compliant contact; "
-                              "stability: the five cases where methods fail")
+                              "stability: the five cases where methods fail; conditions: "
+                              "seeded conditions in the IDSS initial-contact box")
     study_p.add_argument("scenario", nargs="?", default=str(PAPER_EXAMPLE),
                          help="scenario YAML (default: the paper's example)")
     study_p.add_argument("--out", required=True, help=OUT_HELP)
@@ -150,7 +151,12 @@ def _failed(code, kind, e, caught, finish) -> int:
 def _study(args) -> int:
     from drake_dock.docking.output import check_destination
     from drake_dock.docking.scenario import load_scenario
-    if args.which == "stability":
+    if args.which == "conditions":
+        from drake_dock.studies.conditions import ConditionsPlan as Plan
+        from drake_dock.studies.conditions import run_conditions as run_plan
+        from drake_dock.studies.conditions import summary_lines as lines
+        from drake_dock.studies.conditions import write_conditions as write
+    elif args.which == "stability":
         from drake_dock.studies.stability import StabilityPlan as Plan
         from drake_dock.studies.stability import run_stability as run_plan
         from drake_dock.studies.stability import summary_lines as lines

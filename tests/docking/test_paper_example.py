@@ -9,6 +9,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from drake_dock.core.patches import posed
+from drake_dock.docking.penetration import deepest_penetration
 from drake_dock.docking.scene import apds_pairs
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 
@@ -213,3 +214,11 @@ def test_replay_plays_in_headless_chromium(runs):
     assert blue.mean() > 1e-3 and orange.mean() > 1e-3
     assert (np.abs(a - b).sum(-1) > 10).mean() > 1e-3       # it plays
     assert errors == []
+
+
+def test_no_feature_enters_a_solid_of_the_other_apds(runs):
+    """The independent interpenetration check (`drake_dock.docking.penetration`) over the whole
+    run: the couples keep every ring edge, guide side and tip arc out of the other APDS."""
+    ts, g = runs["ts"], runs["scenario"].geometry
+    pen = deepest_penetration(g, ts["t"], ts["R_WA"], ts["p_WA"], ts["apds_names"].tolist())
+    assert pen.depth < 1e-6, pen.describe()

@@ -1,0 +1,168 @@
+"""An interpenetration check of two APDS over a run, independent of the contact code.
+
+Written from the paper's geometry (Sect. 4) with its own formulas, it uses no patch, couple or
+seek of `drake_dock.core`. Each APDS is a set of solids in its own frame (cylindrical rho, theta,
+zeta; e3 along the docking axis, ring face at zeta = 0):
+- petal k (k = 1..3): the material behind its guide surface, the cone
+  rho = R - zeta cot(alpha1) (Eq. 12) between its two guide sides (the angular inset theta_1 of
+  Eq. 13), 0 <= zeta <= H, to ``petal_depth`` below the surface (towards the axis);
+- the ring: the annulus Rs <= rho <= R of depth ``ring_depth`` below the ring face.
+The other APDS's features are sampled as points: the ring's inside and outside circles and its
+face, the six guide sides (Eq. 14) and the three petal tip arcs (zeta = H). A point inside a
+solid lies at a depth, its distance to the nearest face of that solid through which it could
+have entered (the guide surface, a side, the tip; the ring's face or its walls). Checked: guide
+sides, tip arcs and the ring's inside circle against the other APDS's petals; the ring's
+circles and face against the other ring. A petal passing through the other ring's annulus (so
+also the ring's face and outside circle against the other's petal roots) is the paper's reading
+(docs/model.md) and is not checked.
+
+Between two samples of the run the relative pose is interpolated (translation linearly, rotation
+along its geodesic) in sub-steps that move no feature point more than ``max_travel``, so that a
+feature crossing a solid between two samples is seen inside it.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from drake_dock.docking.scene import rot_vec
+
+
+@dataclasses.dataclass
+class Penetration:
+    """The deepest point found: its depth (m; 0 when none), the time, and which feature of which
+    APDS lay inside which solid of the other."""
+
+    depth: float = 0.0
+    time: float = math.nan
+    feature: str = ""
+    solid: str = ""
+
+    def describe(self) -> str:
+        if self.depth == 0.0:
+            return "no interpenetration"
+        return (f"{self.feature} {self.depth * 1e3:.3g} mm inside {self.solid} at "
+                f"t = {self.time:.6g} s")
+
+
+def _inset(g, zeta):
+    """Eq. (13): theta_1(zeta) = arcsin(R sin(alpha2) / rho(zeta)) - alpha2."""
+    rho = g.R - zeta / math.tan(g.alpha1)
+    return np.arcsin(np.clip(g.R * math.sin(g.alpha2) / rho, -1.0, 1.0)) - g.alpha2
+
+
+def feature_points(g, *, n_circle=1440, n_side=80, n_arc=60, n_face=9):
+    """{feature name: (M, 3) points in the APDS frame}."""
+    th = np.linspace(0.0, 2 * math.pi, n_circle, endpoint=False)
+    c, s = np.cos(th), np.sin(th)
+
+    def circle(r, z=0.0):
+        return np.stack([r * c, r * s, np.full_like(th, z)], -1)
+
+    out = {"ring inside circle": circle(g.Rs), "ring outside circle": circle(g.R)}
+    out["ring face"] = np.concatenate([circle(r)[::4] for r in np.linspace(g.Rs, g.R, n_face)])
+    A, tan1 = g.R * math.sin(g.alpha2), math.tan(g.alpha1)
+    end = float(_inset(g, g.H))
+    for i in range(1, 7):                          # Eq. (14), sine form
+        phi, sigma = (i - 1) * math.pi / 3, (1 if i % 2 else -1)
+        t = phi + sigma * np.linspace(0.0, end, n_side)
+        rho = A / np.sin(g.alpha2 + sigma * (t - phi))
+        out[f"guide side {i}"] = np.stack([rho * np.cos(t), rho * np.sin(t),
+                                           (g.R - rho) * tan1], -1)
+    r_tip = g.R - g.H / tan1
+    for k in (1, 2, 3):
+        phi = (2 * k - 2) * math.pi / 3
+        t = np.linspace(phi + end, phi + math.pi / 3 - end, n_arc)
+        out[f"petal {k} tip arc"] = np.stack([r_tip * np.cos(t), r_tip * np.sin(t),
+                                              np.full_like(t, g.H)], -1)
+    return out
+
+
+def petal_depth_of(g, X, k, petal_depth):
+    """Depth of each point X (M, 3), in the APDS frame, inside petal k's solid (<= 0: outside)."""
+    rho = np.hypot(X[:, 0], X[:, 1])
+    zeta = X[:, 2]
+    sa, ca = math.sin(g.alpha1), math.cos(g.alpha1)
+    s = (rho - g.R) * sa + zeta * ca                # signed distance to the cone, outward > 0
+    rho_f, zeta_f = rho - s * sa, zeta - s * ca       # foot on the cone
+    phi = (2 * k - 2) * math.pi / 3
+    inset = _inset(g, np.clip(zeta_f, 0.0, g.H))
+    dth = np.mod(np.arctan2(X[:, 1], X[:, 0]) - phi + math.pi, 2 * math.pi) - math.pi
+    to_side = np.minimum(dth - inset, math.pi / 3 - inset - dth) * rho_f
+    along = np.minimum(zeta_f, g.H - zeta_f) / sa     # along the generatrix to bottom or tip
+    return np.minimum.reduce([-s, petal_depth + s, to_side, along])
+
+
+def ring_depth_of(g, X, ring_depth):
+    rho = np.hypot(X[:, 0], X[:, 1])
+    return np.minimum.reduce([-X[:, 2], X[:, 2] + ring_depth, rho - g.Rs, g.R - rho])
+
+
+def _rotvec(R):
+    """Rotation vector of R (log map), for interpolation."""
+    c = np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0)
+    a = math.acos(c)
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    if a < 1e-12:
+        return 0.5 * w
+    if a > math.pi - 1e-6:                          # near a half turn: from R + I
+        k = np.sqrt(np.maximum((np.diag(R) + 1.0) / 2.0, 0.0))
+        k *= np.where(np.sign(w) == 0, 1.0, np.sign(w))
+        return a * k / np.linalg.norm(k)
+    return a / (2.0 * math.sin(a)) * w
+
+
+def relative_poses(R_WA, p_WA, a, b):
+    """Pose (R, p) of APDS a in APDS b's frame at each sample."""
+    Rb_T = np.swapaxes(R_WA[:, b], -1, -2)
+    return Rb_T @ R_WA[:, a], np.einsum("nij,nj->ni", Rb_T, p_WA[:, a] - p_WA[:, b])
+
+
+def deepest_penetration(g, t, R_WA, p_WA, names, *, petal_depth=0.05, ring_depth=0.04,
+                        max_travel=1e-3, features=None) -> Penetration:
+    """The deepest interpenetration of the two APDS over the samples t (N,) with their frames'
+    poses R_WA (N, 2, 3, 3), p_WA (N, 2, 3) (the timeseries fields), names the two APDS names;
+    ``features`` replaces `feature_points` (a subset, for tests)."""
+    feats = feature_points(g) if features is None else features
+    reach = max(float(np.linalg.norm(X, axis=1).max()) for X in feats.values())
+    best = Penetration()
+    for a, b in ((0, 1), (1, 0)):
+        R, p = relative_poses(R_WA, p_WA, a, b)
+        for n in range(len(t)):
+            if n == 0:
+                steps = [(t[0], R[0], p[0])]
+            else:
+                dR = R[n - 1].T @ R[n]
+                r = _rotvec(dR)
+                travel = np.linalg.norm(p[n] - p[n - 1]) + np.linalg.norm(r) * reach
+                m = max(1, int(math.ceil(travel / max_travel)))
+                steps = [(t[n - 1] + (t[n] - t[n - 1]) * f, R[n - 1] @ rot_vec(f * r),
+                          p[n - 1] + f * (p[n] - p[n - 1]))
+                         for f in np.arange(1, m + 1) / m]
+            for tt, Rab, pab in steps:
+                best = _deepest_at(g, feats, Rab, pab, tt, names[a], names[b], best,
+                                   petal_depth, ring_depth)
+    return best
+
+
+# The ring's face and outside circle overlap the other APDS's petal roots near capture (the
+# paper's reading: a petal passes the other ring's annulus); its inside circle does not.
+CHECKED_AGAINST_PETALS = ("ring inside circle",)
+
+
+def _deepest_at(g, feats, R, p, t, name_a, name_b, best, petal_depth, ring_depth):
+    for fname, X in feats.items():
+        Y = X @ R.T + p
+        solids = []
+        if fname in CHECKED_AGAINST_PETALS or not fname.startswith("ring"):
+            solids += [(f"{name_b} petal {k}", petal_depth_of(g, Y, k, petal_depth))
+                       for k in (1, 2, 3)]
+        if fname.startswith("ring"):
+            solids.append((f"{name_b} ring", ring_depth_of(g, Y, ring_depth)))
+        for sname, depth in solids:
+            d = float(depth.max())
+            if d > best.depth:
+                best = Penetration(d, float(t), f"{name_a} {fname}", sname)
+    return best

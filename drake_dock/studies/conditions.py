@@ -1,0 +1,231 @@
+"""The working-conditions sweep (`drake-dock study conditions`): seeded random conditions inside
+the International Docking System Standard's initial-contact box, and corners of it, each run to
+its outcome and checked by the independent interpenetration check
+(`drake_dock.docking.penetration`).
+
+The box (docs/model.md, "Initial conditions"): closing rate 0.05-0.10 m/s; lateral
+misalignment |offset| <= 0.10 m; lateral rate |v| <= 0.04 m/s; pitch and yaw (the tilt's two
+components) within 4 deg each; roll (the relative yaw about the axis) within 4 deg; angular
+rates within 0.2 deg/s about each axis. Random conditions are uniform over the box (the disks
+uniform by area); a corner puts every parameter at an extreme, with seeded signs and
+directions. The base scenario gives everything else.
+
+One row per run: the inputs, the outcome (captured, rebound, jammed, timeout, or `error` with
+the typed error's class and message), capture time, impacts, peak contact force, momentum drift,
+the energy ledger's closure, the deepest interpenetration with where and when it was found,
+and the wall time.
+"""
+from __future__ import annotations
+
+import copy
+import csv
+import dataclasses
+import io
+import json
+import math
+import time as _time
+
+import numpy as np
+
+from drake_dock.docking.output import atomic_directory
+from drake_dock.docking.penetration import deepest_penetration
+from drake_dock.docking.results import summary, timeseries
+from drake_dock.docking.scenario import validate
+from drake_dock.docking.simulate import simulate
+from drake_dock.errors import DrakeDockError
+
+IDSS_BOX = {"chaser_speed": (0.05, 0.10), "lateral_offset": 0.10, "lateral_velocity": 0.04,
+            "tilt_deg": 4.0, "target_yaw_deg": 4.0, "angular_velocity_deg_s": 0.2}
+PENETRATION_LIMIT = 1e-4     # m: deeper is reported as a model failure
+
+
+@dataclasses.dataclass
+class ConditionsPlan:
+    random: int = 60
+    corners: int = 16
+    seed: int = 2026
+
+    @classmethod
+    def quick(cls):
+        return cls(random=3, corners=1)
+
+    @classmethod
+    def full(cls):
+        return cls()
+
+
+def _disk(rng, radius):
+    r, a = radius * math.sqrt(rng.uniform()), rng.uniform(0.0, 2 * math.pi)
+    return [r * math.cos(a), r * math.sin(a)]
+
+
+def random_condition(rng) -> dict:
+    b = IDSS_BOX
+    return {"chaser_speed": rng.uniform(*b["chaser_speed"]),
+            "lateral_offset": _disk(rng, b["lateral_offset"]),
+            "lateral_velocity": _disk(rng, b["lateral_velocity"]),
+            "tilt_deg": rng.uniform(-b["tilt_deg"], b["tilt_deg"], 2).tolist(),
+            "target_yaw_deg": rng.uniform(-b["target_yaw_deg"], b["target_yaw_deg"]),
+            "angular_velocity_deg_s": (b["angular_velocity_deg_s"]
+                                       * rng.uniform(-1, 1, 3)).tolist()}
+
+
+def corner_condition(rng) -> dict:
+    """Every parameter at an extreme: the speed at either end, the two disks' vectors at their
+    full radius in a random direction, each tilt and rate component and the roll at +-max."""
+    b = IDSS_BOX
+
+    def on_circle(radius):
+        a = rng.uniform(0.0, 2 * math.pi)
+        return [radius * math.cos(a), radius * math.sin(a)]
+
+    def sign(n):
+        return rng.choice([-1.0, 1.0], n)
+
+    return {"chaser_speed": float(rng.choice(b["chaser_speed"])),
+            "lateral_offset": on_circle(b["lateral_offset"]),
+            "lateral_velocity": on_circle(b["lateral_velocity"]),
+            "tilt_deg": (b["tilt_deg"] * sign(2)).tolist(),
+            "target_yaw_deg": float(b["target_yaw_deg"] * sign(1)[0]),
+            "angular_velocity_deg_s": (b["angular_velocity_deg_s"] * sign(3)).tolist()}
+
+
+def conditions(plan: ConditionsPlan) -> list:
+    """[(name, condition)] in a fixed order, from the plan's seed."""
+    rng = np.random.default_rng(plan.seed)
+    out = [(f"random {k + 1}", random_condition(rng)) for k in range(plan.random)]
+    out += [(f"corner {k + 1}", corner_condition(rng)) for k in range(plan.corners)]
+    return out
+
+
+def with_condition(scenario, condition: dict):
+    s = copy.deepcopy(scenario)
+    for name, value in condition.items():
+        setattr(s.initial, name, value)
+    return validate(s)
+
+
+def run_condition(scenario, name: str, condition: dict) -> dict:
+    """One row: the run's outcome and checks, or the typed error that ended it."""
+    row = {"name": name, **{k: json.dumps(v) if isinstance(v, list) else v
+                            for k, v in condition.items()}}
+    wall0 = _time.perf_counter()
+    try:
+        s = with_condition(scenario, condition)
+        result = simulate(s)
+        ts = timeseries(result)
+        summ = summary(result, ts)
+    except DrakeDockError as e:
+        row.update(outcome="error", reason=f"{type(e).__name__}: {e}",
+                   wall_time_s=_time.perf_counter() - wall0)
+        return row
+    pen = deepest_penetration(s.geometry, ts["t"], ts["R_WA"], ts["p_WA"], ts["apds_names"].tolist())
+    row.update(outcome=summ["outcome"], reason=summ["outcome_reason"],
+               capture_time_s=summ["capture_time_s"], impacts=summ["number_of_impacts"],
+               peak_contact_force_N=summ["peak_contact_force_N"],
+               momentum_drift_linear=summ["momentum_drift_relative"]["linear"],
+               momentum_drift_angular=summ["momentum_drift_relative"]["angular"],
+               energy_closure=summ["energy_ledger"]["closure_error_relative"],
+               penetration_m=pen.depth, penetration=pen.describe(),
+               final_lateral_m=summ["final_misalignment"]["lateral_m"],
+               final_tilt_deg=summ["final_misalignment"]["tilt_deg"],
+               wall_time_s=_time.perf_counter() - wall0)
+    return row
+
+
+def run_conditions(scenario, plan: ConditionsPlan, log=print) -> dict:
+    rows = []
+    todo = conditions(plan)
+    for k, (name, cond) in enumerate(todo, 1):
+        row = run_condition(scenario, name, cond)
+        rows.append(row)
+        log(f"[{k}/{len(todo)}] {name}: {row['outcome']}"
+            + (f", deepest interpenetration {row['penetration_m'] * 1e3:.3g} mm"
+               if "penetration_m" in row else f" ({row['reason']})"))
+    return {"plan": dataclasses.asdict(plan), "rows": rows}
+
+
+def counts(rows) -> dict:
+    out = {}
+    for r in rows:
+        out[r["outcome"]] = out.get(r["outcome"], 0) + 1
+    return out
+
+
+def summary_lines(result) -> list:
+    rows = result["rows"]
+    ran = [r for r in rows if "penetration_m" in r]
+    deep = [r for r in ran if r["penetration_m"] > PENETRATION_LIMIT]
+    lines = [f"{len(rows)} conditions: " + ", ".join(f"{k} {v}"
+                                                     for k, v in sorted(counts(rows).items()))]
+    if ran:
+        lines.append(f"interpenetration deeper than {PENETRATION_LIMIT * 1e3:g} mm in "
+                     f"{len(deep)} of {len(ran)} finished runs; deepest "
+                     f"{max(r['penetration_m'] for r in ran) * 1e3:.3g} mm")
+        lines.append(f"largest momentum drift {max(r['momentum_drift_linear'] for r in ran):.2e}"
+                     f" (linear), {max(r['momentum_drift_angular'] for r in ran):.2e} "
+                     f"(angular); largest energy-ledger closure error "
+                     f"{max(abs(r['energy_closure']) for r in ran):.2e}")
+    errors = {}
+    for r in rows:
+        if r["outcome"] == "error":
+            kind = r["reason"].split(":")[0]
+            errors[kind] = errors.get(kind, 0) + 1
+    if errors:
+        lines.append("errors: " + ", ".join(f"{k} {v}" for k, v in sorted(errors.items())))
+    return lines
+
+
+FIELDS = ("name", "chaser_speed", "lateral_offset", "lateral_velocity", "tilt_deg",
+          "target_yaw_deg", "angular_velocity_deg_s", "outcome", "reason", "capture_time_s",
+          "impacts", "peak_contact_force_N", "momentum_drift_linear", "momentum_drift_angular",
+          "energy_closure", "penetration_m", "penetration", "final_lateral_m",
+          "final_tilt_deg", "wall_time_s")
+
+
+def rows_csv(rows) -> str:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, FIELDS, lineterminator="\n")
+    w.writeheader()
+    for r in rows:
+        w.writerow({k: r.get(k, "") for k in FIELDS})
+    return buf.getvalue()
+
+
+def outcome_figure(rows, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    style = {"captured": ("o", "tab:green"), "rebound": ("s", "tab:blue"),
+             "jammed": ("D", "tab:orange"), "timeout": ("v", "tab:purple"),
+             "error": ("x", "tab:red")}
+    fig, ax = plt.subplots(figsize=(6.4, 4.6), layout="constrained")
+    for outcome, (marker, color) in style.items():
+        sel = [r for r in rows if r["outcome"] == outcome]
+        if not sel:
+            continue
+        off = [1e3 * math.hypot(*json.loads(r["lateral_offset"])) for r in sel]
+        tilt = [math.hypot(*json.loads(r["tilt_deg"])) for r in sel]
+        ax.scatter(off, tilt, marker=marker, color=color, label=f"{outcome} ({len(sel)})")
+    deep = [r for r in rows if r.get("penetration_m", 0.0) > PENETRATION_LIMIT]
+    if deep:
+        ax.scatter([1e3 * math.hypot(*json.loads(r["lateral_offset"])) for r in deep],
+                   [math.hypot(*json.loads(r["tilt_deg"])) for r in deep], s=160,
+                   facecolors="none", edgecolors="k",
+                   label=f"interpenetration > {PENETRATION_LIMIT * 1e3:g} mm ({len(deep)})")
+    ax.set_xlabel("lateral offset at first contact |offset| [mm]")
+    ax.set_ylabel("tilt |(pitch, yaw)| [deg]")
+    ax.set_title("Outcomes over the IDSS initial-contact box")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def write_conditions(result, out_dir):
+    rows = result["rows"]
+    with atomic_directory(out_dir) as tmp:
+        (tmp / "conditions.csv").write_text(rows_csv(rows))
+        outcome_figure(rows, tmp / "conditions.png")
+        (tmp / "summary.json").write_text(json.dumps(
+            {"plan": result["plan"], "counts": counts(rows), "lines": summary_lines(result)},
+            indent=2) + "\n")

@@ -1,0 +1,71 @@
+"""The conditions sweep's sampling against the IDSS box it states, its determinism, and its
+outputs read back."""
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+from drake_dock.studies.conditions import (IDSS_BOX, ConditionsPlan, conditions, rows_csv,
+                                           with_condition, write_conditions)
+
+PLAN = ConditionsPlan(random=200, corners=32, seed=11)
+
+
+def test_random_conditions_fill_the_box_and_stay_inside():
+    rows = [c for name, c in conditions(PLAN) if name.startswith("random")]
+    speed = np.array([c["chaser_speed"] for c in rows])
+    off = np.array([math.hypot(*c["lateral_offset"]) for c in rows])
+    vel = np.array([math.hypot(*c["lateral_velocity"]) for c in rows])
+    tilt = np.array([c["tilt_deg"] for c in rows])
+    yaw = np.array([c["target_yaw_deg"] for c in rows])
+    rate = np.array([c["angular_velocity_deg_s"] for c in rows])
+    lo, hi = IDSS_BOX["chaser_speed"]
+    assert lo <= speed.min() and speed.max() <= hi
+    assert off.max() <= IDSS_BOX["lateral_offset"] and vel.max() <= IDSS_BOX["lateral_velocity"]
+    assert np.abs(tilt).max() <= IDSS_BOX["tilt_deg"]
+    assert np.abs(yaw).max() <= IDSS_BOX["target_yaw_deg"]
+    assert np.abs(rate).max() <= IDSS_BOX["angular_velocity_deg_s"]
+    # Uniform over the disk by area: the fraction within half the radius is 1/4.
+    assert np.mean(off < 0.5 * IDSS_BOX["lateral_offset"]) == pytest.approx(0.25, abs=0.08)
+    assert speed.min() < lo + 0.1 * (hi - lo) and speed.max() > hi - 0.1 * (hi - lo)
+
+
+def test_corners_put_every_parameter_at_an_extreme():
+    for name, c in conditions(PLAN):
+        if not name.startswith("corner"):
+            continue
+        assert c["chaser_speed"] in IDSS_BOX["chaser_speed"]
+        assert math.hypot(*c["lateral_offset"]) == pytest.approx(IDSS_BOX["lateral_offset"])
+        assert math.hypot(*c["lateral_velocity"]) == pytest.approx(IDSS_BOX["lateral_velocity"])
+        assert np.allclose(np.abs(c["tilt_deg"]), IDSS_BOX["tilt_deg"])
+        assert abs(c["target_yaw_deg"]) == IDSS_BOX["target_yaw_deg"]
+        assert np.allclose(np.abs(c["angular_velocity_deg_s"]),
+                           IDSS_BOX["angular_velocity_deg_s"])
+
+
+def test_the_same_seed_gives_the_same_conditions_and_every_one_is_a_valid_scenario(
+        paper_scenario):
+    a, b = conditions(PLAN), conditions(PLAN)
+    assert json.dumps(a) == json.dumps(b)
+    assert json.dumps(a) != json.dumps(conditions(ConditionsPlan(200, 32, seed=12)))
+    for _, c in a[:20] + a[-5:]:
+        s = with_condition(paper_scenario, c)
+        assert s.initial.chaser_speed == c["chaser_speed"]
+    assert paper_scenario.initial.chaser_speed == 1.0      # the base is not changed
+
+
+def test_rows_are_written_and_read_back(tmp_path):
+    rows = [{"name": "random 1", "chaser_speed": 0.07, "lateral_offset": "[0.01, 0.02]",
+             "tilt_deg": "[1.0, -2.0]", "outcome": "captured", "penetration_m": 2e-3,
+             "momentum_drift_linear": 1e-15, "momentum_drift_angular": 2e-15,
+             "energy_closure": 1e-9},
+            {"name": "corner 1", "chaser_speed": 0.1, "lateral_offset": "[0.1, 0.0]",
+             "tilt_deg": "[4.0, 4.0]", "outcome": "error", "reason": "NumericalError: x"}]
+    write_conditions({"plan": {}, "rows": rows}, tmp_path / "out")
+    back = list(csv.DictReader(open(tmp_path / "out" / "conditions.csv")))
+    assert [r["outcome"] for r in back] == ["captured", "error"]
+    assert float(back[0]["penetration_m"]) == 2e-3 and back[1]["reason"] == "NumericalError: x"
+    assert (tmp_path / "out" / "conditions.png").stat().st_size > 10000
+    assert rows_csv(rows) == (tmp_path / "out" / "conditions.csv").read_text()
