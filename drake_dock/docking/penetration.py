@@ -1,24 +1,30 @@
 """An interpenetration check of two APDS over a run, independent of the contact code.
 
-Written from the paper's geometry (Sect. 4) with its own formulas, it uses no patch, couple or
-seek of `drake_dock.core`. Each APDS is a set of solids in its own frame (cylindrical rho, theta,
-zeta; e3 along the docking axis, ring face at zeta = 0):
-- petal k (k = 1..3): the material behind its guide surface, the cone
-  rho = R - zeta cot(alpha1) (Eq. 12) between its two guide sides (the angular inset theta_1 of
-  Eq. 13), 0 <= zeta <= H, to ``petal_depth`` below the surface (towards the axis);
-- the ring: the annulus Rs <= rho <= R of depth ``ring_depth`` below the ring face.
-The other APDS's features are sampled as points: the ring's inside and outside circles and its
-face, the six guide sides (Eq. 14) and the three petal tip arcs (zeta = H). A point inside a
-solid lies at a depth, its distance to the nearest face of that solid through which it could
-have entered (the guide surface, a side, the tip; the ring's face or its walls). Checked: guide
-sides, tip arcs and the ring's inside circle against the other APDS's petals; the ring's
-circles and face against the other ring. A petal passing through the other ring's annulus (so
-also the ring's face and outside circle against the other's petal roots) is the paper's reading
+Written from the paper's geometry (Sect. 4) with its own formulas; it uses no patch, couple or
+seek of `drake_dock.core`. In an APDS's own frame (cylindrical rho, theta, zeta; e3 along the
+docking axis, ring face at zeta = 0):
+- petal k (k = 1..3) is a thin plate on the cone rho = R - zeta cot(alpha1) (Eq. 12) between its
+  two guide sides (the angular inset theta_1 of Eq. 13), 0 <= zeta <= H. A point's signed
+  distance s to the cone (positive away from the axis) and the foot of that distance give its
+  side of the plate and whether it lies over the plate;
+- the ring is a solid annulus Rs <= rho <= R, ``ring_depth`` deep behind the ring face.
+
+The other APDS's features are sampled as material points: the ring's inside and outside circles
+and its face, the six guide sides (Eq. 14) and the three petal tip arcs (zeta = H).
+
+A thin plate has no inside, so a point *crosses* a petal when its s changes sign at a place
+over the plate (its foot, interpolated to s = 0 between two sub-steps, inside the petal): a
+point passing round a side or over the tip changes side without crossing. A point that has
+crossed (an odd number of times) lies at depth |s| while it is over the plate. A point inside
+the other ring's solid lies at its distance to the nearest face. Checked: guide sides, tip arcs
+and the ring's inside circle against the other APDS's petals; the ring's circles and face
+against the other ring. A petal passing through the other ring's annulus (so also the ring's
+face and outside circle against the other's petal roots) is the paper's reading
 (docs/model.md) and is not checked.
 
-Between two samples of the run the relative pose is interpolated (translation linearly, rotation
-along its geodesic) in sub-steps that move no feature point more than ``max_travel``, so that a
-feature crossing a solid between two samples is seen inside it.
+Between two samples of the run the relative pose is interpolated (translation linearly,
+rotation along its geodesic) in sub-steps that move no feature point more than ``max_travel``.
+Every point starts on its own side (the initial configuration is checked by the scenario).
 """
 from __future__ import annotations
 
@@ -28,6 +34,9 @@ import math
 import numpy as np
 
 from drake_dock.docking.scene import rot_vec
+
+PETAL_FEATURES = ("ring inside circle", "guide side", "petal")     # name prefixes
+RING_FEATURES = ("ring",)
 
 
 @dataclasses.dataclass
@@ -43,7 +52,7 @@ class Penetration:
     def describe(self) -> str:
         if self.depth == 0.0:
             return "no interpenetration"
-        return (f"{self.feature} {self.depth * 1e3:.3g} mm inside {self.solid} at "
+        return (f"{self.feature} {self.depth * 1e3:.3g} mm through {self.solid} at "
                 f"t = {self.time:.6g} s")
 
 
@@ -80,22 +89,27 @@ def feature_points(g, *, n_circle=1440, n_side=80, n_arc=60, n_face=9):
     return out
 
 
-def petal_depth_of(g, X, k, petal_depth):
-    """Depth of each point X (M, 3), in the APDS frame, inside petal k's solid (<= 0: outside)."""
+def petal_coordinates(g, X, k):
+    """For points X (M, 3) in the APDS frame and petal k: the signed distance s to the cone
+    (positive away from the axis), the foot's fraction across the petal (0 and 1 on its guide
+    sides) and the foot's height zeta. The foot is over the plate for 0 <= fraction <= 1 and
+    0 <= zeta <= H."""
     rho = np.hypot(X[:, 0], X[:, 1])
-    zeta = X[:, 2]
     sa, ca = math.sin(g.alpha1), math.cos(g.alpha1)
-    s = (rho - g.R) * sa + zeta * ca                # signed distance to the cone, outward > 0
-    rho_f, zeta_f = rho - s * sa, zeta - s * ca       # foot on the cone
-    phi = (2 * k - 2) * math.pi / 3
+    s = (rho - g.R) * sa + X[:, 2] * ca
+    zeta_f = X[:, 2] - s * ca
     inset = _inset(g, np.clip(zeta_f, 0.0, g.H))
+    phi = (2 * k - 2) * math.pi / 3
     dth = np.mod(np.arctan2(X[:, 1], X[:, 0]) - phi + math.pi, 2 * math.pi) - math.pi
-    to_side = np.minimum(dth - inset, math.pi / 3 - inset - dth) * rho_f
-    along = np.minimum(zeta_f, g.H - zeta_f) / sa     # along the generatrix to bottom or tip
-    return np.minimum.reduce([-s, petal_depth + s, to_side, along])
+    return s, (dth - inset) / (math.pi / 3 - 2 * inset), zeta_f
+
+
+def _over(g, frac, zeta_f, tol=1e-9):
+    return (frac >= -tol) & (frac <= 1 + tol) & (zeta_f >= -tol) & (zeta_f <= g.H + tol)
 
 
 def ring_depth_of(g, X, ring_depth):
+    """Depth of points X (M, 3) inside the ring's solid (<= 0: outside)."""
     rho = np.hypot(X[:, 0], X[:, 1])
     return np.minimum.reduce([-X[:, 2], X[:, 2] + ring_depth, rho - g.Rs, g.R - rho])
 
@@ -120,8 +134,48 @@ def relative_poses(R_WA, p_WA, a, b):
     return Rb_T @ R_WA[:, a], np.einsum("nij,nj->ni", Rb_T, p_WA[:, a] - p_WA[:, b])
 
 
-def deepest_penetration(g, t, R_WA, p_WA, names, *, petal_depth=0.05, ring_depth=0.04,
-                        max_travel=1e-3, features=None) -> Penetration:
+def sub_steps(t, R, p, reach, max_travel):
+    """(t, R, p) at the first sample, then sub-steps between samples that move no point within
+    ``reach`` of the origin more than ``max_travel``."""
+    yield t[0], R[0], p[0]
+    for n in range(1, len(t)):
+        r = _rotvec(R[n - 1].T @ R[n])
+        travel = np.linalg.norm(p[n] - p[n - 1]) + np.linalg.norm(r) * reach
+        m = max(1, int(math.ceil(travel / max_travel)))
+        for f in np.arange(1, m + 1) / m:
+            yield (t[n - 1] + (t[n] - t[n - 1]) * f, R[n - 1] @ rot_vec(f * r),
+                   p[n - 1] + f * (p[n] - p[n - 1]))
+
+
+@dataclasses.dataclass
+class _PetalWatch:
+    """One feature against one petal: each point's last s and foot, and whether it has crossed."""
+
+    name: str
+    solid: str
+    s: np.ndarray = None
+    frac: np.ndarray = None
+    zeta: np.ndarray = None
+    crossed: np.ndarray = None
+
+    def step(self, g, s, frac, zeta):
+        """Updates with the sub-step's coordinates; returns the depth of each point."""
+        if self.s is None:
+            self.crossed = np.zeros(len(s), dtype=bool)
+        else:
+            flip = np.sign(s) * np.sign(self.s) < 0
+            if flip.any():
+                w = self.s[flip] / (self.s[flip] - s[flip])      # where s = 0, linearly
+                through = _over(g, self.frac[flip] + w * (frac[flip] - self.frac[flip]),
+                                self.zeta[flip] + w * (zeta[flip] - self.zeta[flip]))
+                idx = np.flatnonzero(flip)[through]
+                self.crossed[idx] = ~self.crossed[idx]
+        self.s, self.frac, self.zeta = s, frac, zeta
+        return np.where(self.crossed & _over(g, frac, zeta), np.abs(s), 0.0)
+
+
+def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=1e-3,
+                        features=None) -> Penetration:
     """The deepest interpenetration of the two APDS over the samples t (N,) with their frames'
     poses R_WA (N, 2, 3, 3), p_WA (N, 2, 3) (the timeseries fields), names the two APDS names;
     ``features`` replaces `feature_points` (a subset, for tests)."""
@@ -130,39 +184,17 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, petal_depth=0.05, ring_depth
     best = Penetration()
     for a, b in ((0, 1), (1, 0)):
         R, p = relative_poses(R_WA, p_WA, a, b)
-        for n in range(len(t)):
-            if n == 0:
-                steps = [(t[0], R[0], p[0])]
-            else:
-                dR = R[n - 1].T @ R[n]
-                r = _rotvec(dR)
-                travel = np.linalg.norm(p[n] - p[n - 1]) + np.linalg.norm(r) * reach
-                m = max(1, int(math.ceil(travel / max_travel)))
-                steps = [(t[n - 1] + (t[n] - t[n - 1]) * f, R[n - 1] @ rot_vec(f * r),
-                          p[n - 1] + f * (p[n] - p[n - 1]))
-                         for f in np.arange(1, m + 1) / m]
-            for tt, Rab, pab in steps:
-                best = _deepest_at(g, feats, Rab, pab, tt, names[a], names[b], best,
-                                   petal_depth, ring_depth)
-    return best
-
-
-# The ring's face and outside circle overlap the other APDS's petal roots near capture (the
-# paper's reading: a petal passes the other ring's annulus); its inside circle does not.
-CHECKED_AGAINST_PETALS = ("ring inside circle",)
-
-
-def _deepest_at(g, feats, R, p, t, name_a, name_b, best, petal_depth, ring_depth):
-    for fname, X in feats.items():
-        Y = X @ R.T + p
-        solids = []
-        if fname in CHECKED_AGAINST_PETALS or not fname.startswith("ring"):
-            solids += [(f"{name_b} petal {k}", petal_depth_of(g, Y, k, petal_depth))
-                       for k in (1, 2, 3)]
-        if fname.startswith("ring"):
-            solids.append((f"{name_b} ring", ring_depth_of(g, Y, ring_depth)))
-        for sname, depth in solids:
-            d = float(depth.max())
-            if d > best.depth:
-                best = Penetration(d, float(t), f"{name_a} {fname}", sname)
+        watches = {(f, k): _PetalWatch(f"{names[a]} {f}", f"{names[b]} petal {k}")
+                   for f in feats if f.startswith(PETAL_FEATURES) for k in (1, 2, 3)}
+        for tt, Rab, pab in sub_steps(t, R, p, reach, max_travel):
+            for fname, X in feats.items():
+                Y = X @ Rab.T + pab
+                found = [(w.solid, w.step(g, *petal_coordinates(g, Y, k)))
+                         for (f, k), w in watches.items() if f == fname]
+                if fname.startswith(RING_FEATURES):
+                    found.append((f"{names[b]} ring", ring_depth_of(g, Y, ring_depth)))
+                for solid, depth in found:
+                    d = float(depth.max())
+                    if d > best.depth:
+                        best = Penetration(d, float(tt), f"{names[a]} {fname}", solid)
     return best

@@ -1,19 +1,22 @@
-"""The interpenetration check against constructions of known depth: a point pushed a known
-distance through a petal or into a ring, the paper's own guide sides lying on their petal's
-edges (Eq. 13 against Eq. 14), and a ring that passes right through a petal between two samples
-(the paper example keeps every feature out: tests/docking/test_paper_example.py)."""
+"""The interpenetration check against constructions of known depth: the paper's own guide sides
+and tip arcs on their petal's edges (Eq. 13 against Eq. 14), a point pushed a known distance
+through a petal, a point passing round a petal's tip (no crossing), a point of a ring inside the
+other ring, and a ring that passes right through a petal and out of it between two samples (the
+paper example keeps every feature out: tests/docking/test_paper_example.py)."""
 import math
 
 import numpy as np
 import pytest
 
 from drake_dock.docking.penetration import (deepest_penetration, feature_points,
-                                            petal_depth_of, ring_depth_of)
+                                            petal_coordinates, ring_depth_of)
+
+NAMES = ["target_apds", "chaser_apds"]
 
 
 def _cone_point(g, k, s, zeta):
     """The point of petal k's guide surface at fraction s across the petal and height zeta, and
-    the cone's outward unit normal there (from Eq. 12 and 13 written out here)."""
+    the cone's outward unit normal there (Eq. 12 and 13 written out here)."""
     rho = g.R - zeta / math.tan(g.alpha1)
     inset = math.asin(g.R * math.sin(g.alpha2) / rho) - g.alpha2
     th = (2 * k - 2) * math.pi / 3 + inset + s * (math.pi / 3 - 2 * inset)
@@ -23,27 +26,63 @@ def _cone_point(g, k, s, zeta):
     return x, n
 
 
-@pytest.mark.parametrize("k", [1, 2, 3])
-def test_a_point_pushed_through_a_petal_is_at_its_depth(geom, k):
-    for zeta in (0.05, 0.1, 0.15):
-        x, n = _cone_point(geom, k, 0.5, zeta)
-        delta = np.array([1e-6, 1e-4, 2e-3, 1e-2])
-        X = x - delta[:, None] * n
-        assert petal_depth_of(geom, X, k, 0.05) == pytest.approx(delta, rel=1e-9, abs=1e-15)
-        assert np.all(petal_depth_of(geom, x + delta[:, None] * n, k, 0.05) < 0)
-        others = [j for j in (1, 2, 3) if j != k]
-        assert all(np.all(petal_depth_of(geom, X, j, 0.05) < 0) for j in others)
-
-
-def test_the_paper_guide_sides_lie_on_their_petal_edges(geom):
-    """Eq. (14)'s sides, sampled by the check, lie on the cone of Eq. (12) at the angular inset
-    of Eq. (13): depth zero in their own petal (side 2k-1 and 2k bound petal k)."""
+def test_the_paper_guide_sides_and_tips_lie_on_their_petal_edges(geom):
+    """Eq. (14)'s sides lie on the cone of Eq. (12) at the angular inset of Eq. (13): s = 0 and
+    fraction 0 (odd sides) or 1 (even sides) of their petal; the tip arcs at zeta = H."""
     f = feature_points(geom)
     for i in range(1, 7):
-        d = petal_depth_of(geom, f[f"guide side {i}"], (i + 1) // 2, 0.05)
-        assert np.abs(d).max() < 1e-12
+        s, frac, zeta = petal_coordinates(geom, f[f"guide side {i}"], (i + 1) // 2)
+        assert np.abs(s).max() < 1e-12
+        assert np.abs(frac - (0.0 if i % 2 else 1.0)).max() < 1e-9
+        assert zeta.min() == pytest.approx(0.0, abs=1e-12)
+        assert zeta.max() == pytest.approx(geom.H, abs=1e-12)
     for k in (1, 2, 3):
-        assert np.abs(petal_depth_of(geom, f[f"petal {k} tip arc"], k, 0.05)).max() < 1e-12
+        s, frac, zeta = petal_coordinates(geom, f[f"petal {k} tip arc"], k)
+        assert np.abs(s).max() < 1e-12 and np.abs(zeta - geom.H).max() < 1e-12
+        assert frac.min() == pytest.approx(0.0, abs=1e-9)
+        assert frac.max() == pytest.approx(1.0, abs=1e-9)
+
+
+def _path(points):
+    """A one-point feature of the chaser, its APDS frame the target's translated along the
+    points (one sample per point, 1 ms apart)."""
+    n = len(points)
+    p_WA = np.zeros((n, 2, 3))
+    p_WA[:, 1] = points
+    R_WA = np.broadcast_to(np.eye(3), (n, 2, 3, 3)).copy()
+    return np.arange(n) * 1e-3, R_WA, p_WA
+
+
+def _depth_along(geom, points, max_travel=1e-3, feature="ring inside circle"):
+    t, R_WA, p_WA = _path(np.asarray(points))
+    return deepest_penetration(geom, t, R_WA, p_WA, NAMES, max_travel=max_travel,
+                               features={feature: np.zeros((1, 3))})
+
+
+@pytest.mark.parametrize("k", [1, 2, 3])
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_a_point_pushed_through_a_petal_is_at_its_depth(geom, k, side):
+    """From 10 mm on either side of petal k, through its face, to delta beyond it."""
+    x, n = _cone_point(geom, k, 0.4, 0.12)
+    for delta in (1e-6, 1e-4, 2e-3):
+        found = _depth_along(geom, [x + side * 0.01 * n, x - side * delta * n])
+        assert found.depth == pytest.approx(delta, rel=1e-9)
+        assert found.solid == f"target_apds petal {k}" and found.time == 1e-3
+    # Back out the way it came: no longer through the plate.
+    back = _depth_along(geom, [x + side * 0.01 * n, x - side * 2e-3 * n, x + side * 0.02 * n])
+    assert back.depth == pytest.approx(2e-3, rel=1e-9) and back.time == 1e-3
+
+
+def test_a_point_passing_over_the_tip_does_not_cross(geom):
+    """Outside petal 1 near its tip, up over the tip arc, down behind the petal: it changes
+    side above the plate, not through it."""
+    x, n = _cone_point(geom, 1, 0.5, geom.H)
+    up = np.array([0.0, 0.0, 0.03])
+    path = [x + 0.01 * n - 0.02 * up, x + 0.01 * n + up, x - 0.01 * n + up,
+            x - 0.01 * n - 0.5 * up]
+    assert _depth_along(geom, path).depth == 0.0
+    # The same end reached straight through the face is a crossing.
+    assert _depth_along(geom, [path[0], path[-1]]).depth > 0.005
 
 
 def test_ring_depth_is_the_distance_to_the_nearest_face(geom):
@@ -53,23 +92,21 @@ def test_ring_depth_is_the_distance_to_the_nearest_face(geom):
     assert ring_depth_of(geom, X, 0.04) == pytest.approx([0.001, 0.02, 0.003, -0.001])
 
 
-def test_a_ring_passing_through_a_petal_between_samples_is_seen(geom):
-    """Two samples 1 ms apart of a point of the chaser's inside circle: 10 mm outside petal 1's
-    guide surface, then moved 0.1 m towards the axis, 61 mm beyond the surface and past the
-    50 mm solid behind it. Neither sample is inside; the sub-steps between them are."""
+def test_a_ring_passing_through_a_petal_and_out_between_samples_is_seen(geom):
+    """Two samples 1 ms apart of a point of the chaser's inside circle: 10 mm outside petal 1,
+    then 50 mm behind it and 0.2 m down along the cone's generatrix, out from under the petal.
+    Neither sample shows it through the plate; the sub-steps do, 32 mm deep as it leaves."""
     x, n = _cone_point(geom, 1, 0.5, 0.1)
-    th = math.atan2(x[1], x[0])
-    radial = np.array([math.cos(th), math.sin(th), 0.0])
-    feats = {"ring inside circle": np.array([geom.Rs * radial])}
-    p0 = x + 0.01 * n - geom.Rs * radial
-    p_WA = np.zeros((2, 2, 3))
-    p_WA[:, 1] = [p0, p0 - 0.1 * radial]
-    R_WA = np.broadcast_to(np.eye(3), (2, 2, 3, 3)).copy()
-    t, names = np.array([0.0, 1e-3]), ["target_apds", "chaser_apds"]
-    ends = deepest_penetration(geom, t, R_WA, p_WA, names, max_travel=1.0, features=feats)
-    assert ends.depth == 0.0
-    found = deepest_penetration(geom, t, R_WA, p_WA, names, features=feats)
+    e_rho = np.array([x[0], x[1], 0.0]) / math.hypot(x[0], x[1])
+    down = math.cos(geom.alpha1) * e_rho - math.sin(geom.alpha1) * np.array([0.0, 0.0, 1.0])
+    start = x + 0.01 * n
+    end = start - 0.06 * n + 0.2 * down
+    assert _depth_along(geom, [start, end], max_travel=1.0).depth == 0.0
+    found = _depth_along(geom, [start, end])
     assert found.feature == "chaser_apds ring inside circle"
     assert found.solid == "target_apds petal 1"
-    # The deepest sub-step is near the solid's middle, 25 mm from both its faces.
-    assert found.depth == pytest.approx(0.025, abs=1e-3) and 0.0 < found.time < 1e-3
+    s, frac, zeta = petal_coordinates(geom, end[None], 1)
+    assert zeta[0] < 0.0                              # the end is no longer over the plate
+    leaving = 0.1 / (0.2 * math.sin(geom.alpha1))     # path fraction where the foot is at 0
+    assert found.depth == pytest.approx(0.06 * leaving - 0.01, abs=1e-3)
+    assert 0.0 < found.time < 1e-3
