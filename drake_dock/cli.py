@@ -201,7 +201,7 @@ def _campaign(args) -> int:
         return _guarded(work, args.out, bar.close)
     except KeyboardInterrupt:
         bar.close()
-        print(_error("stopped", interrupted_text(args.out)), file=sys.stderr)
+        print(_error("interrupted", interrupted_text(args.out)), file=sys.stderr)
         return 130
 
 

@@ -52,13 +52,17 @@ def run_campaign(plan_file, out, *, workers=None, scheduler=None, resume=False, 
     _check_options(workers, scheduler)
     plan, base, fields = load_plan(plan_file)
     store = CampaignStore(out, plan_identity(plan, base),
-                          [c for f in fields for c in f.columns]).open(resume=resume)
+                          [c for f in fields for c in f.columns]).check(resume=resume)
     progress = progress or CampaignProgress()
     missing = [i for i in range(plan.samples) if i not in store.done]
-    progress.start(plan.samples, plan.samples - len(missing))
     specs = sample_specs(plan, fields, missing)
-    if specs:
-        with dask_client(workers, scheduler) as client:
+    if not specs:
+        store.create()
+        progress.start(plan.samples, plan.samples)
+    else:
+        with dask_client(workers, scheduler) as client:    # connected before DIR is written
+            store.create()
+            progress.start(plan.samples, plan.samples - len(missing))
             size = batch_size(plan.batch, len(specs), threads(client))
             batches = [specs[k:k + size] for k in range(0, len(specs), size)]
             run_on_dask(client, runner, base, batches,
@@ -101,5 +105,4 @@ def interrupted_text(out) -> str:
     if parts.is_dir():
         import pyarrow.parquet as pq
         saved = sum(pq.read_metadata(p).num_rows for p in parts.glob("part-*.parquet"))
-    return f"interrupted: {saved} samples saved in {out}; the same command (or --resume) " \
-           f"runs the others"
+    return f"{saved} samples saved in {out}; the same command (or --resume) runs the others"

@@ -66,6 +66,8 @@ def _histogram(ax, values, label):
     v = v[np.isfinite(v)]
     if v.size:
         ax.hist(v, bins=min(40, max(5, v.size // 5)), color="tab:blue")
+    else:
+        ax.text(0.5, 0.5, "no sample", ha="center", va="center", transform=ax.transAxes)
     ax.set_xlabel(label)
     ax.set_ylabel("samples")
 

@@ -64,34 +64,45 @@ def _marker_kind(root: Path):
 
 
 class CampaignStore:
-    """Opens (``open``) a campaign directory for a plan identified by ``identity`` (a JSON-able
-    dict); ``done`` holds the samples already saved."""
+    """A campaign directory for a plan identified by ``identity`` (a JSON-able dict):
+    ``check`` it, then ``create`` it; ``done`` holds the samples already saved."""
 
     def __init__(self, out, identity: dict, input_columns: list[str]):
         self.root = Path(out)
         self.identity = identity
         self.schema = schema(input_columns)
         self.done: set[int] = set()
+        self.existing = False
 
-    def open(self, *, resume: bool) -> "CampaignStore":
+    def check(self, *, resume: bool) -> "CampaignStore":
+        """Refuses a directory that is neither new, empty nor a campaign of the same plan;
+        reads the samples saved there. Writes nothing."""
         root = self.root
-        existing = root.is_dir() and not root.is_symlink() and _marker_kind(root) == KIND
-        if resume and not existing:
+        self.existing = root.is_dir() and not root.is_symlink() and _marker_kind(root) == KIND
+        if resume and not self.existing:
             raise InputError("--resume", str(root), f"a campaign directory (holding {MARKER} "
                              f"of kind '{KIND}') to resume", "nothing to resume there")
-        if existing:
+        if self.existing:
             self._check_existing()
+            self.done = self._saved_samples()
         else:
             check_destination(root)
             if root.is_dir() and any(os.scandir(root)):
                 raise InputError("--out", str(root), "a new path, an empty directory or a "
                                  "campaign directory of the same plan",
                                  "a drake_dock output of another kind")
+        return self
+
+    def create(self):
+        """Makes the directory (if new), clears interrupted writes, writes the marker."""
+        root = self.root
+        if self.existing:
+            for tmp in list(root.glob(f"{TMP_PREFIX}*")) + list(root.glob(f"*/{TMP_PREFIX}*")):
+                tmp.unlink()         # a write interrupted before its rename
+        else:
             (root / PARTS).mkdir(parents=True, exist_ok=True)
             atomic_write(root / "plan.json", (json.dumps(self.identity, indent=1) + "\n").encode())
         self.write_marker()
-        self.done = self._saved_samples()
-        return self
 
     def _check_existing(self):
         root = self.root
@@ -109,8 +120,6 @@ class CampaignStore:
             raise InputError("--out", str(root), "a new path, an empty directory or a campaign "
                              "of the same plan", f"it holds a campaign of another plan "
                              f"({', '.join(keys) or 'plan.json unreadable'} differ)")
-        for tmp in list(root.glob(f"{TMP_PREFIX}*")) + list(root.glob(f"*/{TMP_PREFIX}*")):
-            tmp.unlink()             # a write interrupted before its rename
 
     def write_marker(self):
         atomic_write(self.root / MARKER, (json.dumps(
