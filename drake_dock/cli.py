@@ -89,9 +89,25 @@ def main(argv=None) -> int:
     study_p.add_argument("--out", required=True, help=OUT_HELP)
     study_p.add_argument("--quick", action="store_true",
                          help="a few points only (for CI)")
+    camp_p = sub.add_parser("campaign", help="run a seeded campaign of samples around a "
+                            "scenario on Dask (docs/campaigns.md)")
+    camp_p.add_argument("plan", help="campaign plan YAML (e.g. models/idss_envelope.yaml)")
+    camp_p.add_argument("--out", required=True,
+                        help="campaign directory: a new path, an empty directory, or a "
+                             "campaign of the same plan, whose missing samples are run")
+    camp_p.add_argument("--workers", type=int, default=None,
+                        help="local worker processes (default: one per core)")
+    camp_p.add_argument("--scheduler", default=None,
+                        help="address of a running Dask scheduler (tcp://HOST:8786) instead "
+                             "of a local cluster")
+    camp_p.add_argument("--resume", action="store_true",
+                        help="DIR must hold a campaign of this plan; run its missing samples")
+    camp_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
     if args.command == "study":
         return _study(args)
+    if args.command == "campaign":
+        return _campaign(args)
     # Imported here so that `--help` stays fast.
     from drake_dock.docking.output import check_destination
     from drake_dock.run import format_summary, run
@@ -175,6 +191,24 @@ def _study(args) -> int:
         write(result, args.out)
         return lines(result)
     return _guarded(work, args.out)
+
+
+def _campaign(args) -> int:
+    import io
+    from drake_dock.campaign.campaign import interrupted_text, run_campaign, summary_lines
+    from drake_dock.campaign.progress import CampaignProgress
+    bar = CampaignProgress(io.StringIO() if args.no_progress else None)
+
+    def work():
+        return summary_lines(run_campaign(args.plan, args.out, workers=args.workers,
+                                          scheduler=args.scheduler, resume=args.resume,
+                                          progress=bar))
+    try:
+        return _guarded(work, args.out, bar.close)
+    except KeyboardInterrupt:
+        bar.close()
+        print(_error("interrupted", interrupted_text(args.out)), file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -1,0 +1,144 @@
+"""One campaign sample: the base scenario with the sample's values, simulated to its outcome,
+reduced to a plain row (a dict of numbers and strings, which pickles; Drake's Diagrams,
+Simulators and Contexts do not).
+
+A process keeps the last few Diagrams it built (`diagram_for`) and reuses one for every sample
+whose values leave it unchanged; a run on a reused Diagram gives bitwise the same row as on a
+fresh one (tests/campaign). Any failure of a sample (a typed error of drake_dock, a value out of
+range, anything else) is its row's ``outcome: error`` with the message in ``error``; it never
+stops the campaign.
+"""
+from __future__ import annotations
+
+import collections
+import copy
+import math
+import time
+
+import numpy as np
+
+from drake_dock.campaign.plan import set_field
+from drake_dock.docking.diagram import build_docking_diagram
+from drake_dock.docking.plant import stewart_deflection
+from drake_dock.docking.results import summary, timeseries
+from drake_dock.docking.scenario import validate
+from drake_dock.docking.simulate import simulate
+from drake_dock.errors import DrakeDockError, NumericalError
+
+# The row's columns after the sample, its seed and the varied inputs (`Field.columns`).
+RESULT_COLUMNS = {
+    "outcome": str, "reason": str, "capture_time": float, "end_time": float,
+    "peak_contact_force": float, "peak_stewart_stroke": float, "peak_stewart_force": float,
+    "final_axial": float, "final_lateral": float, "final_tilt_deg": float, "impacts": int,
+    "momentum_drift": float, "energy_closure": float, "wall_time": float, "error": str}
+ERROR = "error"
+CACHE_SIZE = 4
+_DIAGRAMS: collections.OrderedDict = collections.OrderedDict()
+
+
+def build_key(scenario) -> str:
+    """What `build_docking_diagram` reads from a scenario: the geometry, bodies, Stewart
+    element, chaser APDS offset, contact law, accuracy, capture distance and closing speed
+    (the energy scale of the error control). Samples that differ only elsewhere (the
+    misalignment, the roll, the duration) share a Diagram."""
+    s = scenario
+    return repr((s.geometry, s.bodies, s.stewart, s.chaser_apds_offset, s.contact,
+                 s.simulation.accuracy, s.simulation.capture_distance, s.initial.chaser_speed))
+
+
+def diagram_for(scenario):
+    """This process's Diagram for the scenario: built once per `build_key`, kept for the last
+    CACHE_SIZE keys."""
+    key = build_key(scenario)
+    dd = _DIAGRAMS.pop(key, None) or build_docking_diagram(scenario)
+    _DIAGRAMS[key] = dd
+    while len(_DIAGRAMS) > CACHE_SIZE:
+        _DIAGRAMS.popitem(last=False)
+    return dd
+
+
+def sample_scenario(base, values: dict):
+    """A copy of the base scenario with the sample's {dotted path: value}, validated."""
+    s = copy.deepcopy(base)
+    for path, value in values.items():
+        set_field(s, path, value)
+    return validate(s)
+
+
+def input_columns(values: dict) -> dict:
+    """The varied inputs as flat columns: path, or path[k] per component of a vector."""
+    out = {}
+    for path, v in values.items():
+        if isinstance(v, list):
+            out.update({f"{path}[{k}]": float(x) for k, x in enumerate(v)})
+        else:
+            out[path] = float(v)
+    return out
+
+
+def stewart_peaks(result) -> tuple[float, float]:
+    """The largest translational deflection (m) of the Stewart element and the largest force
+    (N) it exerts on the target APDS, over the recorded samples."""
+    dp = result.dd.dp
+    pc = dp.plant.CreateDefaultContext()
+    stroke = force = 0.0
+    for x in result.record.x:
+        dp.plant.SetPositionsAndVelocities(pc, x)
+        deflection, _ = stewart_deflection(dp, pc)
+        f = dp.bushing.CalcBushingSpatialForceOnFrameC(pc).translational()
+        stroke = max(stroke, float(np.linalg.norm(deflection)))
+        force = max(force, float(np.linalg.norm(f)))
+    return stroke, force
+
+
+def measure(result) -> dict:
+    """The row's result columns of a finished run (RESULT_COLUMNS but wall_time)."""
+    s = summary(result, timeseries(result))
+    stroke, force = stewart_peaks(result)
+    fm = s["final_misalignment"]
+    row = {"outcome": s["outcome"], "reason": s["outcome_reason"],
+           "capture_time": s["capture_time_s"], "end_time": s["end_time_s"],
+           "peak_contact_force": s["peak_contact_force_N"], "peak_stewart_stroke": stroke,
+           "peak_stewart_force": force, "final_axial": fm["axial_m"],
+           "final_lateral": fm["lateral_m"], "final_tilt_deg": fm["tilt_deg"],
+           "impacts": s["number_of_impacts"],
+           "momentum_drift": s["momentum_drift_relative"]["linear"],
+           "energy_closure": s["energy_ledger"]["closure_error_relative"], "error": None}
+    for name, v in row.items():
+        if isinstance(v, float) and not math.isfinite(v):
+            raise NumericalError(f"the sample's {name} is not finite (an overflow of extreme "
+                                 f"inputs)", time=result.end_time)
+    return row
+
+
+def failed(message: str, reason: str) -> dict:
+    """The result columns of a sample that ended in an error."""
+    row = dict.fromkeys(RESULT_COLUMNS)
+    row.update(outcome=ERROR, reason=reason, error=message)
+    return row
+
+
+def run_sample(base, spec, *, reuse: bool = True) -> dict:
+    """The row of one sample ``spec = (sample, seed, {path: value})``. ``reuse``: run on this
+    process's cached Diagram (`diagram_for`); otherwise build a fresh one."""
+    sample, seed, values = spec
+    row = {"sample": int(sample), "seed": int(seed), **input_columns(values)}
+    t0 = time.perf_counter()
+    try:
+        scenario = sample_scenario(base, values)
+        result = simulate(scenario, dd=diagram_for(scenario) if reuse else None)
+        row.update(measure(result))
+    except DrakeDockError as e:
+        _DIAGRAMS.clear()            # nothing of a failed run is kept
+        row.update(failed(str(e), f"{type(e).__name__}"))
+    except Exception as e:  # noqa: BLE001 - a sample's failure is its row, never the campaign's
+        _DIAGRAMS.clear()
+        row.update(failed(f"internal error ({type(e).__name__}): {e}"[:2000],
+                          f"{type(e).__name__}"))
+    row["wall_time"] = time.perf_counter() - t0
+    return row
+
+
+def run_batch(base, specs) -> list[dict]:
+    """The rows of a batch of samples, in order (the Dask task)."""
+    return [run_sample(base, spec) for spec in specs]

@@ -1,0 +1,76 @@
+"""The plan: a bad value exits 2 naming the field, before anything runs or is written; the
+shipped IDSS plan loads; the samplers' points against closed forms."""
+import math
+
+import numpy as np
+import pytest
+
+from drake_dock.cli import main
+
+GOOD = """scenario: {scenario}
+samples: 4
+seed: 1
+sampler: sobol
+vary:
+  initial.lateral_offset: {{uniform: [[-0.1, 0.1], [-0.1, 0.1]]}}
+  initial.target_yaw_deg: {{normal: [5.0, 0.5]}}
+"""
+
+
+@pytest.mark.parametrize("change, field", [
+    (("sampler: sobol", "sampler: halton"), "sampler"),
+    (("samples: 4", "samples: 0"), "samples"),
+    (("samples: 4", "samples: 2.5"), "samples"),
+    (("seed: 1", "seeds: 1"), "seeds"),
+    (("initial.target_yaw_deg", "initial.yaw"), "vary.initial.yaw"),
+    (("[[-0.1, 0.1], [-0.1, 0.1]]", "[[-0.1, 0.1]]"), "vary.initial.lateral_offset.uniform"),
+    (("[[-0.1, 0.1], [-0.1, 0.1]]", "[[-0.1, 0.1], [-0.7, 0.7]]"), "vary.initial.lateral_offset"),
+    (("normal: [5.0, 0.5]", "normal: [5.0, -0.5]"), "vary.initial.target_yaw_deg.normal"),
+    (("normal: [5.0, 0.5]", "lognormal: [5.0, 0.5]"), "vary.initial.target_yaw_deg"),
+])
+def test_a_bad_plan_exits_2_naming_the_field(tmp_path, capsys, change, field):
+    from drake_dock.docking.scenario import PAPER_EXAMPLE
+    plan = tmp_path / "plan.yaml"
+    plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE).replace(*change))
+    out = tmp_path / "out"
+    assert main(["campaign", str(plan), "--out", str(out)]) == 2
+    err = " ".join(capsys.readouterr().err.split())      # the paragraph, unwrapped
+    assert "bad input" in err and f"{field} = " in err, err
+    assert not out.exists()
+
+
+def test_the_good_plan_and_the_shipped_idss_plan_load(tmp_path):
+    from drake_dock.campaign.plan import load_plan
+    from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE, load_scenario
+    plan = tmp_path / "plan.yaml"
+    plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE))
+    assert [f.path for f in load_plan(plan)[2]] == ["initial.lateral_offset",
+                                                    "initial.target_yaw_deg"]
+    idss, base, fields = load_plan(MODELS_DIR / "idss_envelope.yaml")
+    assert base == load_scenario(PAPER_EXAMPLE)
+    assert sum(f.dims for f in fields) == 11         # the eleven random initial parameters
+
+
+def test_edges_sampler_follows_the_arcsine_law_and_sobol_points_keep_their_index():
+    from drake_dock.campaign.sampling import unit_points
+    u = unit_points("edges", 3, 2, list(range(1024)), 1024)
+    # The arcsine law: P(u < a) = (2 / pi) asin(sqrt(a)); Sobol' points match it closely.
+    for a in (0.05, 0.1, 0.5):
+        expected = 2.0 / math.pi * math.asin(math.sqrt(a))
+        assert np.all(np.abs((u < a).mean(axis=0) - expected) < 0.01)
+    first = unit_points("sobol", 3, 2, list(range(8)), 8)
+    assert np.array_equal(first, unit_points("sobol", 3, 2, list(range(100)), 100)[:8])
+    assert np.array_equal(unit_points("uniform", 3, 2, [5], 10),
+                          unit_points("uniform", 3, 2, [9, 5], 1000)[1:])
+
+
+@pytest.mark.parametrize("extra, field", [(["--workers", "0"], "--workers"),
+                                          (["--resume"], "--resume")])
+def test_bad_options_exit_2_naming_them(tmp_path, capsys, extra, field):
+    from drake_dock.docking.scenario import PAPER_EXAMPLE
+    plan = tmp_path / "plan.yaml"
+    plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE))
+    out = tmp_path / "out"
+    assert main(["campaign", str(plan), "--out", str(out), *extra]) == 2
+    assert f"{field} = " in " ".join(capsys.readouterr().err.split())
+    assert not out.exists()
