@@ -29,7 +29,7 @@ def runs(tmp_path_factory):
     ts = dict(np.load(outs[0] / "timeseries.npz"))
     summary = json.loads((outs[0] / "summary.json").read_text())
     return dict(outs=outs, ts=ts, summary=summary, scenario=load_scenario(PAPER_EXAMPLE),
-                stdout=out)
+                stdout=out, stderr=err)
 
 
 def _params(runs):
@@ -64,6 +64,14 @@ def test_files_and_fields(runs):
     for t in ts["impact_t"]:
         at = np.flatnonzero(ts["t"] == t)
         assert ts["sample_kind"][at].tolist() == [1, 2]
+
+
+def test_drake_log_lines_go_to_the_log_file(runs):
+    """Drake's log lines (Meshcat's start-up line, when the replay is drawn) are in drake.log
+    in the output, not on the terminal."""
+    log = (runs["outs"][0] / "drake.log").read_text()
+    assert "Meshcat listening" in log
+    assert "Meshcat" not in runs["stderr"] + runs["stdout"]
 
 
 def test_capture_reached_and_reported(runs):
@@ -203,6 +211,11 @@ def _replay_page(runs, errors):
             browser.close()
 
 
+def _restart(page):
+    """Plays the replay from its start."""
+    page.evaluate("() => { viewer.animator.reset(); viewer.animator.play(); }")
+
+
 def _shot(page):
     import io
 
@@ -217,6 +230,7 @@ def test_replay_plays_in_headless_chromium(runs):
     different times differ (it plays), and no JavaScript error is logged."""
     errors = []
     with _replay_page(runs, errors) as page:
+        _restart(page)          # it plays once on load, perhaps before the page is shown
         a = _shot(page)
         page.wait_for_timeout(900)
         b = _shot(page)
@@ -246,7 +260,7 @@ def test_replay_time_readout_and_force_arrows(runs):
     t_slide = float(sliding[len(sliding) // 2])
     errors = []
     with _replay_page(runs, errors) as page:
-        page.evaluate("() => { viewer.animator.reset(); viewer.animator.play(); }")
+        _restart(page)
         readout = page.locator("#time-readout")
         page.wait_for_timeout(200)
         first = float(readout.get_attribute("data-time"))
