@@ -119,9 +119,10 @@ def _impulses(sh, ax, ts, focus, idx):
     if not hit.any():
         sh.note(ax, "no impact on these couples")
         return None
-    ax.set_yscale("log")
-    lo, hi = P[hit].min(), P[hit].max()
-    ax.set_ylim(lo / 3, hi * 4)
+    positive = P[hit][P[hit] > 0]
+    if positive.size:
+        ax.set_yscale("log")
+        ax.set_ylim(positive.min() / 3, positive.max() * 4)
     return legend_beside(ax, title="impulses")
 
 

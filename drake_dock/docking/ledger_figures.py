@@ -8,14 +8,13 @@ import numpy as np
 from drake_dock.docking.figure_kit import (PALETTE, Sheet, impact_lines, legend_beside,
                                            time_axes)
 from drake_dock.docking.loads import interface_loads
-from drake_dock.docking.results import relative_text
+from drake_dock.docking.results import IN_CONTACT, relative_text
 
-CONTACT = 2     # timeseries status codes >= CONTACT: in contact (sliding 2, sticking 3)
 
 
 def contact_couples(ts) -> list:
     """Indices of the couples ever in contact or taking part in an impact."""
-    ever = (ts["status"] >= CONTACT).any(0) | ts["impact_couples"].any(0)
+    ever = (ts["status"] >= IN_CONTACT).any(0) | ts["impact_couples"].any(0)
     return np.flatnonzero(ever).tolist()
 
 
@@ -36,7 +35,7 @@ def couple_forces_figure(ts, out):
                 lw=1.2, ls="--")
         n_imp = int(ts["impact_couples"][:, j].sum())
         P = ts["impact_normal_impulse"][:, j].sum()
-        ax.set_title(f"{cn[j]}: in contact {(ts['status'][:, j] >= CONTACT).mean():.0%} of "
+        ax.set_title(f"{cn[j]}: in contact {(ts['status'][:, j] >= IN_CONTACT).mean():.0%} of "
                      f"samples, {n_imp} impacts ({P:.3g} N s)", fontsize=8)
         impact_lines(ax, ts)
     for ax in axs.flat[len(idx):]:

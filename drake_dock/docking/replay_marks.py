@@ -15,6 +15,7 @@ from pydrake.geometry import Cylinder, MeshcatCone, Rgba, Sphere
 from pydrake.math import RigidTransform, RollPitchYaw
 
 from drake_dock.docking.loads import couple_forces_W
+from drake_dock.docking.results import IN_CONTACT
 
 ROOT = "/contact"
 ARROW_MAX = 0.25                 # m: the arrow of the run's largest contact force
@@ -23,7 +24,6 @@ ARROW_RGBA = Rgba(0.1, 0.85, 0.1, 1.0)
 POINT_RGBA = Rgba(1.0, 0.9, 0.0, 1.0)
 FLASH_RGBA = Rgba(1.0, 0.0, 1.0, 0.6)
 FLASH_SECONDS = 0.25             # animation seconds an impact stays flashed
-CONTACT = 2                      # timeseries status codes >= CONTACT: in contact
 CHASER = "chaser_apds"
 
 
@@ -70,7 +70,7 @@ def add_marks(meshcat, ts, pairs, t_frame, fps, slow_motion):
                              RigidTransform(RollPitchYaw(np.pi, 0, 0), [0, 0, 1.0]))
         meshcat.SetObject(f"{base}/flash", Sphere(0.05), FLASH_RGBA)
         for k in range(len(t_frame)):
-            touching = bool(status[k, j] >= CONTACT)
+            touching = bool(status[k, j] >= IN_CONTACT)
             pushing = touching and mag[k, j] > 0.0
             anim.SetProperty(k, f"{base}/point", "visible", touching)
             anim.SetTransform(k, f"{base}/point", RigidTransform(points[k, j]))
@@ -102,8 +102,8 @@ def _flash_frames(ts, t_frame, fps, slow_motion):
 def _readout_lines(ts, status, mag, flash, names):
     lines = []
     for k in range(len(status)):
-        touching = np.flatnonzero(status[k] >= CONTACT)
-        sliding = int((status[k] == CONTACT).sum())
+        touching = np.flatnonzero(status[k] >= IN_CONTACT)
+        sliding = int((status[k] == IN_CONTACT).sum())
         text = (f"in contact: {len(touching)} couple{'s' if len(touching) != 1 else ''}"
                 + (f" ({sliding} sliding), total force {mag[k].sum():.4g} N" if len(touching)
                    else ""))

@@ -20,6 +20,8 @@ from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
                                       stewart_potential)
 
+IN_CONTACT = 2      # status codes >= IN_CONTACT: the couple is in contact (2 sliding, 3 sticking)
+
 
 def timeseries(result) -> dict:
     dd = result.dd
