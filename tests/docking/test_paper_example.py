@@ -216,6 +216,13 @@ def _restart(page):
     page.evaluate("() => { viewer.animator.reset(); viewer.animator.play(); }")
 
 
+def _seek(page, ta):
+    """Pauses the replay at animation time ``ta`` (s) and lets it draw."""
+    page.evaluate(f"() => {{ viewer.animator.pause(); viewer.animator.seek({ta}); }}")
+    page.wait_for_timeout(400)
+    return page
+
+
 def _shot(page):
     import io
 
@@ -226,14 +233,12 @@ def _shot(page):
 
 @needs_chromium
 def test_replay_plays_in_headless_chromium(runs):
-    """replay.html in headless Chromium: the canvas shows the APDS (not blank), two frames at
-    different times differ (it plays), and no JavaScript error is logged."""
+    """replay.html in headless Chromium: the canvas shows the APDS (not blank), two frames 0.9 s
+    apart in animation time differ (sought, not waited for: the wall time of a screenshot
+    varies with the machine's load), and no JavaScript error is logged."""
     errors = []
     with _replay_page(runs, errors) as page:
-        _restart(page)          # it plays once on load, perhaps before the page is shown
-        a = _shot(page)
-        page.wait_for_timeout(900)
-        b = _shot(page)
+        a, b = (_shot(_seek(page, ta)) for ta in (0.3, 1.2))
     assert a.std() > 10.0                                   # not a blank canvas
     # The APDS colours (blue target APDS, orange chaser APDS) are on screen.
     blue = (a[..., 2] > a[..., 0] + 60) & (a[..., 2] > 120)
@@ -262,16 +267,16 @@ def test_replay_time_readout_and_force_arrows(runs):
     with _replay_page(runs, errors) as page:
         _restart(page)
         readout = page.locator("#time-readout")
-        page.wait_for_timeout(200)
+        now = "parseFloat(document.getElementById('time-readout').dataset.time)"
+        page.wait_for_function(f"() => {now} >= 0", timeout=30_000)
         first = float(readout.get_attribute("data-time"))
-        page.wait_for_timeout(500)
+        # Advances (polled: how often the page draws depends on the machine's load).
+        page.wait_for_function(f"() => {now} > {first}", timeout=30_000)
         second = float(readout.get_attribute("data-time"))
         shots = {}
         for t in (t0 + 0.5 * (ts["impact_t"][0] - t0), t_slide):
-            page.evaluate(f"() => {{ viewer.animator.pause(); "
-                          f"viewer.animator.seek({(t - t0) * slow}); }}")
-            page.wait_for_timeout(400)
-            shots[t] = (_shot(page), float(readout.get_attribute("data-time")),
+            shots[t] = (_shot(_seek(page, (t - t0) * slow)),
+                        float(readout.get_attribute("data-time")),
                         readout.text_content())
     assert second > first >= t0
     before, during = shots.values()
