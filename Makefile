@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= out/paper_example
 
-.PHONY: demo test test-core bench clean
+.PHONY: demo test test-core bench clean notebook
 
 $(BIN)/.installed: pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
@@ -14,6 +14,15 @@ $(BIN)/.installed: pyproject.toml constraints.txt
 
 demo: $(BIN)/.installed
 	$(BIN)/drake-dock run models/paper_example.yaml --out $(OUT)
+
+# Jupyter (the `notebook` extra) and the tutorial opened in it.
+$(BIN)/.notebook: $(BIN)/.installed
+	$(BIN)/python -m pip install --quiet -c constraints.txt -e ".[notebook]"
+	touch $@
+
+# Jupyter refuses to run as root unless told (containers).
+notebook: $(BIN)/.notebook
+	$(BIN)/jupyter notebook $(if $(filter 0,$(shell id -u)),--allow-root) notebooks/tutorial.ipynb
 
 test: $(BIN)/.installed
 	$(BIN)/python -m pytest -q

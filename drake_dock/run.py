@@ -1,5 +1,6 @@
 """Runs a docking scenario end to end and writes its outputs atomically into a directory:
-``timeseries.npz``, ``summary.json``, the figures (PNG) and ``replay.html``.
+``timeseries.npz``, ``summary.json``, the figures (PNG), ``replay.html`` and ``drake.log`` (the
+lines Drake logged during the run, which are kept off the terminal).
 
 A failed run (bad input, numerical failure) leaves no directory, or the previous complete one
 untouched (`drake_dock.docking.output.atomic_directory`). The destination is checked before anything is
@@ -8,13 +9,16 @@ previous drake_dock output is replaced.
 """
 from __future__ import annotations
 
+import contextlib
 import io
 import json
+import logging
 from types import SimpleNamespace
 
 import numpy as np
 
 from drake_dock.docking.replay import replay_html
+from drake_dock.docking.scene import apds_pairs
 from drake_dock.docking.results import (momenta, momentum_reference_point, relative_text, summary,
                                         timeseries)
 from drake_dock.docking.simulate import simulate
@@ -46,12 +50,38 @@ def _non_finite(node, path=""):
     return None
 
 
-def run(scenario, out_dir, *, progress=None, state=None) -> dict:
-    """Simulates ``scenario`` and writes everything into ``out_dir``; returns the summary.
-    Raises `InputError` for a destination that may not be replaced, before simulating, and
-    `NumericalError` for a failed simulation or a non-finite summary value (nothing written)."""
+@contextlib.contextmanager
+def drake_log():
+    """Collects the records of Drake's logger ("drake", where pydrake sends Drake's log lines)
+    into a list of lines instead of letting them reach the terminal; restored after."""
+    logger = logging.getLogger("drake")
+    lines = []
+    handler = logging.Handler()
+    handler.emit = lambda record: lines.append(f"{record.levelname}: {record.getMessage()}")
+    saved = logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+    try:
+        yield lines
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = saved
+
+
+def run(scenario, out_dir, *, progress=None, state=None, dd=None, full=False):
+    """Simulates ``scenario`` and writes everything into ``out_dir``; returns the summary, or
+    with ``full`` a namespace (summary, timeseries, result: the `RunResult`, figures: the
+    `FigureRecord`s). ``dd``: a docking Diagram built by the caller (with a controller on
+    ``chaser_wrench``, say; `drake_dock.docking.simulate.simulate`). Raises `InputError` for a
+    destination that may not be replaced, before simulating, and `NumericalError` for a failed
+    simulation or a non-finite summary value (nothing written)."""
     check_destination(out_dir)
-    result = simulate(scenario, progress=progress, state=state)
+    with drake_log() as log:
+        return _run(scenario, out_dir, progress, state, dd, full, log)
+
+
+def _run(scenario, out_dir, progress, state, dd, full, log):
+    result = simulate(scenario, progress=progress, state=state, dd=dd)
     if hasattr(progress, "note"):
         progress.note(f"{result.outcome} at t = {result.end_time:.4f} s; writing the outputs "
                       f"(arrays, figures, replay)")
@@ -65,20 +95,23 @@ def run(scenario, out_dir, *, progress=None, state=None) -> dict:
     P, L, _, _ = momenta(ts, [p.mass for p in params], [p.inertia for p in params],
                          momentum_reference_point(scenario, ts))
     nq = result.dd.dp.plant.num_positions()
-    html = replay_html(scenario, ts["t"], np.asarray(result.record.x)[:, :nq])
+    html = replay_html(scenario, ts["t"], np.asarray(result.record.x)[:, :nq], ts=ts)
     with atomic_directory(out_dir) as tmp:
         (tmp / "timeseries.npz").write_bytes(_npz_bytes(ts))
-        summ["figures"] = run_figures(ts, summ, (P, L), tmp,
-                                      focus_couples=result.initial.closing_pairs)
+        records = run_figures(ts, summ, (P, L), tmp, focus_couples=result.initial.closing_pairs,
+                              pairs=apds_pairs(scenario.geometry))
         poses = {n: (ts["R_WA"][0, j], ts["p_WA"][0, j])
                  for j, n in enumerate(ts["apds_names"].tolist())}
         cn = ts["couple_names"].tolist()
         first = {c: SimpleNamespace(p1=ts["p1_W"][0, cn.index(c)], p2=ts["p2_W"][0, cn.index(c)])
                  for c in result.initial.closing_pairs}
-        initial_configuration_figure(scenario.geometry, poses, first,
-                                     tmp / "initial_configuration.png")
+        records.append(initial_configuration_figure(scenario.geometry, poses, first, tmp))
+        summ["figures"] = [r.name for r in records]
         (tmp / "replay.html").write_text(html)
         (tmp / "summary.json").write_text(json.dumps(summ, indent=2, allow_nan=False) + "\n")
+        (tmp / "drake.log").write_text("".join(line + "\n" for line in log))
+    if full:
+        return SimpleNamespace(summary=summ, timeseries=ts, result=result, figures=records)
     return summ
 
 

@@ -5,6 +5,11 @@ events never cut the simulation's steps): a display-only Diagram (plant, SceneGr
 MeshcatVisualizer) is posed at frame times spaced 1/fps apart in animation time, positions
 interpolated linearly between samples (quaternions renormalised). Animation time is simulation
 time times ``slow_motion``: the capture phase lasts a fraction of a second.
+
+The camera looks at the two APDS from the side, from outside the spacecraft hulls with a narrow
+field of view, so that the rings fill the view; the hulls are drawn translucent. Given the
+run's timeseries, the contact points, force arrows, impact flashes and the time readout of
+`drake_dock.docking.replay_marks` are added.
 """
 from __future__ import annotations
 
@@ -13,6 +18,12 @@ from pydrake.geometry import Meshcat, MeshcatParams, MeshcatVisualizer
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_dock.docking.plant import add_docking_plant
+from drake_dock.docking.replay_marks import add_marks, overlay_html
+from drake_dock.docking.scene import apds_pairs
+
+CAMERA_DISTANCE = 2.8     # m from the rings' midpoint, outside the hulls (radius 1.2 m)
+CAMERA_FOV = 26.0         # deg, vertical
+HULL_OPACITY = 0.3
 
 
 def make_meshcat() -> Meshcat:
@@ -43,8 +54,30 @@ def interpolate_positions(t, Q, t_frame, quaternion_starts=()):
     return out
 
 
-def replay_html(scenario, t, Q, *, fps=30.0, slow_motion=10.0, meshcat=None) -> str:
-    """The HTML page replaying positions Q[N, nq] (the plant's layout) sampled at t[N]."""
+def _frame_camera(meshcat, dp, q0, radius):
+    """Camera on the midpoint of the two ring centres, from the side of the docking axis,
+    raised by 10 degrees, at the distance where the rings (``radius``) fill the view."""
+    X = dp.plant.CreateDefaultContext()
+    dp.plant.SetPositions(X, q0)
+    poses = [f.CalcPoseInWorld(X) for f in dp.apds_frames.values()]
+    centre = 0.5 * sum(p.translation() for p in poses)
+    axis = poses[0].rotation().matrix()[:, 2]
+    side = np.cross(axis, [0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else \
+        np.cross(axis, [1.0, -1.0, 0.0])
+    side /= np.linalg.norm(side)
+    distance = max(CAMERA_DISTANCE, 2.4 * radius / np.tan(np.radians(CAMERA_FOV / 2)) / 2)
+    el = np.radians(10.0)
+    eye = centre + distance * (np.cos(el) * side + np.sin(el) * axis)
+    meshcat.SetCamera(Meshcat.PerspectiveCamera(fov=CAMERA_FOV, near=0.05, far=100.0))
+    meshcat.SetCameraPose(eye, centre)
+    for body in ("target", "chaser"):
+        meshcat.SetProperty(f"/drake/visualizer/{body}/{body}_hull", "modulated_opacity",
+                            HULL_OPACITY)
+
+
+def replay_html(scenario, t, Q, *, fps=30.0, slow_motion=10.0, meshcat=None, ts=None) -> str:
+    """The HTML page replaying positions Q[N, nq] (the plant's layout) sampled at t[N]; with
+    the run's timeseries ``ts`` (same samples), the contact marks and the time readout."""
     meshcat = meshcat or make_meshcat()
     builder = DiagramBuilder()
     dp = add_docking_plant(builder, scenario)
@@ -57,17 +90,21 @@ def replay_html(scenario, t, Q, *, fps=30.0, slow_motion=10.0, meshcat=None) -> 
     t = np.asarray(t, float)
     n = int(np.floor((t[-1] - t[0]) * slow_motion * fps)) + 1
     t_anim = np.arange(n) / fps
-    Qf = interpolate_positions(t, np.asarray(Q), t[0] + t_anim / slow_motion, quats)
-    # Look at the two rings from the side, close enough to see the petals slide.
-    X = dp.plant.CreateDefaultContext()
-    dp.plant.SetPositions(X, Qf[0])
-    centre = 0.5 * sum(f.CalcPoseInWorld(X).translation() for f in dp.apds_frames.values())
-    meshcat.SetCameraPose(centre + np.array([1.3, -1.3, 0.5]), centre)
+    t_frame = t[0] + t_anim / slow_motion
+    Qf = interpolate_positions(t, np.asarray(Q), t_frame, quats)
     meshcat.StartRecording(frames_per_second=fps)
     for ta, q in zip(t_anim, Qf):
         ctx.SetTime(float(ta))
         dp.plant.SetPositions(pc, q)
         diagram.ForcedPublish(ctx)
+    _frame_camera(meshcat, dp, Qf[0], scenario.geometry.R)
+    overlay = ""
+    if ts is not None:
+        lines = add_marks(meshcat, ts, apds_pairs(scenario.geometry), t_frame, fps,
+                          slow_motion)
+        overlay = overlay_html(float(t[0]), fps, slow_motion, lines)
     meshcat.StopRecording()
     meshcat.PublishRecording()
-    return meshcat.StaticHtml()
+    page = meshcat.StaticHtml()
+    at = page.rfind("</body>")
+    return page[:at] + overlay + page[at:] if at >= 0 else page + overlay

@@ -5,7 +5,10 @@ Field layout: t[N]; body_names[3]; p_WB[N,3,3], R_WB[N,3,3,3], v_WB[N,3,3], w_WB
 axis towards the other APDS); couple_names[12]; status[N,12] (the pair's `Mode`: 0 far,
 1 tracked, 2 sliding, 3 sticking); active[N,12] (tracked or in contact); gap[N,12];
 lambda_n[N,12]; lambda_t[N,12,2];
-u[N,12,3] (couple parameters, unused entries 0); p1_W[N,12,3], p2_W[N,12,3]; sample_kind[N]
+u[N,12,3] (couple parameters, unused entries 0); p1_W[N,12,3], p2_W[N,12,3]; frame_W[N,12,3,3]
+(columns ta, tb, n: the contact frame, n from the couple's body 2 to its body 1; the identity
+for far couples); stewart_x[N,3] (m), stewart_rpy[N,3] (rad) (the Stewart element's deflection,
+`drake_dock.docking.plant.stewart_deflection`); sample_kind[N]
 (0 step end, 1 just before an impact, 2 just after); ring_distance[N]; energy[N,k] with
 energy_names[k]; impact_t[M], impact_couples[M,12] (bool), impact_normal_impulse[M,12],
 impact_tangential_impulse[M,12,2], impact_restitution[M].
@@ -16,7 +19,10 @@ import numpy as np
 
 from drake_dock.core.hybrid import Mode
 from drake_dock.systems.contact_system import COUPLE_SLICES
-from drake_dock.docking.plant import APDS_NAMES, BODY_NAMES, stewart_potential
+from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
+                                      stewart_potential)
+
+IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or sticking)
 
 
 def timeseries(result) -> dict:
@@ -30,6 +36,7 @@ def timeseries(result) -> dict:
     v_WB, w_WB = np.zeros((N, 3, 3)), np.zeros((N, 3, 3))
     p_WA, R_WA = np.zeros((N, 2, 3)), np.zeros((N, 2, 3, 3))
     pe = np.zeros(N)
+    sx, srpy = np.zeros((N, 3)), np.zeros((N, 3))
     for k in range(N):
         plant.SetPositionsAndVelocities(pc, X[k])
         for j, name in enumerate(BODY_NAMES):
@@ -42,6 +49,7 @@ def timeseries(result) -> dict:
             Xa = dd.dp.apds_frames[name].CalcPoseInWorld(pc)
             p_WA[k, j], R_WA[k, j] = Xa.translation(), Xa.rotation().matrix()
         pe[k] = stewart_potential(dd.dp, pc)
+        sx[k], srpy[k] = stewart_deflection(dd.dp, pc)
     C = np.asarray(rec.couples)
     S = COUPLE_SLICES
     status = C[:, :, S["status"]][..., 0].astype(np.int8)
@@ -63,7 +71,8 @@ def timeseries(result) -> dict:
         couple_names=np.array(names), status=status, active=status >= Mode.TRACKED,
         gap=C[:, :, S["gap"]][..., 0], lambda_n=C[:, :, S["lambda_n"]][..., 0],
         lambda_t=C[:, :, S["lambda_t"]], u=C[:, :, S["u"]], p1_W=C[:, :, S["p1"]],
-        p2_W=C[:, :, S["p2"]], sample_kind=np.asarray(rec.kind, dtype=np.int8),
+        p2_W=C[:, :, S["p2"]], frame_W=C[:, :, S["frame"]].reshape(N, -1, 3, 3),
+        stewart_x=sx, stewart_rpy=srpy, sample_kind=np.asarray(rec.kind, dtype=np.int8),
         ring_distance=np.asarray(rec.ring_distance), energy=energy,
         energy_names=np.array(energy_names),
         impact_t=np.array([imp["t"] for imp in result.impacts], dtype=float),

@@ -1,5 +1,6 @@
 """The paper's example (Sect. 8.2) end to end through the CLI, checked on its output files
 against conservation laws, symmetry, the geometry and a second run."""
+import contextlib
 import json
 import subprocess
 import sys
@@ -29,7 +30,7 @@ def runs(tmp_path_factory):
     ts = dict(np.load(outs[0] / "timeseries.npz"))
     summary = json.loads((outs[0] / "summary.json").read_text())
     return dict(outs=outs, ts=ts, summary=summary, scenario=load_scenario(PAPER_EXAMPLE),
-                stdout=out)
+                stdout=out, stderr=err)
 
 
 def _params(runs):
@@ -64,6 +65,14 @@ def test_files_and_fields(runs):
     for t in ts["impact_t"]:
         at = np.flatnonzero(ts["t"] == t)
         assert ts["sample_kind"][at].tolist() == [1, 2]
+
+
+def test_drake_log_lines_go_to_the_log_file(runs):
+    """Drake's log lines (Meshcat's start-up line, when the replay is drawn) are in drake.log
+    in the output, not on the terminal."""
+    log = (runs["outs"][0] / "drake.log").read_text()
+    assert "Meshcat listening" in log
+    assert "Meshcat" not in runs["stderr"] + runs["stdout"]
 
 
 def test_capture_reached_and_reported(runs):
@@ -178,18 +187,16 @@ def test_gaps_and_points_on_patches(runs):
 
 
 CHROMIUM = "/usr/bin/chromium"
+needs_chromium = pytest.mark.skipif(not __import__("os").path.exists(CHROMIUM),
+                                    reason="Debian's chromium is not installed (.ci/run "
+                                           "installs it)")
 
 
-@pytest.mark.skipif(not __import__("os").path.exists(CHROMIUM),
-                    reason="Debian's chromium is not installed (.ci/run installs it)")
-def test_replay_plays_in_headless_chromium(runs):
-    """replay.html in headless Chromium: the canvas shows the APDS (not blank), two frames at
-    different times differ (it plays), and no JavaScript error is logged."""
-    import io
-
-    from PIL import Image
+@contextlib.contextmanager
+def _replay_page(runs, errors):
+    """replay.html of the first run open in headless Chromium, its canvas drawn; JavaScript
+    errors collected into ``errors``."""
     from playwright.sync_api import sync_playwright
-    errors = []
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=[
             "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox"])
@@ -197,22 +204,86 @@ def test_replay_plays_in_headless_chromium(runs):
         page.on("console", lambda m: m.type == "error" and errors.append(m.text))
         page.on("pageerror", lambda e: errors.append(str(e)))
         page.goto((runs["outs"][0] / "replay.html").as_uri())
-        canvas = page.locator("canvas").first
-        canvas.wait_for(timeout=60_000)
+        page.locator("canvas").first.wait_for(timeout=60_000)
         page.wait_for_timeout(300)
-        shots = []
-        for _ in range(2):
-            png = canvas.screenshot()
-            shots.append(np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), float))
-            page.wait_for_timeout(900)
-        browser.close()
-    a, b = shots
+        try:
+            yield page
+        finally:
+            browser.close()
+
+
+def _restart(page):
+    """Plays the replay from its start."""
+    page.evaluate("() => { viewer.animator.reset(); viewer.animator.play(); }")
+
+
+def _seek(page, ta):
+    """Pauses the replay at animation time ``ta`` (s) and lets it draw."""
+    page.evaluate(f"() => {{ viewer.animator.pause(); viewer.animator.seek({ta}); }}")
+    page.wait_for_timeout(400)
+    return page
+
+
+def _shot(page):
+    import io
+
+    from PIL import Image
+    png = page.locator("canvas").first.screenshot()
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), float)
+
+
+@needs_chromium
+def test_replay_plays_in_headless_chromium(runs):
+    """replay.html in headless Chromium: the canvas shows the APDS (not blank), two frames 0.9 s
+    apart in animation time differ (sought, not waited for: the wall time of a screenshot
+    varies with the machine's load), and no JavaScript error is logged."""
+    errors = []
+    with _replay_page(runs, errors) as page:
+        a, b = (_shot(_seek(page, ta)) for ta in (0.3, 1.2))
     assert a.std() > 10.0                                   # not a blank canvas
     # The APDS colours (blue target APDS, orange chaser APDS) are on screen.
     blue = (a[..., 2] > a[..., 0] + 60) & (a[..., 2] > 120)
     orange = (a[..., 0] > a[..., 2] + 60) & (a[..., 0] > 120)
     assert blue.mean() > 1e-3 and orange.mean() > 1e-3
     assert (np.abs(a - b).sum(-1) > 10).mean() > 1e-3       # it plays
+    assert errors == []
+
+
+def _green(img):
+    """Pixels of the force arrows' green."""
+    return int(((img[..., 1] > img[..., 0] + 60) & (img[..., 1] > img[..., 2] + 60)).sum())
+
+
+@needs_chromium
+def test_replay_time_readout_and_force_arrows(runs):
+    """The time readout advances while the replay plays; at a time when the three couples
+    slide (from the timeseries) the readout shows that time and force arrows are on screen,
+    and before the first contact none is."""
+    ts = runs["ts"]
+    t0, slow = ts["t"][0], 10.0
+    idx = [ts["couple_names"].tolist().index(c) for c in runs["summary"]["first_closing_couples"]]
+    sliding = ts["t"][(ts["status"][:, idx] == 2).all(1) & (ts["t"] > ts["impact_t"].max())]
+    t_slide = float(sliding[len(sliding) // 2])
+    errors = []
+    with _replay_page(runs, errors) as page:
+        _restart(page)
+        readout = page.locator("#time-readout")
+        now = "parseFloat(document.getElementById('time-readout').dataset.time)"
+        page.wait_for_function(f"() => {now} >= 0", timeout=30_000)
+        first = float(readout.get_attribute("data-time"))
+        # Advances (polled: how often the page draws depends on the machine's load).
+        page.wait_for_function(f"() => {now} > {first}", timeout=30_000)
+        second = float(readout.get_attribute("data-time"))
+        shots = {}
+        for t in (t0 + 0.5 * (ts["impact_t"][0] - t0), t_slide):
+            shots[t] = (_shot(_seek(page, (t - t0) * slow)),
+                        float(readout.get_attribute("data-time")),
+                        readout.text_content())
+    assert second > first >= t0
+    before, during = shots.values()
+    assert _green(before[0]) < 5 and "in contact: 0 couples" in before[2]
+    assert _green(during[0]) > 100
+    assert abs(during[1] - t_slide) <= 1.0 / (30.0 * slow) and "3 sliding" in during[2]
     assert errors == []
 
 

@@ -157,7 +157,7 @@ def test_seeking_matches_brute_force_on_random_poses(geom, seed):
 def test_seeking_matches_brute_force_points(geom, kind):
     """Interior couples at a positive gap (the scenes of test_couple, random instants): the
     same couple as dense sampling + scipy, both points within 1e-9 m."""
-    from test_couple import cc_scene, cs_scene
+    from couple_scenes import cc_scene, cs_scene
     _, c1, m1, c2, m2 = cs_scene(geom) if kind == "CS" else cc_scene(geom)
     for t in np.random.default_rng(7).uniform(0.0, 1.0, 4):
         P1, P2 = posed(c1, *m1.pose(t)), posed(c2, *m2.pose(t))
