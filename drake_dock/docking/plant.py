@@ -203,10 +203,3 @@ class StewartDamperPower:
         f.SetZero()
         self.plant.CalcForceElementsContribution(self.ctx, f)
         return float(self.plant.CalcGeneralizedForces(self.ctx, f) @ v)
-
-
-def total_energy(dp: DockingPlant, plant_context) -> float:
-    """Kinetic energy plus the Stewart potential."""
-    v = dp.plant.GetVelocities(plant_context)
-    return float(0.5 * v @ dp.plant.CalcMassMatrix(plant_context) @ v
-                 + stewart_potential(dp, plant_context))

@@ -16,7 +16,6 @@ import copy
 import dataclasses
 import time as _time
 
-import numpy as np
 from pydrake.systems.analysis import Simulator, SimulatorStatus
 
 from drake_dock.systems.contact_system import CONTACT, COUPLE_OUTPUT_SIZE, FAR, ContactModes

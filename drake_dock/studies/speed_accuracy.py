@@ -35,7 +35,6 @@ import csv
 import dataclasses
 import io
 import math
-import time as _time
 from pathlib import Path
 
 import numpy as np
