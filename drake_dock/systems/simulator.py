@@ -35,11 +35,12 @@ def tolerances(config: SimulatorConfig, witness_accuracy: float | None = None) -
     return Tolerances(acc, 0.01 * acc, min(hi, max(lo, 1e-2 * acc)))
 
 
-def make_simulator(system, config: SimulatorConfig, set_state=None, *,
+def make_simulator(system, config: SimulatorConfig, set_state=None, *, context=None,
                    witness_accuracy: float | None = None) -> Simulator:
-    """A `Simulator` of ``system`` with ``config`` applied and the context's accuracy set
-    (`tolerances`); ``set_state(root_context)`` writes the initial state first."""
-    sim = Simulator(system)
+    """A `Simulator` of ``system`` (on ``context`` if given, as Drake's constructor) with
+    ``config`` applied and the context's accuracy set (`tolerances`);
+    ``set_state(root_context)`` writes the initial state first."""
+    sim = Simulator(system) if context is None else Simulator(system, context)
     root = sim.get_mutable_context()
     if set_state is not None:
         set_state(root)
