@@ -81,7 +81,7 @@ from scipy.optimize import brentq
 from drake_dock.core.lzb.friction import select_modes
 from drake_dock.core.lzb.inputs import check_inputs, per_couple
 from drake_dock.core.lzb.laws import LAWS
-from drake_dock.core.lzb.problem import ImpactProblem
+from drake_dock.core.lzb.problem import APPROACH, FRICTION, NORMAL, ImpactProblem
 from drake_dock.errors import NumericalError
 
 __all__ = ["LAWS", "ImpactResult", "solve_lzb", "check_inputs", "per_couple"]
@@ -116,11 +116,11 @@ def active_events(prob, dense, t0, t1, g0, g1):
     phases) is not missed, nor a crossing that follows a start at the threshold."""
     out = []
     for kind, j in zip(*np.nonzero((g0 > 0) & (g1 <= 0))):
-        if kind == 1 or prob.locked[j]:     # friction, a locked couple's release
+        if kind == FRICTION or prob.locked[j]:     # friction, a locked couple's release
             out.append((kind, j, t0, t1))
     T = np.concatenate([[t0], t0 + _INSIDE * (t1 - t0), [t1]])
     inside = prob.normal_event_values(dense(T[1:-1]))
-    for kind, G in ((0, inside[0]), (2, inside[1])):
+    for kind, G in ((NORMAL, inside[0]), (APPROACH, inside[1])):
         G = np.column_stack([g0[kind], G, g1[kind]])       # (s, samples)
         # Inside the step a crossing counts from a value clear of round-off.
         down = ((G[:, :-1] > _CLEAR) | ((G[:, :-1] > 0) & (np.arange(len(T) - 1) == 0))) \
