@@ -9,11 +9,12 @@ import argparse
 import time
 
 import numpy as np
-from pydrake.systems.analysis import Simulator
+from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.core.constraints import STICK, solve_given_modes
 from drake_dock.core.hybrid import Mode
 from drake_dock.studies.small_scenes import stool
+from drake_dock.systems.simulator import make_simulator
 
 
 def per_call(fn, repeats):
@@ -33,11 +34,10 @@ def main():
     a = ap.parse_args()
     sc = stool()
     sys_ = sc.system
-    sim = Simulator(sys_)
+    sim = make_simulator(sys_, SimulatorConfig(), lambda ctx: sc.set_state(
+        ctx, (np.eye(3), np.array([0, 0, 0.2 + sc.params["foot_radius"]])),
+        (np.zeros(3), np.zeros(3))), witness_accuracy=1e-8)
     ctx = sim.get_mutable_context()
-    sc.set_state(ctx, (np.eye(3), np.array([0, 0, 0.2 + sc.params["foot_radius"]])),
-                 (np.zeros(3), np.zeros(3)))
-    ctx.SetAccuracy(1e-8)
     sim.Initialize()
     sim.AdvanceTo(0.01)
     modes = sys_.get_modes(ctx)

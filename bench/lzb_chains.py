@@ -15,7 +15,8 @@ import time
 
 import numpy as np
 
-from drake_dock.core.lzb.solve import check_inputs, per_couple, solve_lzb
+from drake_dock.core.lzb.inputs import check_inputs, per_couple
+from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.core.lzb.problem import ImpactProblem
 from drake_dock.core.lzb.limit import continuous_limit_chain
 
@@ -63,10 +64,10 @@ def solve_lzb_fixed_step(M, Wn, v_minus, stiffness, eta, restitution, *, dP, law
         for kind, j in zip(*np.nonzero((g_old > 0) & (g_new <= 0))):
             prob.apply_event(y, kind, j, events, 0.0)
         g_old = prob.event_values(y)
-        lam = K * np.maximum(y[prob.ix], 0.0) ** eta_
+        lam = K * np.maximum(y[prob.layout.x], 0.0) ** eta_
         if lam.max() > 0:
             t_step = dP / lam.max()
-    P = y[prob.iP]
+    P = y[prob.layout.P]
     return v + MinvW @ P
 
 

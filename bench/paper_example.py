@@ -13,7 +13,6 @@ import argparse
 import time
 
 import numpy as np
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_dock.docking.diagram import build_docking_diagram
@@ -21,19 +20,15 @@ from drake_dock.docking.plant import add_docking_plant, set_initial_state
 from drake_dock.docking.scene import initial_state
 from drake_dock.docking.simulate import simulate
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.systems.simulator import make_simulator
 
 
 def free_flight(scenario, state, t_end):
     builder = DiagramBuilder()
     dp = add_docking_plant(builder, scenario)
     diagram = builder.Build()
-    sim = Simulator(diagram)
-    ctx = sim.get_mutable_context()
-    set_initial_state(dp, dp.plant.GetMyMutableContextFromRoot(ctx), state)
-    sp = scenario.simulation
-    ApplySimulatorConfig(SimulatorConfig(integration_scheme=sp.integration_scheme,
-                                         accuracy=sp.accuracy, max_step_size=sp.max_step), sim)
-    ctx.SetAccuracy(sp.accuracy)
+    sim = make_simulator(diagram, scenario.simulator_config, lambda root: set_initial_state(
+        dp, dp.plant.GetMyMutableContextFromRoot(root), state))
     t0 = time.perf_counter()
     sim.Initialize()
     sim.AdvanceTo(t_end)
@@ -81,13 +76,13 @@ def main():
     if args.coarse_step > 0:
         import copy
         sc2 = copy.deepcopy(scenario)
-        sc2.simulation.max_step = args.coarse_step
+        sc2.simulator_config.max_step_size = args.coarse_step
         coarse = simulate(sc2, state=state, dd=build_docking_diagram(sc2))
     other = None
-    if args.compare_scheme and args.compare_scheme != scenario.simulation.integration_scheme:
+    if args.compare_scheme and args.compare_scheme != scenario.simulator_config.integration_scheme:
         import copy
         sc3 = copy.deepcopy(scenario)
-        sc3.simulation.integration_scheme = args.compare_scheme
+        sc3.simulator_config.integration_scheme = args.compare_scheme
         other = simulate(sc3, state=state, dd=build_docking_diagram(sc3))
     print(f"scenario: {args.scenario}")
     print(f"set-up (excluded): initial state {t_state:.2f} s, diagram {t_build:.2f} s")
@@ -105,12 +100,12 @@ def main():
               f"{plain.wall_time / wall:.1f}x")
     if coarse is not None:
         print(f"with the step cap (= output spacing) {args.coarse_step:g} s instead of "
-              f"{scenario.simulation.max_step:g} s: {coarse.wall_time:.3f} s, "
+              f"{scenario.simulator_config.max_step_size:g} s: {coarse.wall_time:.3f} s, "
               f"{coarse.evaluations} evaluations, {len(coarse.record.t)} samples instead of "
               f"{len(r.record.t)}; capture {coarse.capture_time:.9f} s vs {r.capture_time:.9f} s; "
               f"ratio {wall / coarse.wall_time:.2f}x")
     if other is not None:
-        print(f"with {args.compare_scheme} instead of {scenario.simulation.integration_scheme}: "
+        print(f"with {args.compare_scheme} instead of {scenario.simulator_config.integration_scheme}: "
               f"{other.wall_time:.3f} s, {other.evaluations} evaluations, "
               f"{len(other.record.t)} samples; capture {other.capture_time:.9f} s vs "
               f"{r.capture_time:.9f} s; ratio {other.wall_time / wall:.2f}x")

@@ -23,7 +23,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
+from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.framework import LeafSystem
 
 from drake_dock.studies.compliant import (CompliantConfig, hunt_crossley_dissipation,
@@ -32,6 +32,7 @@ from drake_dock.docking.scene import initial_state
 from drake_dock.docking.simulate import simulate
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.speed_accuracy import METRICS, rigid_metrics
+from drake_dock.systems.simulator import make_simulator
 
 sys.path.insert(0, str(Path(__file__).parent))
 from paper_example import free_flight  # noqa: E402  (a sibling bench script)
@@ -54,9 +55,8 @@ class _Empty(LeafSystem):
 def empty_leaf_cost(scheme, n_min=3000) -> float:
     """Wall seconds per derivative evaluation of `_Empty` under ``scheme``."""
     s = _Empty()
-    sim = Simulator(s)
-    sim.get_mutable_context().SetContinuousState([1.0, 0.0])
-    ApplySimulatorConfig(SimulatorConfig(integration_scheme=scheme, accuracy=1e-3), sim)
+    sim = make_simulator(s, SimulatorConfig(integration_scheme=scheme, accuracy=1e-3),
+                         lambda root: root.SetContinuousState([1.0, 0.0]))
     t0 = time.perf_counter()
     sim.Initialize()
     t = 0.0
@@ -76,15 +76,15 @@ def main():
     state = initial_state(scenario)
     e3 = state.X_WB["target_apds"][0][:, 2].copy()
     sc = copy.deepcopy(scenario)
-    sc.simulation.accuracy = 1e-8
+    sc.simulator_config.accuracy = 1e-8
     ref = rigid_metrics(simulate(sc, state=state), e3)
 
     def err(m):
         return {k: abs(m[k] - ref[k]) / abs(ref[k]) for k in METRICS}
 
     fast = copy.deepcopy(scenario)
-    fast.simulation.accuracy = 1e-3
-    fast.simulation.max_step = 0.01
+    fast.simulator_config.accuracy = 1e-3
+    fast.simulator_config.max_step_size = 0.01
     runs = [simulate(fast, state=state) for _ in range(args.repeats)]
     t_dd = float(np.median([r.wall_time for r in runs]))
     evals = runs[0].evaluations
@@ -100,7 +100,7 @@ def main():
                  "chaser_axial_velocity": r.chaser_axial_velocity,
                  "peak_contact_force": r.peak_force}
             rows.append((cfg.label(), r.wall_time, err(m) if r.captured else None))
-    leaf = empty_leaf_cost(scenario.simulation.integration_scheme)
+    leaf = empty_leaf_cost(scenario.simulator_config.integration_scheme)
     t_free = free_flight(fast, state, ref["capture_time"])
     w0 = state.V_WB["target_apds"][0] @ e3
     v0 = state.V_WB["chaser"][1] @ e3

@@ -10,8 +10,7 @@ import time
 import numpy as np
 
 from drake_dock.run import time_shares_line
-from drake_dock.studies.small_scenes import G, disk_on_incline, stool
-from drake_dock.studies.stability import SmallRun
+from drake_dock.studies.small_scenes import G, SmallRun, disk_on_incline, stool
 
 
 def small(name, sc, X, V, t_end):

@@ -44,13 +44,6 @@ from drake_dock.core.vec3 import add as _add, axpy as _axpy, cross as _cr, dot a
     mul as _mul, rot as _rot, sub as _sub
 
 
-def cross(a, b):
-    """3-vector cross product of numpy arrays (np.cross costs ~10 us per call on small
-    vectors)."""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                     a[0] * b[1] - a[1] * b[0]])
-
-
 def _unit(a):
     na = math.sqrt(_dot(a, a))
     if na == 0.0:     # degenerate (parallel curves): reported by `conditioning`, no NaN
@@ -268,11 +261,3 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
         u=U[0], drift=U[1], residual=residual, udot=U[2], conditioning=cond, p1=V[0],
         p2=V[1], n=V[2], ta=V[3], tb=V[4], gap=_dot(n, d), v_rel=V[5],
         vn=_dot(n, v_rel), vt=T[0], bias_n=_dot(n, conv) + _dot(ndot, v_rel), bias_t=T[1])
-
-
-def orientation_sign(kind, patch1, X1, patch2, X2, u) -> float:
-    """sigma of Definition 2 for a pair becoming potential: the sign that makes the gap of the
-    couple u non-negative (n from Body 2 towards Body 1)."""
-    ev = evaluate_couple(kind, patch1, X1, (np.zeros(3), np.zeros(3)), patch2, X2,
-                         (np.zeros(3), np.zeros(3)), u, 1.0, project=False)
-    return 1.0 if ev.gap >= 0.0 else -1.0

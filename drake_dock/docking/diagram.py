@@ -20,6 +20,7 @@ from pydrake.systems.framework import (DiagramBuilder, EventStatus, LeafSystem, 
                                        WitnessFunctionDirection)
 
 from drake_dock.systems.contact_system import ContactOptions, ContactPair, RigidContactSystem
+from drake_dock.systems.simulator import tolerances
 from drake_dock.docking.plant import DockingPlant, StewartDamperPower, make_docking_plant
 from drake_dock.docking.scene import apds_pairs
 
@@ -79,11 +80,8 @@ def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagra
     pairs = [ContactPair(p.name, p.kind, frames[p.body1], p.patch1, frames[p.body2], p.patch2)
              for p in apds_pairs(scenario.geometry)]
     if options is None:
-        # LZB's relative accuracy 1e-2 of the integrator's (within [1e-12, 1e-8]): its error in
-        # the post-impact velocities (4e-10 relative at rtol 1e-8 on the example's impacts)
-        # stays far below the integration error.
-        options = ContactOptions(impact_rtol=min(1e-8, max(1e-12,
-                                                           1e-2 * scenario.simulation.accuracy)))
+        # LZB's accuracy follows the simulator's (`drake_dock.systems.simulator.tolerances`).
+        options = ContactOptions(impact_rtol=tolerances(scenario.simulator_config).impact_rtol)
     contact = builder.AddSystem(RigidContactSystem(
         dp.plant, pairs, scenario.contact, options,
         wrench_bodies=("chaser",),

@@ -60,7 +60,7 @@ def add_docking_plant(builder, scenario) -> DockingPlant:
     """Adds the plant and SceneGraph of the scenario's three bodies to ``builder``; finalized.
     (Drake integrates this plant itself: free flight with the Stewart element, no contact.)"""
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, time_step=0.0)
-    return _populate(plant, scene_graph, scenario)
+    return populate_plant(plant, scene_graph, scenario)
 
 
 def make_docking_plant(scenario, scene_graph=None) -> DockingPlant:
@@ -70,12 +70,14 @@ def make_docking_plant(scenario, scene_graph=None) -> DockingPlant:
     plant = MultibodyPlant(0.0)
     if scene_graph is not None:
         plant.RegisterAsSourceForSceneGraph(scene_graph)
-    return _populate(plant, scene_graph, scenario)
+    return populate_plant(plant, scene_graph, scenario)
 
 
-def _populate(plant, scene_graph, scenario, collision=None) -> DockingPlant:
-    """``collision(plant, bodies)``, if given, registers collision geometry before Finalize
-    (the compliant baseline, `compliant.py`)."""
+def populate_plant(plant, scene_graph, scenario, collision=None) -> DockingPlant:
+    """Adds the scenario's three bodies, the Stewart element and (with a registered geometry
+    source) the visual geometry to ``plant``, then finalizes it. ``collision(plant, bodies)``,
+    if given, registers collision geometry before Finalize (the compliant baseline,
+    `drake_dock.studies.compliant`)."""
     plant.mutable_gravity_field().set_gravity_vector(np.zeros(3))
     b = scenario.bodies
     bodies = {name: plant.AddRigidBody(name, _spatial_inertia(getattr(b, name)))
@@ -201,10 +203,3 @@ class StewartDamperPower:
         f.SetZero()
         self.plant.CalcForceElementsContribution(self.ctx, f)
         return float(self.plant.CalcGeneralizedForces(self.ctx, f) @ v)
-
-
-def total_energy(dp: DockingPlant, plant_context) -> float:
-    """Kinetic energy plus the Stewart potential."""
-    v = dp.plant.GetVelocities(plant_context)
-    return float(0.5 * v @ dp.plant.CalcMassMatrix(plant_context) @ v
-                 + stewart_potential(dp, plant_context))

@@ -21,6 +21,7 @@ from drake_dock.core.hybrid import Mode
 from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
                                       stewart_potential)
+from drake_dock.docking.scene import CHASER_APDS, apds_pairs
 
 IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or sticking)
 
@@ -78,6 +79,20 @@ def timeseries(result) -> dict:
         impact_t=np.array([imp["t"] for imp in result.impacts], dtype=float),
         impact_couples=imp_c, impact_normal_impulse=imp_n, impact_tangential_impulse=imp_t,
         impact_restitution=np.array([imp["restitution"] for imp in result.impacts], dtype=float))
+
+
+def rigid_chaser_force(result):
+    """(t, F): the net contact force on the chaser [N, 3] at the samples of a drake_dock
+    `RunResult`, from the couples' lambda_n, lambda_t and frames."""
+    rec = result.record
+    sign = np.array([1.0 if p.body1 == CHASER_APDS else -1.0
+                     for p in apds_pairs(result.scenario.geometry)])
+    t = np.asarray(rec.t)
+    C = np.asarray(rec.couples)
+    frames = C[:, :, COUPLE_SLICES["frame"]].reshape(len(t), -1, 3, 3)
+    lam = np.concatenate([C[:, :, COUPLE_SLICES["lambda_t"]],
+                          C[:, :, COUPLE_SLICES["lambda_n"]]], axis=2)
+    return t, np.einsum("c,kcxy,kcy->kx", sign, frames, lam)
 
 
 def momenta(ts: dict, masses, inertias, about):

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import yaml
 from pydrake.common.yaml import yaml_load_typed
+from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.core.contact_law import ContactLaw
 from drake_dock.docking.apds import ApdsGeometry
@@ -80,20 +81,27 @@ class InitialCondition:
 class SimulationParams:
     duration: float = 10.0           # the timeout (s): a run ends earlier at a named outcome
     jam_time: float = 2.0            # s without 1 mm of progress of the rings: "jammed"
-    accuracy: float = 1e-6           # integrator error control and witness isolation
-    max_step: float = 0.002          # largest integration step (s); also the sample spacing
     capture_distance: float = 0.005  # axial ring-centre distance ending the capture phase (m)
-    # Drake's error-controlled explicit integrator (SimulatorConfig.integration_scheme). The
-    # third-order Bogacki-Shampine reuses its last stage (3 evaluations a step against RK5's
-    # 6): where the step cap, not the accuracy, sets the step, it does the same work for half
-    # the evaluations (bench/paper_example.py prints both; docs/performance.md).
-    integration_scheme: str = "bogacki_shampine3"
+
+
+def default_simulator_config() -> SimulatorConfig:
+    """Drake's simulator settings of a docking run (`drake_dock.systems.simulator`): the
+    third-order Bogacki-Shampine integrator with error control at ``accuracy`` (which also sets
+    the witness isolation window and LZB's accuracy: `drake_dock.systems.simulator.tolerances`)
+    and its step capped at ``max_step_size`` (s), which is also the sample spacing of the
+    outputs. Bogacki-Shampine reuses its last stage (3 evaluations a step against RK5's 6):
+    where the step cap, not the accuracy, sets the step, it does the same work for half the
+    evaluations (bench/paper_example.py prints both; docs/performance.md)."""
+    return SimulatorConfig(integration_scheme="bogacki_shampine3", max_step_size=0.002,
+                           accuracy=1e-6, use_error_control=True)
 
 
 MAX_TILT_DEG = 30.0        # initial.tilt_deg: beyond it the petals no longer guide the rings
 MAX_LATERAL_SPEED = 1.0    # initial.lateral_velocity (m/s)
 MAX_RATE_DEG_S = 90.0      # initial.angular_velocity_deg_s
-MAX_STEPS = 1e6      # simulation.duration / simulation.max_step: a run that can end
+MAX_STEPS = 1e6      # simulation.duration / simulator_config.max_step_size: a run that can end
+MIN_REALTIME_RATE = 0.01   # simulator_config.target_realtime_rate, unless 0 (no pacing)
+# Drake's error-controlled explicit integrators (SimulatorConfig.integration_scheme).
 INTEGRATION_SCHEMES = ("bogacki_shampine3", "runge_kutta3", "runge_kutta5")
 
 
@@ -106,20 +114,32 @@ class Scenario:
     contact: ContactLaw = dataclasses.field(default_factory=ContactLaw)
     initial: InitialCondition = dataclasses.field(default_factory=InitialCondition)
     simulation: SimulationParams = dataclasses.field(default_factory=SimulationParams)
+    simulator_config: SimulatorConfig = dataclasses.field(
+        default_factory=default_simulator_config)
 
 
 # Validation ---------------------------------------------------------------------------------
+def _schema_fields(schema):
+    """{name: type} of a dataclass or of a Drake class that Drake's YAML loader reads through
+    its ``__fields__`` (SimulatorConfig); None for other types."""
+    if dataclasses.is_dataclass(schema):
+        return typing.get_type_hints(schema)
+    if isinstance(schema, type) and hasattr(schema, "__fields__"):
+        return {f.name: f.type for f in schema.__fields__}
+    return None
+
+
 def _check_raw(node, schema, path):
     """Walks the raw YAML against the dataclass tree, so that an unknown key or a value of the
     wrong type is named by its dotted path before Drake's loader sees it."""
     where = path.rstrip(".") or "scenario"
-    if dataclasses.is_dataclass(schema):
+    hints = _schema_fields(schema)
+    if hints is not None:
         if not isinstance(node, dict):
             raise InputError(where, node, "a mapping of fields")
-        hints = typing.get_type_hints(schema)
         for key, value in node.items():
             if key not in hints:
-                allowed = ", ".join(f.name for f in dataclasses.fields(schema))
+                allowed = ", ".join(hints)
                 raise InputError(f"{path}{key}", value, f"a known field of '{where}' ({allowed})",
                                  "unknown key")
             _check_raw(value, hints[key], f"{path}{key}.")
@@ -136,6 +156,9 @@ def _check_raw(node, schema, path):
     elif schema is str:
         if not isinstance(node, str):
             raise InputError(where, node, "a string")
+    elif schema is bool:
+        if not isinstance(node, bool):
+            raise InputError(where, node, "true or false")
     elif typing.get_origin(schema) is list:
         if not isinstance(node, list):
             raise InputError(where, node, "a list of numbers")
@@ -220,19 +243,32 @@ def validate(s: Scenario) -> Scenario:
             raise InputError(f"initial.{name}", value, allowed)
     _positive("simulation.duration", s.simulation.duration)
     _positive("simulation.jam_time", s.simulation.jam_time)
-    if not 0 < _finite("simulation.accuracy", s.simulation.accuracy) < 1:
-        raise InputError("simulation.accuracy", s.simulation.accuracy, "0 < accuracy < 1")
-    _positive("simulation.max_step", s.simulation.max_step)
-    if s.simulation.duration / s.simulation.max_step > MAX_STEPS:
-        raise InputError("simulation.max_step", s.simulation.max_step,
-                         f">= simulation.duration / {MAX_STEPS:.0e} = "
-                         f"{s.simulation.duration / MAX_STEPS:.3g} s",
-                         f"more than {MAX_STEPS:.0e} steps")
     _positive("simulation.capture_distance", s.simulation.capture_distance)
-    if s.simulation.integration_scheme not in INTEGRATION_SCHEMES:
-        raise InputError("simulation.integration_scheme", s.simulation.integration_scheme,
-                         f"one of {', '.join(INTEGRATION_SCHEMES)}")
+    _validate_simulator_config(s.simulator_config, s.simulation.duration)
     return s
+
+
+def _validate_simulator_config(c: SimulatorConfig, duration: float):
+    f = "simulator_config"
+    if c.integration_scheme not in INTEGRATION_SCHEMES:
+        raise InputError(f"{f}.integration_scheme", c.integration_scheme,
+                         f"one of {', '.join(INTEGRATION_SCHEMES)}")
+    if not 0 < _finite(f"{f}.accuracy", c.accuracy) < 1:
+        raise InputError(f"{f}.accuracy", c.accuracy, "0 < accuracy < 1")
+    _positive(f"{f}.max_step_size", c.max_step_size)
+    if duration / c.max_step_size > MAX_STEPS:
+        raise InputError(f"{f}.max_step_size", c.max_step_size,
+                         f">= simulation.duration / {MAX_STEPS:.0e} = "
+                         f"{duration / MAX_STEPS:.3g} s", f"more than {MAX_STEPS:.0e} steps")
+    if not c.use_error_control:
+        raise InputError(f"{f}.use_error_control", c.use_error_control,
+                         "true (the witness isolation and LZB's accuracy follow the accuracy)")
+    if _finite(f"{f}.start_time", c.start_time) != 0.0:
+        raise InputError(f"{f}.start_time", c.start_time, "0 (a run starts at t = 0)")
+    rate = _finite(f"{f}.target_realtime_rate", c.target_realtime_rate)
+    if rate != 0.0 and not rate >= MIN_REALTIME_RATE:
+        raise InputError(f"{f}.target_realtime_rate", c.target_realtime_rate,
+                         f"0 (as fast as possible) or >= {MIN_REALTIME_RATE:g}")
 
 
 def load_scenario(filename=None, *, data: str | None = None) -> Scenario:

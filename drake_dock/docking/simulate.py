@@ -5,10 +5,9 @@ impact's witness gives the state just before it) and, for each impact, one sampl
 just after it at the same time (from the impact log; no step end sees that state). The
 simulation ends at ``simulation.duration`` or at capture (`CaptureMonitor`'s witness).
 
-Integration: ``simulation.integration_scheme`` (default Bogacki-Shampine 3) with error control
-at ``simulation.accuracy``; the context's
-accuracy, which sets Drake's witness isolation window (1e-2 of it, in seconds), is the same
-value; the step is capped at ``simulation.max_step``.
+Integration: the scenario's ``simulator_config`` (Drake's `SimulatorConfig`), applied by
+`drake_dock.systems.simulator.make_simulator`; the witness isolation window and LZB's accuracy
+follow from it (`drake_dock.systems.simulator.tolerances`).
 """
 from __future__ import annotations
 
@@ -17,9 +16,7 @@ import copy
 import dataclasses
 import time as _time
 
-import numpy as np
-from pydrake.systems.analysis import (ApplySimulatorConfig, Simulator, SimulatorConfig,
-                                      SimulatorStatus)
+from pydrake.systems.analysis import Simulator, SimulatorStatus
 
 from drake_dock.core.hybrid import Mode
 from drake_dock.systems.contact_system import COUPLE_OUTPUT_SIZE, ContactModes
@@ -28,7 +25,7 @@ from drake_dock.docking.outcome import OutcomeWatch, progress_fraction
 from drake_dock.docking.plant import set_initial_state
 from drake_dock.docking.scene import InitialState, initial_state
 from drake_dock.errors import DrakeDockError, NumericalError
-from drake_dock.systems.stepping import WitnessApproach
+from drake_dock.systems.simulator import make_simulator, make_witness_approach
 
 STEP, PRE_IMPACT, POST_IMPACT = 0, 1, 2
 
@@ -63,18 +60,16 @@ class RunResult:
     reason: str = ""
 
 
-def make_simulator(dd: DockingDiagram, scenario, state: InitialState) -> Simulator:
-    sim = Simulator(dd.diagram)
-    root = sim.get_mutable_context()
-    pc = dd.dp.plant.CreateDefaultContext()
-    set_initial_state(dd.dp, pc, state)
-    dd.contact.set_from_plant_context(dd.contact.GetMyMutableContextFromRoot(root), pc)
-    sp = scenario.simulation
-    ApplySimulatorConfig(SimulatorConfig(integration_scheme=sp.integration_scheme,
-                                         accuracy=sp.accuracy, max_step_size=sp.max_step,
-                                         use_error_control=True), sim)
-    root.SetAccuracy(sp.accuracy)
-    return sim
+def docking_simulator(dd: DockingDiagram, state: InitialState, config,
+                      witness_accuracy: float | None = None) -> Simulator:
+    """The Simulator of a docking diagram (`make_simulator` with ``config``, a
+    `SimulatorConfig`): ``state`` placed (`set_initial_state`) and copied into the contact
+    system, which owns the state."""
+    def set_state(root):
+        pc = dd.dp.plant.CreateDefaultContext()
+        set_initial_state(dd.dp, pc, state)
+        dd.contact.set_from_plant_context(dd.contact.GetMyMutableContextFromRoot(root), pc)
+    return make_simulator(dd.diagram, config, set_state, witness_accuracy=witness_accuracy)
 
 
 class _Recorder:
@@ -164,13 +159,13 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
     with _numerical_failure("the initial placement", lambda: (0.0, ())):
         state = state or initial_state(scenario)
         dd = dd or build_docking_diagram(scenario)
-        sim = make_simulator(dd, scenario, state)
+        sim = docking_simulator(dd, state, scenario.simulator_config)
     rec = _Recorder(dd)
     t_end = scenario.simulation.duration if duration is None else duration
 
     sp = scenario.simulation
-    approach = WitnessApproach(sim, [dd.contact, dd.capture], sp.max_step,
-                               0.01 * sp.accuracy) if witness_approach else None
+    approach = make_witness_approach(sim, [dd.contact, dd.capture], scenario.simulator_config) \
+        if witness_approach else None
 
     watch = None
     ended = []
@@ -221,5 +216,5 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
                      outcome, reason)
 
 
-__all__ = ["simulate", "make_simulator", "RunResult", "Record", "STEP", "PRE_IMPACT",
+__all__ = ["simulate", "docking_simulator", "RunResult", "Record", "STEP", "PRE_IMPACT",
            "POST_IMPACT", "COUPLE_OUTPUT_SIZE"]

@@ -1,6 +1,6 @@
 """The docking scene with Drake's own compliant contact: the baseline of the speed-accuracy study.
 
-The same three bodies, Stewart element (`plant._populate`), friction and initial state as the
+The same three bodies, Stewart element (`plant.populate_plant`), friction and initial state as the
 rigid model; the contact is MultibodyPlant's, between collision geometry made from the same
 analytic patches (`apds.py`):
 
@@ -37,7 +37,7 @@ from pydrake.geometry import (AddCompliantHydroelasticProperties, AddContactMate
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import (AddMultibodyPlantSceneGraph, ContactModel, CoulombFriction,
                                      DiscreteContactApproximation)
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
+from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder, EventStatus
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
@@ -45,8 +45,9 @@ from scipy.spatial import ConvexHull
 
 from drake_dock.docking.apds import guide_surface
 from drake_dock.docking.diagram import axial_ring_distance
-from drake_dock.docking.plant import DockingPlant, _populate, set_initial_state
+from drake_dock.docking.plant import DockingPlant, populate_plant, set_initial_state
 from drake_dock.errors import InputError
+from drake_dock.systems.simulator import make_simulator
 
 
 @dataclasses.dataclass
@@ -69,6 +70,14 @@ class CompliantConfig:
                 else f"RK3 acc={self.accuracy:.0e}")
         unit = "Pa" if self.model == "hydroelastic" else "N/m"
         return f"{self.model} k={self.stiffness:.0e} {unit}, {step}"
+
+    def simulator_config(self) -> SimulatorConfig:
+        """Discrete (SAP): Drake's default Simulator (the plant's own step sets the steps);
+        continuous: error-controlled Runge-Kutta 3 at ``accuracy``."""
+        if self.time_step > 0:
+            return SimulatorConfig()
+        return SimulatorConfig(integration_scheme="runge_kutta3", accuracy=self.accuracy,
+                               use_error_control=True)
 
     def validate(self):
         if self.model not in ("hydroelastic", "point"):
@@ -184,7 +193,7 @@ def build_compliant_diagram(scenario, cfg: CompliantConfig) -> CompliantDiagram:
                                                 props)
                 n[0] += 1
 
-    dp = _populate(plant, scene_graph, scenario, collision=collision)
+    dp = populate_plant(plant, scene_graph, scenario, collision=collision)
     return CompliantDiagram(builder.Build(), dp, n[0])
 
 
@@ -213,14 +222,9 @@ def run_compliant(scenario, state, cfg: CompliantConfig, *, t_max: float,
     cd = cd or build_compliant_diagram(scenario, cfg)
     dp = cd.dp
     plant = dp.plant
-    sim = Simulator(cd.diagram)
+    sim = make_simulator(cd.diagram, cfg.simulator_config(), lambda root: set_initial_state(
+        dp, plant.GetMyMutableContextFromRoot(root), state))
     root = sim.get_mutable_context()
-    pc = plant.GetMyMutableContextFromRoot(root)
-    set_initial_state(dp, pc, state)
-    if cfg.time_step == 0:
-        ApplySimulatorConfig(SimulatorConfig(integration_scheme="runge_kutta3",
-                                             accuracy=cfg.accuracy, use_error_control=True), sim)
-        root.SetAccuracy(cfg.accuracy)
     e3 = state.X_WB["target_apds"][0][:, 2].copy()
     chaser, apds = dp.bodies["chaser"], dp.bodies["target_apds"]
     m_c = scenario.bodies.chaser.mass

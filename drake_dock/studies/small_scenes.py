@@ -5,7 +5,8 @@ Painleve's rod with a rounded tip (C-S), and a three-footed stool (three C-S cou
 Each builder returns a `SmallScene`: a finalized continuous MultibodyPlant (not in a diagram;
 the contact system owns the state), the `RigidContactSystem`, and a function that writes an
 initial state into the system's context. Gravity is tilted instead of the plane (an incline of
-angle theta is a horizontal plane under g = 9.81 (sin theta, 0, -cos theta)).
+angle theta is a horizontal plane under g = 9.81 (sin theta, 0, -cos theta)). `SmallRun` runs a
+scene's system.
 """
 from __future__ import annotations
 
@@ -16,12 +17,21 @@ import numpy as np
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import FixedOffsetFrame, RotationalInertia, SpatialInertia
+from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.core.contact_law import ContactLaw
-from drake_dock.systems.contact_system import ContactOptions, ContactPair, RigidContactSystem
+from drake_dock.systems.contact_system import (COUPLE_SLICES, ContactOptions, ContactPair,
+                                               RigidContactSystem)
 from drake_dock.core.patches import Circle, PlaneRect, Segment
+from drake_dock.systems.simulator import make_simulator, make_witness_approach
 
 G = 9.81
+PAINLEVE_THETA = math.radians(30.0)
+# The small scenes integrate at SMALL_SCENE_ACCURACY (RK5) and locate their events to 1e-2 of
+# a context accuracy of at least WITNESS_ACCURACY_FLOOR, in seconds; `ContactOptions`' default
+# impact_rtol (1e-10) is `drake_dock.systems.simulator.tolerances`' value for it.
+SMALL_SCENE_ACCURACY = 1e-10
+WITNESS_ACCURACY_FLOOR = 1e-8
 
 
 @dataclasses.dataclass
@@ -119,6 +129,30 @@ def painleve_rod(theta, *, mass=1.0, half_length=0.5, tip_radius=0.01, mu=1.0,
                                                 rho=tip_radius, mu=mu))
 
 
+def painleve_state(sc, omega=0.0):
+    """Pose and twist of `painleve_rod`'s rod with its tip on the plane sliding at 1 m/s
+    towards -x (v_z = 0 at the tip), spinning at ``omega`` about y."""
+    th, l, rho = sc.params["theta"], sc.params["l"], sc.params["rho"]
+    ax = np.array([math.cos(th), 0, math.sin(th)])
+    R = np.array([[math.cos(th), 0, -math.sin(th)], [0, 1, 0],
+                  [math.sin(th), 0, math.cos(th)]])
+    com = np.array([0, 0, rho]) + l * ax
+    w = np.array([0, omega, 0])
+    r = -l * ax - np.array([0, 0, rho])
+    return (R, com), (w, np.array([-1.0, 0, 0]) - np.cross(w, r))
+
+
+def painleve_closed_form(mu, *, theta=PAINLEVE_THETA, mass=1.0, l=0.5, rho=0.01):
+    """(lambda_n, mu_c) of the sliding rod at rest in rotation (planar form): the tip's normal
+    acceleration is A lambda_n - g with A = 1/m + l c (l c - mu (l s + rho)) / I; consistent
+    sliding needs A > 0, i.e. mu < mu_c."""
+    I = mass * l * l / 3
+    c, s = math.cos(theta), math.sin(theta)
+    A = 1 / mass + l * c * (l * c - mu * (l * s + rho)) / I
+    mu_c = (I / mass + l * l * c * c) / (l * c * (l * s + rho))
+    return (G / A if A > 0 else math.nan), mu_c
+
+
 def stool(*, mass=3.0, foot_radius=0.05, leg_radius=0.25, mu=0.3, restitution=0.0,
           options=ContactOptions()) -> SmallScene:
     """A body with three rounded feet (Circles in vertical planes, 120 deg apart) on the plane
@@ -141,3 +175,35 @@ def stool(*, mass=3.0, foot_radius=0.05, leg_radius=0.25, mu=0.3, restitution=0.
     system = RigidContactSystem(plant, pairs, ContactLaw(mu=mu, restitution=restitution),
                                 options)
     return SmallScene(plant, system, body, dict(mass=mass, foot_radius=foot_radius))
+
+
+class SmallRun:
+    """A small scene's ``system`` in a Simulator (`make_simulator`: RK5 at ``accuracy``, the
+    step capped at ``max_step``) with `WitnessApproach`, initialized; ``couple(name)`` reads a
+    couple's output, ``samples`` holds (t, gap of the first pair, x[:13]) after each step."""
+
+    def __init__(self, system, set_state, *, accuracy=SMALL_SCENE_ACCURACY, max_step=0.01):
+        self.system = system
+        config = SimulatorConfig(integration_scheme="runge_kutta5", accuracy=accuracy,
+                                 max_step_size=max_step)
+        witness = max(accuracy, WITNESS_ACCURACY_FLOOR)
+        self.sim = make_simulator(system, config, set_state, witness_accuracy=witness)
+        self.ctx = self.sim.get_mutable_context()
+        approach = make_witness_approach(self.sim, [system], config, witness_accuracy=witness)
+        self.samples = []
+
+        def monitor(root):
+            self.samples.append((root.get_time(), self.couple(system.pairs[0].name)["gap"],
+                                 root.get_continuous_state_vector().CopyToVector()[:13]))
+            approach(root)
+        self.sim.Initialize()
+        self.sim.set_monitor(monitor)
+
+    def couple(self, name):
+        y = self.system.get_couple_output_port(name).Eval(self.ctx)
+        return {k: (float(y[s][0]) if len(y[s]) == 1 else y[s])
+                for k, s in COUPLE_SLICES.items()}
+
+    @property
+    def impacts(self):
+        return self.system.get_modes(self.ctx).impacts

@@ -35,17 +35,15 @@ import csv
 import dataclasses
 import io
 import math
-import time as _time
 from pathlib import Path
 
 import numpy as np
 
-from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.studies.compliant import (CompliantConfig, build_compliant_diagram,
                                           hunt_crossley_dissipation, run_compliant)
-from drake_dock.docking.scene import CHASER_APDS
+from drake_dock.docking.results import rigid_chaser_force
 from drake_dock.docking.simulate import simulate
-from drake_dock.docking.scene import apds_pairs, initial_state
+from drake_dock.docking.scene import initial_state
 from drake_dock.errors import DrakeDockError
 
 METRICS = ("capture_time", "apds_spin_rate", "chaser_axial_velocity", "peak_contact_force")
@@ -59,8 +57,9 @@ class StudyPlan:
     tolerance: float = 1e-3
     wall_limit: float = 120.0        # per compliant run: stopped beyond it (reported)
     t_max_factor: float = 2.0        # compliant runs end at this x the reference capture time
-    # drake_dock's step cap is the output spacing (scenario.simulation.max_step); each accuracy
-    # is also run with these caps (error control then sets the steps; the samples are sparser)
+    # drake_dock's step cap is the output spacing (scenario.simulator_config.max_step_size);
+    # each accuracy is also run with these caps (error control then sets the steps; the
+    # samples are sparser)
     rigid_max_steps: tuple = ()
 
     @staticmethod
@@ -80,20 +79,6 @@ class StudyPlan:
         c += [CompliantConfig("hydroelastic", 1e8, 0.0, accuracy=1e-2)]
         return StudyPlan((1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8), 1e-10, c, wall_limit=90.0,
                          rigid_max_steps=(0.01, 0.02))
-
-
-def rigid_chaser_force(result):
-    """(t, F): the net contact force on the chaser [N, 3] at the samples of a drake_dock
-    `RunResult`, from the couples' lambda_n, lambda_t and frames."""
-    rec = result.record
-    sign = np.array([1.0 if p.body1 == CHASER_APDS else -1.0
-                     for p in apds_pairs(result.scenario.geometry)])
-    t = np.asarray(rec.t)
-    C = np.asarray(rec.couples)
-    frames = C[:, :, COUPLE_SLICES["frame"]].reshape(len(t), -1, 3, 3)
-    lam = np.concatenate([C[:, :, COUPLE_SLICES["lambda_t"]],
-                          C[:, :, COUPLE_SLICES["lambda_n"]]], axis=2)
-    return t, np.einsum("c,kcxy,kcy->kx", sign, frames, lam)
 
 
 def rigid_metrics(result, e3) -> dict:
@@ -148,9 +133,9 @@ def run_study(scenario, plan: StudyPlan, log=print) -> dict:
 
     def rigid(acc, max_step=None):
         sc = copy.deepcopy(scenario)
-        sc.simulation.accuracy = acc
+        sc.simulator_config.accuracy = acc
         if max_step is not None:
-            sc.simulation.max_step = max_step
+            sc.simulator_config.max_step_size = max_step
         try:
             r = simulate(sc, state=state)
         except DrakeDockError as exc:
@@ -161,7 +146,7 @@ def run_study(scenario, plan: StudyPlan, log=print) -> dict:
     ref, note, wall = rigid(plan.reference_accuracy)
     if ref is None or ref["capture_time"] is None:
         raise DrakeDockError(f"the reference run failed: {note or 'no capture'}")
-    cap = scenario.simulation.max_step
+    cap = scenario.simulator_config.max_step_size
     points = [Point("drake_dock", "reference", f"drake_dock acc={plan.reference_accuracy:.0e}",
                     "rigid", math.nan, cap, plan.reference_accuracy, wall, True, ref,
                     _errors(ref, ref))]

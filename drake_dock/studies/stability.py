@@ -30,7 +30,6 @@ import time as _time
 from pathlib import Path
 
 import numpy as np
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 
 from drake_dock.core.hybrid import Mode
 from drake_dock.errors import PainleveError, ZenoError
@@ -38,8 +37,9 @@ from drake_dock.systems.contact_system import COUPLE_SLICES, ContactOptions
 from drake_dock.errors import DrakeDockError, NumericalError
 from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.core.lzb.limit import continuous_limit_chain
-from drake_dock.studies.small_scenes import G, disk_on_incline, painleve_rod
-from drake_dock.systems.stepping import WitnessApproach
+from drake_dock.docking.results import rigid_chaser_force
+from drake_dock.studies.small_scenes import (G, PAINLEVE_THETA, SmallRun, disk_on_incline,
+                                             painleve_closed_form, painleve_rod, painleve_state)
 
 SAWTOOTH = 0.05
 
@@ -58,39 +58,6 @@ def sawtooth_index(t, F) -> float:
     return float(np.abs(F[1:-1] - line).max() / np.abs(F).mean())
 
 
-class SmallRun:
-    """A small scene in a Simulator with RK5 and `WitnessApproach`; ``couple(name)`` reads a
-    couple's output."""
-
-    def __init__(self, system, set_state, *, accuracy=1e-10, max_step=0.01):
-        self.system = system
-        self.sim = Simulator(system)
-        self.ctx = self.sim.get_mutable_context()
-        set_state(self.ctx)
-        ApplySimulatorConfig(SimulatorConfig(integration_scheme="runge_kutta5",
-                                             accuracy=accuracy, max_step_size=max_step),
-                             self.sim)
-        self.ctx.SetAccuracy(max(accuracy, 1e-8))
-        approach = WitnessApproach(self.sim, [system], max_step, 0.01 * max(accuracy, 1e-8))
-        self.samples = []
-
-        def monitor(root):
-            self.samples.append((root.get_time(), self.couple(system.pairs[0].name)["gap"],
-                                 root.get_continuous_state_vector().CopyToVector()[:13]))
-            approach(root)
-        self.sim.Initialize()
-        self.sim.set_monitor(monitor)
-
-    def couple(self, name):
-        y = self.system.get_couple_output_port(name).Eval(self.ctx)
-        return {k: (float(y[s][0]) if len(y[s]) == 1 else y[s])
-                for k, s in COUPLE_SLICES.items()}
-
-    @property
-    def impacts(self):
-        return self.system.get_modes(self.ctx).impacts
-
-
 # ------------------------------------------------------------------------ (a) step size
 RIGID_STEP_ACCURACY = 1e-8
 
@@ -100,15 +67,14 @@ def step_size_case(scenario, *, output_steps, compliant_steps, stiffnesses, log=
                                               run_compliant)
     from drake_dock.docking.scene import initial_state
     from drake_dock.docking.simulate import simulate
-    from drake_dock.studies.speed_accuracy import rigid_chaser_force
     state = initial_state(scenario)
     rigid = []
     for H in output_steps:
         sc = copy.deepcopy(scenario)
-        sc.simulation.max_step = H
+        sc.simulator_config.max_step_size = H
         # Tight enough that the integration error does not hide the curve's own shape (the
         # runs at different output steps are compared sample by sample).
-        sc.simulation.accuracy = min(sc.simulation.accuracy, RIGID_STEP_ACCURACY)
+        sc.simulator_config.accuracy = min(sc.simulator_config.accuracy, RIGID_STEP_ACCURACY)
         r = simulate(sc, state=state)
         t, F = rigid_chaser_force(r)
         tc = r.capture_time
@@ -175,33 +141,6 @@ def stiffness_ratio_case(ratios, *, eta=1.5, log=print) -> dict:
 
 
 # ---------------------------------------------------------------------- (c) high friction
-PAINLEVE_THETA = math.radians(30.0)
-
-
-def painleve_state(sc, omega=0.0):
-    """Pose and twist of `painleve_rod`'s rod with its tip on the plane sliding at 1 m/s
-    towards -x (v_z = 0 at the tip), spinning at ``omega`` about y."""
-    th, l, rho = sc.params["theta"], sc.params["l"], sc.params["rho"]
-    ax = np.array([math.cos(th), 0, math.sin(th)])
-    R = np.array([[math.cos(th), 0, -math.sin(th)], [0, 1, 0],
-                  [math.sin(th), 0, math.cos(th)]])
-    com = np.array([0, 0, rho]) + l * ax
-    w = np.array([0, omega, 0])
-    r = -l * ax - np.array([0, 0, rho])
-    return (R, com), (w, np.array([-1.0, 0, 0]) - np.cross(w, r))
-
-
-def painleve_closed_form(mu, *, theta=PAINLEVE_THETA, mass=1.0, l=0.5, rho=0.01):
-    """(lambda_n, mu_c) of the sliding rod at rest in rotation (planar form): the tip's normal
-    acceleration is A lambda_n - g with A = 1/m + l c (l c - mu (l s + rho)) / I; consistent
-    sliding needs A > 0, i.e. mu < mu_c."""
-    I = mass * l * l / 3
-    c, s = math.cos(theta), math.sin(theta)
-    A = 1 / mass + l * c * (l * c - mu * (l * s + rho)) / I
-    mu_c = (I / mass + l * l * c * c) / (l * c * (l * s + rho))
-    return (G / A if A > 0 else math.nan), mu_c
-
-
 def high_friction_case(mus, *, scenario=None, docking_mus=(), log=print) -> dict:
     rod = []
     for mu in mus:

@@ -3,6 +3,8 @@ import math
 
 import numpy as np
 
+from drake_dock.studies.small_scenes import painleve_closed_form
+
 
 def _plt():
     import matplotlib
@@ -81,7 +83,6 @@ def high_friction_figure(c, path):
     ok = [r for r in c["rod"] if r["error"] is None]
     bad = [r for r in c["rod"] if r["error"] is not None]
     mu = np.linspace(0, max(r["mu"] for r in c["rod"]), 400)
-    from drake_dock.studies.stability import painleve_closed_form
     lam = [painleve_closed_form(m)[0] for m in mu]
     ax.plot(mu, lam, "b-", lw=1, label="closed form (planar)")
     ax.plot([r["mu"] for r in ok], [r["lambda_n"] for r in ok], "ko", label="drake_dock")

@@ -1,12 +1,13 @@
 """The docking Diagram with the rigid contact system: the paper's first impact (Sect. 8.2)."""
 import numpy as np
 import pytest
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
+from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.core.hybrid import Mode
 from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.plant import body_momenta, set_initial_state
+from drake_dock.docking.plant import body_momenta
 from drake_dock.docking.scene import initial_state
+from drake_dock.docking.simulate import docking_simulator
 
 
 @pytest.fixture(scope="module")
@@ -27,15 +28,12 @@ def first_impact(axisymmetric_scenario):
     s = axisymmetric_scenario
     state = initial_state(s)
     dd = build_docking_diagram(s)
-    sim = Simulator(dd.diagram)
+    sim = docking_simulator(dd, state, SimulatorConfig(
+        integration_scheme="runge_kutta5", accuracy=1e-10, max_step_size=0.01),
+        witness_accuracy=1e-8)
     root = sim.get_mutable_context()
     ctx = dd.contact.GetMyMutableContextFromRoot(root)
     pc = dd.dp.plant.CreateDefaultContext()
-    set_initial_state(dd.dp, pc, state)
-    dd.contact.set_from_plant_context(ctx, pc)
-    ApplySimulatorConfig(SimulatorConfig(integration_scheme="runge_kutta5", accuracy=1e-10,
-                                         max_step_size=0.01), sim)
-    root.SetAccuracy(1e-8)
     sim.Initialize()
 
     def momenta():

@@ -76,7 +76,8 @@ def test_wrong_type():
 @pytest.mark.parametrize("value, allowed", [("euler", "one of bogacki_shampine3"),
                                             ("3", "a string")])
 def test_unknown_integration_scheme(value, allowed):
-    e = _fails(f"simulation: {{integration_scheme: {value}}}", "simulation.integration_scheme")
+    e = _fails(f"simulator_config: {{integration_scheme: {value}}}",
+               "simulator_config.integration_scheme")
     assert e.allowed.startswith(allowed)
 
 
@@ -118,8 +119,14 @@ PHYSICAL = {
                                            "chaser_apds_offset[2]", "chaser body"),
     "target APDS behind the target": ("stewart: {p_TA: [0.0, 0.0, -5.03]}", "stewart.p_TA[2]",
                                       "target body"),
-    "more steps than a run can take": ("simulation: {max_step: 1.0e-12}", "simulation.max_step",
-                                       "simulation.duration"),
+    "more steps than a run can take": ("simulator_config: {max_step_size: 1.0e-12}",
+                                       "simulator_config.max_step_size", "simulation.duration"),
+    "no error control": ("simulator_config: {use_error_control: false}",
+                         "simulator_config.use_error_control", "accuracy"),
+    "a run not starting at 0": ("simulator_config: {start_time: 1.0}",
+                                "simulator_config.start_time", "t = 0"),
+    "a run paced to stand still": ("simulator_config: {target_realtime_rate: 1.0e-300}",
+                                   "simulator_config.target_realtime_rate", "as fast as"),
 }
 
 

@@ -7,10 +7,11 @@ import numpy as np
 import pytest
 from pydrake.math import RigidTransform, RotationMatrix, RollPitchYaw
 from pydrake.multibody.math import SpatialVelocity
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
+from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
 
 from drake_dock.docking.plant import add_docking_plant, body_momenta
+from drake_dock.systems.simulator import make_simulator
 
 
 def _build(scenario):
@@ -21,10 +22,9 @@ def _build(scenario):
 
 
 def _simulator(diagram, context, accuracy):
-    sim = Simulator(diagram, context)
-    ApplySimulatorConfig(SimulatorConfig(integration_scheme="runge_kutta5", accuracy=accuracy,
-                                         max_step_size=0.01), sim)
-    context.SetAccuracy(accuracy)
+    sim = make_simulator(diagram, SimulatorConfig(integration_scheme="runge_kutta5",
+                                                  accuracy=accuracy, max_step_size=0.01),
+                         context=context)
     sim.Initialize()
     return sim
 

@@ -145,7 +145,7 @@ def test_step_size_drake_dock_smooth_at_every_output_step(quick):
     assert fine["step"] < coarse["step"]
     # Both integrate to the case's relative accuracy and locate capture by Drake's witness
     # isolation, to within its window (1e-2 of the accuracy, in seconds) after the zero.
-    acc = min(load_scenario(PAPER_EXAMPLE).simulation.accuracy, S.RIGID_STEP_ACCURACY)
+    acc = min(load_scenario(PAPER_EXAMPLE).simulator_config.accuracy, S.RIGID_STEP_ACCURACY)
     assert coarse["capture_time"] == pytest.approx(fine["capture_time"],
                                                    abs=acc * fine["capture_time"] + 1e-2 * acc)
     for r in a["rigid"]:

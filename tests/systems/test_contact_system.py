@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
+from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import ConstantVectorSource, TrajectorySource
 from pydrake.trajectories import PiecewisePolynomial
@@ -13,23 +13,23 @@ from pydrake.trajectories import PiecewisePolynomial
 from drake_dock.core.hybrid import Mode
 from drake_dock.errors import PainleveError
 from drake_dock.systems.contact_system import COUPLE_SLICES, ContactOptions
-from drake_dock.studies.small_scenes import G, disk_on_incline, painleve_rod, rod_on_edge, stool
+from drake_dock.studies.small_scenes import (WITNESS_ACCURACY_FLOOR, G, disk_on_incline,
+                                             painleve_rod, rod_on_edge, stool)
+from drake_dock.systems.simulator import make_simulator
 
 ACC = 1e-10
 
 
 def start(system, set_state, accuracy=ACC, diagram=None):
-    sim = Simulator(diagram or system)
-    root = sim.get_mutable_context()
-    ctx = system.GetMyMutableContextFromRoot(root) if diagram else root
-    set_state(ctx)
-    ApplySimulatorConfig(SimulatorConfig(integration_scheme="runge_kutta5",
-                                         accuracy=accuracy, max_step_size=0.05), sim)
     # The context's accuracy sets Drake's witness isolation window (1e-2 of it, in seconds);
     # the integrator keeps its own target accuracy.
-    root.SetAccuracy(max(accuracy, 1e-8))
+    sim = make_simulator(diagram or system, SimulatorConfig(
+        integration_scheme="runge_kutta5", accuracy=accuracy, max_step_size=0.05),
+        lambda root: set_state(system.GetMyMutableContextFromRoot(root) if diagram else root),
+        witness_accuracy=max(accuracy, WITNESS_ACCURACY_FLOOR))
+    root = sim.get_mutable_context()
     sim.Initialize()
-    return sim, root, ctx
+    return sim, root, system.GetMyMutableContextFromRoot(root) if diagram else root
 
 
 def couple(system, ctx, name):

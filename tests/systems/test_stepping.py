@@ -5,27 +5,25 @@ import math
 
 import numpy as np
 import pytest
-from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
+from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.systems.contact_system import ContactOptions
 from drake_dock.studies.small_scenes import G, disk_on_incline
-from drake_dock.systems.stepping import WitnessApproach
+from drake_dock.systems.simulator import make_simulator, make_witness_approach, tolerances
 
 H, E, ACC, MAX_STEP = 0.05, 0.5, 1e-8, 0.01
+CONFIG = SimulatorConfig(integration_scheme="runge_kutta5", accuracy=ACC, max_step_size=MAX_STEP)
 
 
 def bounce(approach: bool):
     sc = disk_on_incline(0.0, mu=0.3, restitution=E, options=ContactOptions(zeno_speed=1e-2))
     r = sc.params["radius"]
-    sim = Simulator(sc.system)
+    sim = make_simulator(sc.system, CONFIG, lambda ctx: sc.set_state(
+        ctx, (np.eye(3), np.array([0, 0, r + H])), (np.zeros(3), np.zeros(3))))
     ctx = sim.get_mutable_context()
-    sc.set_state(ctx, (np.eye(3), np.array([0, 0, r + H])), (np.zeros(3), np.zeros(3)))
-    ApplySimulatorConfig(SimulatorConfig(integration_scheme="runge_kutta5", accuracy=ACC,
-                                         max_step_size=MAX_STEP), sim)
-    ctx.SetAccuracy(ACC)
     sim.Initialize()
     if approach:
-        wa = WitnessApproach(sim, [sc.system], MAX_STEP, 0.01 * ACC)
+        wa = make_witness_approach(sim, [sc.system], CONFIG)
         sim.set_monitor(lambda c: wa(c))
     n0 = sc.system.evaluations
     v1 = math.sqrt(2 * G * H)
@@ -42,7 +40,7 @@ def test_same_impact_times_with_fewer_evaluations():
     # Closed form: impact k after flights 2 v1 e^j / g.
     expected = [t1 + sum(2 * v1 * E**j / G for j in range(1, k + 1)) for k in range(3)]
     assert len(t_fast) == len(t_plain) == 3
-    window = 0.01 * ACC
+    window = tolerances(CONFIG).witness_window    # Drake's isolation window
     np.testing.assert_allclose(t_plain, expected, atol=2 * window + 1e-12)
     np.testing.assert_allclose(t_fast, expected, atol=2 * window + 1e-12)
     assert n_fast < n_plain / 2, (n_fast, n_plain)
@@ -66,10 +64,10 @@ def test_gap_rates_of_a_falling_disk_are_its_velocity_and_gravity():
     keeps its lowest point (closed form)."""
     sc = disk_on_incline(0.0, mu=0.3, restitution=E)
     r = sc.params["radius"]
-    sim = Simulator(sc.system)
+    sim = make_simulator(sc.system, CONFIG, lambda ctx: sc.set_state(
+        ctx, (np.eye(3), np.array([0, 0, r + 0.01])),
+        (np.array([0.0, 3.0, 0.0]), np.array([0.2, 0.0, 0.7]))))
     ctx = sim.get_mutable_context()
-    sc.set_state(ctx, (np.eye(3), np.array([0, 0, r + 0.01])),
-                 (np.array([0.0, 3.0, 0.0]), np.array([0.2, 0.0, 0.7])))
     sim.Initialize()
     name = f"{sc.system.pairs[0].name} gap"
     rates = sc.system.witness_rates(ctx)

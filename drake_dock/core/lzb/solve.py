@@ -33,9 +33,9 @@ physical time, as the tests' reference.
   energy lost), or a re-compression when u_n turns negative again before the end: compression
   resumes on the loading curve from the energy stored then (E_start = E).
 - A couple at u_n = 0 within round-off after an event takes the phase its motion starts with
-  (`_Problem.turn_at_once`).
+  (`ImpactProblem.turn_at_once`).
 
-The laws, at each maximal compression:
+The laws, at each maximal compression (`drake_dock.core.lzb.laws`):
 
 - ``"paper"``, Eq. (54): E' = E - (1 - e^2) W, so x jumps to the loading curve at E' and
   unloads on it to x_end = 0; over a contact's compressions the work returned is e^2 times
@@ -78,10 +78,14 @@ import numpy as np
 from scipy.integrate import DOP853
 from scipy.optimize import brentq
 
+from drake_dock.core.lzb.friction import select_modes
+from drake_dock.core.lzb.inputs import check_inputs, per_couple
+from drake_dock.core.lzb.laws import LAWS
+from drake_dock.core.lzb.problem import APPROACH, FRICTION, NORMAL, ImpactProblem
 from drake_dock.errors import NumericalError
-from drake_dock.core.lzb.problem import ImpactEvent, ImpactProblem
 
-LAWS = ("paper", "mono", "bi")
+__all__ = ["LAWS", "ImpactResult", "solve_lzb", "check_inputs", "per_couple"]
+
 _INSIDE = np.arange(1, 32) / 32.0   # where a step's dense output is sampled for events
 _CLEAR = 1e-14                      # scaled event values below this are round-off
 
@@ -96,87 +100,27 @@ class ImpactResult:
     compression_work: np.ndarray   # W_c per couple, summed over its contact episodes (s,)
     restitution_work: np.ndarray   # W_r per couple (s,)
     friction_loss: np.ndarray      # energy dissipated by friction per couple (s,)
-    primary_sequence: list         # couples of largest stored energy, in order (Eq. 32)
     steps: int                     # accepted integration steps
     events: list                   # ImpactEvent log
     kinetic_energy_minus: float
     kinetic_energy_plus: float
     impulse_history: np.ndarray = None  # normal impulses P^3 (N s) after each accepted step
 
-    @property
-    def energy_lost(self):
-        """Per couple: compression work not restituted plus friction loss."""
-        return self.compression_work - self.restitution_work + self.friction_loss
 
-
-def per_couple(name, value, s, *, positive=False, lo=None, hi=None):
-    a = np.broadcast_to(np.asarray(value, dtype=float), (s,)).copy() if np.ndim(value) == 0 \
-        else np.asarray(value, dtype=float)
-    if a.shape != (s,):
-        raise ValueError(f"{name}: expected a scalar or {s} values (one per couple), got shape "
-                         f"{np.shape(value)}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name}: values must be finite, got {a}")
-    if positive and np.any(a <= 0):
-        raise ValueError(f"{name}: values must be > 0, got {a}")
-    if lo is not None and np.any(a < lo):
-        raise ValueError(f"{name}: values must be >= {lo}, got {a}")
-    if hi is not None and np.any(a > hi):
-        raise ValueError(f"{name}: values must be <= {hi}, got {a}")
-    return a
-
-
-def check_inputs(M, Wn, v_minus, Wt):
-    M = np.asarray(M, dtype=float)
-    if M.ndim != 2 or M.shape[0] != M.shape[1]:
-        raise ValueError(f"M: expected a square matrix, got shape {M.shape}")
-    n = M.shape[0]
-    if not np.all(np.isfinite(M)):
-        raise ValueError("M: contains non-finite values")
-    if not np.allclose(M, M.T, rtol=1e-12, atol=1e-12 * np.abs(M).max()):
-        raise ValueError("M: not symmetric")
-    try:
-        L = np.linalg.cholesky(M)
-    except np.linalg.LinAlgError:
-        raise ValueError("M: not positive definite (Cholesky failed)") from None
-    Wn = np.asarray(Wn, dtype=float)
-    if Wn.ndim == 1:
-        Wn = Wn[:, None]
-    if Wn.ndim != 2 or Wn.shape[0] != n or Wn.shape[1] < 1:
-        raise ValueError(f"Wn: expected shape ({n}, s) with s >= 1, got {Wn.shape}")
-    if not np.all(np.isfinite(Wn)):
-        raise ValueError("Wn: contains non-finite values")
-    s = Wn.shape[1]
-    if np.any(np.linalg.norm(Wn, axis=0) == 0):
-        raise ValueError(f"Wn: column(s) {np.flatnonzero(np.linalg.norm(Wn, axis=0) == 0)} "
-                         "are zero")
-    v = np.asarray(v_minus, dtype=float)
-    if v.shape != (n,):
-        raise ValueError(f"v_minus: expected shape ({n},), got {v.shape}")
-    if not np.all(np.isfinite(v)):
-        raise ValueError("v_minus: contains non-finite values")
-    if Wt is not None:
-        Wt = np.asarray(Wt, dtype=float)
-        if Wt.shape != (n, 2 * s):
-            raise ValueError(f"Wt: expected shape ({n}, {2 * s}) (two tangent directions per "
-                             f"couple), got {Wt.shape}")
-        if not np.all(np.isfinite(Wt)):
-            raise ValueError("Wt: contains non-finite values")
-    return M, L, Wn, v, Wt, n, s
-
-
-def _crossings(prob, dense, t0, t1, g0, g1):
+# Events, in the shape of scipy's solve_ivp (find the active events of a step, solve each
+# event equation on the dense output, handle the first and those simultaneous with it).
+def active_events(prob, dense, t0, t1, g0, g1):
     """The events of a step from t0 to t1 as (row, couple, ta, tb) with a sign change of the
     event function inside [ta, tb]. The normal rows are sampled inside the step as well, so
     that u_n crossing zero twice in one step (a brief separation or approach between two
     phases) is not missed, nor a crossing that follows a start at the threshold."""
     out = []
     for kind, j in zip(*np.nonzero((g0 > 0) & (g1 <= 0))):
-        if kind == 1 or prob.locked[j]:     # friction, a locked couple's release
+        if kind == FRICTION or prob.locked[j]:     # friction, a locked couple's release
             out.append((kind, j, t0, t1))
     T = np.concatenate([[t0], t0 + _INSIDE * (t1 - t0), [t1]])
     inside = prob.normal_event_values(dense(T[1:-1]))
-    for kind, G in ((0, inside[0]), (2, inside[1])):
+    for kind, G in ((NORMAL, inside[0]), (APPROACH, inside[1])):
         G = np.column_stack([g0[kind], G, g1[kind]])       # (s, samples)
         # Inside the step a crossing counts from a value clear of round-off.
         down = ((G[:, :-1] > _CLEAR) | ((G[:, :-1] > 0) & (np.arange(len(T) - 1) == 0))) \
@@ -185,6 +129,81 @@ def _crossings(prob, dense, t0, t1, g0, g1):
             i = int(np.argmax(down[j]))
             out.append((kind, j, T[i], T[i + 1]))
     return out
+
+
+def event_time(prob, dense, kind, j, ta, tb):
+    """The zero of couple j's event function of row ``kind`` in [ta, tb] on the step's dense
+    output (ta itself when the function starts on the boundary)."""
+    def f(tt):
+        return prob.event_values(dense(tt))[kind, j]
+    if f(ta) <= 0:
+        return ta
+    return brentq(f, ta, tb, xtol=1e-15 * max(1.0, abs(tb)), rtol=4 * np.finfo(float).eps)
+
+
+def handle_events(prob, dense, brackets, events, impulse_scale):
+    """Applies the first event of the step, and every other one at the same instant
+    (symmetric couples: after the restart their functions would start at <= 0 and their
+    crossings would never be seen again); then the couples at u_n = 0 take the phase their
+    motion starts. Returns (t, y) there, the restart point. ``impulse_scale`` (m_s, v_s)."""
+    roots = [(event_time(prob, dense, kind, j, ta, tb), kind, j) for kind, j, ta, tb in brackets]
+    t_first, kind0, j0 = min(roots, key=lambda r: r[0])
+    # Move to the zero's far side (within round-off) so the crossing is consumed.
+    y = dense(t_first)
+    m_s, v_s = impulse_scale
+    impulse = y[prob.layout.P][:prob.s].sum() * m_s * v_s
+    prob.apply_event(y, kind0, j0, events, impulse)
+    same = 1e-12 * max(1.0, abs(t_first))
+    for tr, kind, j in sorted(roots):
+        if (kind, j) != (kind0, j0) and tr <= t_first + same \
+                and prob.event_values(y)[kind, j] <= 0:
+            prob.apply_event(y, kind, j, events, impulse)
+    prob.turn_at_once(y, events, impulse)
+    return t_first, y
+
+
+def _step(solver, steps, max_steps, events):
+    """One accepted DOP853 step; the number of steps so far."""
+    msg = solver.step()
+    if solver.status == "failed":
+        raise NumericalError(f"LZB integration failed: {msg}")
+    steps += 1
+    if steps > max_steps:
+        raise NumericalError(f"LZB impact did not end within {max_steps} steps "
+                             f"(events so far: {len(events)})",
+                             couples=sorted({ev.couple for ev in events[-10:]}))
+    return steps
+
+
+def integrate(prob, y, events, *, rtol, max_steps, impulse_scale):
+    """The driver: scipy's DOP853 from event to event until the impact ends
+    (`ImpactProblem.finished`); restarted at each event. Returns (y, steps, the normal
+    impulses after each accepted step)."""
+    m_s, v_s = impulse_scale
+    P = prob.layout.P
+    steps, history = 0, []
+    t, h = 0.0, None
+    while not prob.finished(y):
+        solver = DOP853(prob.rhs, t, y, np.inf, rtol=rtol, atol=rtol * 1e-2, first_step=h)
+        prob.classify(y)
+        g_old = prob.event_values(y)
+        while True:
+            steps = _step(solver, steps, max_steps, events)
+            g_new = prob.event_values(solver.y)
+            h = solver.step_size
+            dense = solver.dense_output()
+            brackets = active_events(prob, dense, solver.t_old, solver.t, g_old, g_new)
+            if brackets:
+                t, y = handle_events(prob, dense, brackets, events, impulse_scale)
+                history.append(y[P][:prob.s] * m_s * v_s)
+                break
+            y, t = solver.y, solver.t
+            # A couple that separated unloaded waits for its approach (same rhs).
+            g_old = prob.event_values(y) if prob.classify(y) else g_new
+            history.append(y[P][:prob.s] * m_s * v_s)
+            if prob.finished(y):
+                break
+    return y, steps, history
 
 
 def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, mu_s=None,
@@ -238,7 +257,7 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     k_ref = int(np.argmax(K))
     v_s = max(np.abs(u_minus).max(), np.sqrt(2.0 * E0.max() / m_s) if E0.max() > 0 else 0.0)
     empty = ImpactResult(v.copy(), np.zeros(s), np.zeros((s, 2)), np.zeros(s), np.zeros(s),
-                         np.zeros(s), [], 0, [], KE_minus, KE_minus)
+                         np.zeros(s), 0, [], KE_minus, KE_minus)
     if v_s == 0.0:
         return empty
     un0 = u_minus[:s]
@@ -252,91 +271,23 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     t_s = d_s / v_s
     kappa = K * d_s**eta_ * t_s / (m_s * v_s)   # nondimensional stiffness (Eq. 28)
     x0 = ((eta_ + 1.0) * (E0 / (m_s * v_s**2)) / kappa) ** (1.0 / (eta_ + 1.0))
-    prob = ImpactProblem(G * m_s, u_minus / v_s, kappa, eta_, e, mu_, mu_s_, law, x0, friction)
-    prob.settle = rtol
+    prob = ImpactProblem(G * m_s, u_minus / v_s, kappa, eta_, e, mu_, mu_s_, law, x0, friction,
+                         settle=rtol)
     events = []
     y = prob.y0.copy()
     if friction:
-        prob.select_friction_modes(y, [j for j in range(s) if x0[j] > 0 or un0[j] < 0],
-                                   events, 0.0)
-    steps = 0
-    primary = []
-    history = []
-    t = 0.0
-    atol = rtol * 1e-2
-    h = None
-    while not prob.finished(y):
-        solver = DOP853(prob.rhs, t, y, np.inf, rtol=rtol, atol=atol, first_step=h)
-        prob.classify(y)
-        g_old = prob.event_values(y)
-        restart = False
-        while not restart:
-            msg = solver.step()
-            if solver.status == "failed":
-                raise NumericalError(f"LZB integration failed: {msg}")
-            steps += 1
-            if steps > max_steps:
-                raise NumericalError(f"LZB impact did not end within {max_steps} steps "
-                                     f"(events so far: {len(events)})",
-                                     couples=sorted({ev.couple for ev in events[-10:]}))
-            y_new = solver.y
-            g_new = prob.event_values(y_new)
-            h = solver.step_size
-            dense = solver.dense_output()
-            brackets = _crossings(prob, dense, solver.t_old, solver.t, g_old, g_new)
-            if brackets:
-                t_first, which = np.inf, None
-                roots = []
-                for kind, j, ta, tb in brackets:
-                    f = lambda tt, kind=kind, j=j: prob.event_values(dense(tt))[kind, j]  # noqa
-                    if f(ta) <= 0:    # started on the boundary: the event is at ta
-                        tr = ta
-                    else:
-                        tr = brentq(f, ta, tb, xtol=1e-15 * max(1.0, abs(tb)),
-                                    rtol=4 * np.finfo(float).eps)
-                    roots.append((tr, kind, j))
-                    if tr < t_first:
-                        t_first, which = tr, (kind, j)
-                # Move to the zero's far side (within round-off) so the crossing is consumed.
-                y = dense(t_first)
-                t = t_first
-                impulse = y[prob.iP][:s].sum() * m_s * v_s
-                prob.apply_event(y, which[0], which[1], events, impulse)
-                # Simultaneous events (symmetric couples): every other crossing at the same
-                # instant is applied now; after the restart its function starts at <= 0 and
-                # its crossing would never be seen again.
-                same = 1e-12 * max(1.0, abs(t_first))
-                for tr, kind, j in sorted(roots):
-                    if (kind, j) != which and tr <= t_first + same \
-                            and prob.event_values(y)[kind, j] <= 0:
-                        prob.apply_event(y, kind, j, events, impulse)
-                prob.turn_at_once(y, events, impulse)
-                restart = True
-            else:
-                y = y_new
-                t = solver.t
-                # A couple that separated unloaded waits for its approach (same rhs).
-                g_old = prob.event_values(y) if prob.classify(y) else g_new
-            history.append(y[prob.iP][:s] * m_s * v_s)
-            energies = np.where(y[prob.ix] > 0, prob.kappa * np.maximum(y[prob.ix], 0)
-                                ** (eta_ + 1) / (eta_ + 1), 0.0)
-            if energies.max() > 0:
-                p = int(np.argmax(energies))
-                if not primary or primary[-1] != p:
-                    primary.append(p)
-            if not restart and prob.finished(y):
-                break
-    P = y[prob.iP] * m_s * v_s
+        select_modes(prob, y, [j for j in range(s) if x0[j] > 0 or un0[j] < 0], events, 0.0)
+    y, steps, history = integrate(prob, y, events, rtol=rtol, max_steps=max_steps,
+                                  impulse_scale=(m_s, v_s))
+    L = prob.layout
+    P = y[L.P] * m_s * v_s
     if not friction:
         P = np.concatenate([P, np.zeros(2 * s)])
     v_plus = v + MinvW @ P
     E_scale = m_s * v_s**2
-    Pt = P[s:].reshape(s, 2)
     return ImpactResult(
-        v_plus=v_plus, normal_impulse=P[:s], tangential_impulse=Pt,
-        compression_work=prob.wc * E_scale,
-        restitution_work=-y[prob.iwe] * E_scale,
-        friction_loss=y[prob.iwf] * E_scale,
-        primary_sequence=primary, steps=steps, events=events,
+        v_plus=v_plus, normal_impulse=P[:s], tangential_impulse=P[s:].reshape(s, 2),
+        compression_work=prob.wc * E_scale, restitution_work=-y[L.w_exp] * E_scale,
+        friction_loss=y[L.w_fric] * E_scale, steps=steps, events=events,
         kinetic_energy_minus=KE_minus, kinetic_energy_plus=0.5 * v_plus @ M @ v_plus,
         impulse_history=np.array(history))

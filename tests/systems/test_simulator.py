@@ -1,0 +1,35 @@
+"""`make_simulator`: the configuration Drake reports back is the one given, the context's
+accuracy is the one `tolerances` names, and the docking diagram's LZB accuracy is the one
+derived from the scenario's configuration."""
+import pytest
+from pydrake.systems.analysis import ExtractSimulatorConfig, SimulatorConfig
+from pydrake.systems.primitives import Integrator
+
+from drake_dock.systems.simulator import make_simulator, tolerances
+
+FIELDS = [f.name for f in SimulatorConfig.__fields__]
+
+
+@pytest.mark.parametrize("witness_accuracy", [None, 1e-5])
+def test_config_applied_and_context_accuracy_set(witness_accuracy):
+    config = SimulatorConfig(integration_scheme="runge_kutta5", max_step_size=0.003,
+                             accuracy=1e-7, use_error_control=True)
+    sim = make_simulator(Integrator(2), config, lambda c: c.SetContinuousState([1.0, 2.0]),
+                         witness_accuracy=witness_accuracy)
+    got = ExtractSimulatorConfig(sim)
+    assert {f: getattr(got, f) for f in FIELDS} == {f: getattr(config, f) for f in FIELDS}
+    ctx = sim.get_context()
+    assert list(ctx.get_continuous_state_vector().CopyToVector()) == [1.0, 2.0]
+    expected = config.accuracy if witness_accuracy is None else witness_accuracy
+    assert ctx.get_accuracy() == expected
+    assert tolerances(config, witness_accuracy).witness_accuracy == expected
+
+
+@pytest.mark.parametrize("accuracy", [1e-4, 1e-8])
+def test_docking_lzb_accuracy_follows_the_simulator_config(paper_scenario, accuracy):
+    import copy
+    from drake_dock.docking.diagram import build_docking_diagram
+    scenario = copy.deepcopy(paper_scenario)
+    scenario.simulator_config.accuracy = accuracy
+    dd = build_docking_diagram(scenario)
+    assert dd.contact.options.impact_rtol == tolerances(scenario.simulator_config).impact_rtol
