@@ -3,9 +3,11 @@ the missing samples run on Dask in batches, each finished batch saved as a part,
 ``results.parquet``, ``summary.json``, the figures and the worst samples' scenarios."""
 from __future__ import annotations
 
-import dataclasses
 import json
 from pathlib import Path
+
+import yaml
+from pydrake.common.yaml import yaml_dump_typed
 
 from drake_dock.campaign.execute import dask_client, run_on_dask, threads
 from drake_dock.campaign.figures import capture_probability_figure, histograms_figure
@@ -27,7 +29,7 @@ def plan_identity(plan, base) -> dict:
     plan's file name, which change no row."""
     ident = {"samples": plan.samples, "seed": plan.seed, "sampler": plan.sampler,
              "vary": {p: {d.kind: getattr(d, d.kind)} for p, d in sorted(plan.vary.items())},
-             "scenario": dataclasses.asdict(base)}
+             "scenario": yaml.safe_load(yaml_dump_typed(base))}
     return json.loads(json.dumps(ident))
 
 

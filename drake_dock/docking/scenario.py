@@ -117,6 +117,23 @@ class Scenario:
     simulator_config: SimulatorConfig = dataclasses.field(
         default_factory=default_simulator_config)
 
+    def __getstate__(self):
+        """Pickles (for Dask workers) with Drake's SimulatorConfig as its fields, which pickle."""
+        state = dict(self.__dict__)
+        c = state["simulator_config"]
+        state["simulator_config"] = {f.name: getattr(c, f.name)
+                                     for f in SimulatorConfig.__fields__}
+        return state
+
+    def __eq__(self, other):
+        """Field by field, SimulatorConfig by its fields (Drake's struct has no ==)."""
+        return type(other) is type(self) and self.__getstate__() == other.__getstate__()
+
+    def __setstate__(self, state):
+        state = dict(state)
+        state["simulator_config"] = SimulatorConfig(**state["simulator_config"])
+        self.__dict__.update(state)
+
 
 # Validation ---------------------------------------------------------------------------------
 def _schema_fields(schema):

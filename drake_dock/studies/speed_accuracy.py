@@ -1,5 +1,5 @@
 """The speed-accuracy study (`drake-dock study speed-accuracy`): drake_dock's rigid model at
-several accuracies against Drake's compliant contact (`docking/compliant.py`) on the same scene.
+several accuracies against Drake's compliant contact (`studies/compliant.py`) on the same scene.
 
 Metrics (all at capture, the axial ring-centre distance reaching ``capture_distance``):
 

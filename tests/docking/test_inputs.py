@@ -165,3 +165,15 @@ def test_capture_distance_at_or_beyond_the_start(beyond):
     assert "initial.approach_travel" in str(e.value)
     s.simulation.capture_distance = 0.99 * (d_c + s.initial.approach_travel)
     assert initial_state(s).d0 == d_c + s.initial.approach_travel
+
+
+def test_a_scenario_pickles_and_compares_with_its_simulator_config(paper_scenario):
+    """Dask sends scenarios to its workers by pickle; Drake's SimulatorConfig does not pickle
+    on its own and has no ==, so the scenario handles both, field by field."""
+    import copy
+    import pickle
+    back = pickle.loads(pickle.dumps(paper_scenario))
+    assert back == paper_scenario and back is not paper_scenario
+    other = copy.deepcopy(paper_scenario)
+    other.simulator_config.accuracy *= 2
+    assert other != paper_scenario and pickle.loads(pickle.dumps(other)) == other
