@@ -429,3 +429,21 @@ def test_three_feet_landing_together_with_friction(e, mu):
     res2 = solve_lzb(M, Wn[:, perm], v, 1e9, 1.5, e, Wt=Wt[:, tperm], mu=mu, rtol=1e-10,
                      max_steps=5000)
     np.testing.assert_allclose(res2.normal_impulse, res.normal_impulse[perm], rtol=1e-10)
+
+
+@pytest.mark.parametrize("law", ["paper", "mono", "bi"])
+@pytest.mark.parametrize("e", [0.0, 0.5])
+def test_a_couple_separating_at_round_off_takes_part_as_if_at_rest(law, e):
+    """Newton's cradle: ball 1 hits balls 2 and 3 resting in contact. Ball 3 drifting away at
+    1e-9 of the approach speed (round-off of the caller's velocities) gives the result of the
+    exact rest to within that order; beyond SEPARATING_RTOL the couple is refused."""
+    from drake_dock.core.lzb.solve import SEPARATING_RTOL
+    M, Wn = chain(3)
+    rest = solve_lzb(M, Wn, np.array([1.0, 0.0, 0.0]), [1e7, 1e7], 1.5, e, law=law, rtol=1e-12)
+    drift = solve_lzb(M, Wn, np.array([1.0, 0.0, 1e-9]), [1e7, 1e7], 1.5, e, law=law,
+                      rtol=1e-12)
+    np.testing.assert_allclose(drift.v_plus, rest.v_plus, atol=1e-8)
+    assert abs(drift.v_plus.sum() - (1.0 + 1e-9)) < 1e-12          # momentum
+    with pytest.raises(ValueError, match="already separating"):
+        solve_lzb(M, Wn, np.array([1.0, 0.0, 10 * SEPARATING_RTOL]), [1e7, 1e7], 1.5, e,
+                  law=law)

@@ -88,6 +88,8 @@ __all__ = ["LAWS", "ImpactResult", "solve_lzb", "check_inputs", "per_couple"]
 
 _INSIDE = np.arange(1, 32) / 32.0   # where a step's dense output is sampled for events
 _CLEAR = 1e-14                      # scaled event values below this are round-off
+SEPARATING_RTOL = 1e-6              # normal velocities up to this fraction of the largest are
+                                    # a couple at rest (`drake_dock.core.hybrid.CLOSED_RTOL`)
 
 
 @dataclasses.dataclass
@@ -261,10 +263,14 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     if v_s == 0.0:
         return empty
     un0 = u_minus[:s]
-    if np.any(un0 > 1e-12 * v_s):
-        j = np.flatnonzero(un0 > 1e-12 * v_s)
+    # A couple in contact may separate at round-off speed when another one is hit: up to
+    # SEPARATING_RTOL of the velocity scale it takes part, with zero indentation, and loads
+    # again only if the impact makes it approach (the caller's impact-set rule).
+    if np.any(un0 > SEPARATING_RTOL * v_s):
+        j = np.flatnonzero(un0 > SEPARATING_RTOL * v_s)
         raise ValueError(f"v_minus: couple(s) {j.tolist()} already separating (normal relative "
-                         f"velocity {un0[j]} > 0); pass only couples in contact or approaching")
+                         f"velocity {un0[j]} > {SEPARATING_RTOL:g} of the largest); pass only "
+                         f"couples in contact or approaching")
     if np.all(un0 >= 0) and E0.max() == 0:
         return empty
     d_s = (m_s * v_s**2 / K[k_ref]) ** (1.0 / (eta_[k_ref] + 1.0))   # length scale
