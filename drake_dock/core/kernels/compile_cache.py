@@ -57,5 +57,6 @@ def cache_dir() -> pathlib.Path:
 
 def warm() -> None:
     """Compiles (or loads from the cache) every kernel by evaluating the kernels once."""
-    from drake_dock.core.kernels import tracked
+    from drake_dock.core.kernels import seek, tracked
     tracked.warm()
+    seek.warm()
