@@ -27,10 +27,10 @@ notebook: $(BIN)/.notebook
 test: $(BIN)/.installed
 	$(BIN)/python -m pytest -q
 
-# tests/core in a virtual environment without Drake (numpy, scipy, pytest, pyyaml only).
+# tests/core in a virtual environment without Drake (numpy, scipy, numba, pytest, pyyaml only).
 test-core:
 	$(PYTHON) -m venv .venv-core
-	.venv-core/bin/python -m pip install --quiet -c constraints.txt numpy scipy pytest hypothesis pyyaml
+	.venv-core/bin/python -m pip install --quiet -c constraints.txt numpy scipy numba pytest hypothesis pyyaml
 	PYTHONPATH=. .venv-core/bin/python -m pytest -q -p no:cacheprovider tests/core
 
 bench: $(BIN)/.installed

@@ -362,9 +362,12 @@ class PolarCurve(Patch):
     dim = 1
     periodic = (False,)
 
-    def __init__(self, radial, axial, theta_range, parts=None):
+    def __init__(self, radial, axial, theta_range, parts=None, kernel_params=None):
         self.radial = radial
         self.axial = axial
+        # For a curve in the sine form of Eq. (14), its parameters for the compiled kernels
+        # (drake_dock.core.kernels.jets, kind SINE_POLAR); None otherwise.
+        self.kernel_params = kernel_params
         # Optional th -> (radial triple, axial triple) at one float theta, for curves whose
         # axial part follows from the radial one (`jet` then evaluates them once).
         self.parts = parts

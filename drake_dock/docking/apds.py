@@ -117,7 +117,8 @@ def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
         rad = radial(th)
         return rad, axial_of(*rad)
 
-    return PolarCurve(radial, axial, (phi, phi + sigma * g.theta_end), parts)
+    return PolarCurve(radial, axial, (phi, phi + sigma * g.theta_end), parts,
+                      kernel_params=(A, sigma, phi, tan1, g.R, g.alpha2))
 
 
 class _PetalMap:
@@ -130,6 +131,8 @@ class _PetalMap:
         self.upper = np.array([1.0, g.H])
         self.cot1 = 1.0 / math.tan(g.alpha1)
         self.A = g.R * math.sin(g.alpha2)
+        # The map's parameters for the compiled kernels (kind PETAL).
+        self.kernel_params = (self.phi0, self.cot1, self.A, g.alpha2, g.R)
 
     def _t1(self, z):
         rho = self.g.R - z * self.cot1

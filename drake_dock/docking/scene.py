@@ -9,6 +9,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
+from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import Patch, posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.docking.apds import ApdsGeometry, apds_patches
@@ -107,9 +108,14 @@ class Approach:
 
 
 def pair_couples(pairs, poses, **grid):
-    """Seeks the closest couple of every pair; ``poses`` maps body name -> (R_WB, p_WB)."""
-    return [seek_couple(posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2]),
-                        **grid) for pr in pairs]
+    """Seeks the closest couple of every pair; ``poses`` maps body name -> (R_WB, p_WB). The
+    compiled seek (`drake_dock.core.kernels.seek`) where the patches have kernel descriptions."""
+    out = []
+    for pr in pairs:
+        P1, P2 = posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2])
+        seek = compiled_seek.seek_couple if compiled_seek.supported(P1, P2) else seek_couple
+        out.append(seek(P1, P2, **grid))
+    return out
 
 
 def _gaps_at(pairs, approach, d, refs):

@@ -62,6 +62,7 @@ class ContactOptions:
                                      # track_distance (`seek_couple`): their distance only sets
                                      # the clearance, which keeps track_distance / 2 in hand
     max_impacts: int = 10000
+    compiled: bool = True            # the couples by the compiled kernels (False: in Python)
 
 
 @dataclasses.dataclass

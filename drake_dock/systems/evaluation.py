@@ -13,6 +13,7 @@ from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
 from drake_dock.core.constraints import SLIDE, STICK, ContactRow, solve_given_modes
 from drake_dock.core.couple import evaluate_couple, float_pose, float_vec
 from drake_dock.core.hybrid import Mode
+from drake_dock.core.kernels.couples import DRIFT_REL as KERNEL_DRIFT_REL
 from drake_dock.errors import DriftError
 from drake_dock.systems.contact_types import Evaluation
 from drake_dock.systems.far_pairs import FarPairs
@@ -57,6 +58,14 @@ class PlantEvaluator:
                                                 p.patch1.periodic + p.patch2.periodic)]
                         for p in pairs]
         self.frames, self.fidx = frame_list(pairs)
+        # The tracked couples in one compiled call per evaluation, where every patch has a
+        # kernel description (else, or with options.compiled off, the Python path).
+        self.kernel = None
+        if options.compiled:
+            from drake_dock.core.kernels.tracked import TrackedCouples
+            kernel = TrackedCouples([(p.kind, p.patch1, p.patch2, f)
+                                     for p, f in zip(self.pairs, self.fidx)])
+            self.kernel = kernel if kernel.supported else None
         self.far = FarPairs(pairs, self.fidx)
         self.evaluations = 0
         self._zero_v = np.zeros(self.nv)         # never written
@@ -96,6 +105,41 @@ class PlantEvaluator:
                              f"drift_tol = {self.options.drift_tol:g}", time=time,
                              couples=[p.name])
         return ev
+
+    def couples(self, t, u, poses, twists, modes):
+        """The couples of the pairs that are not far (`CoupleEval` or None per pair) and the
+        couples' rate u*' = Eq. (47) + drift_feedback x projection; `DriftError` as `couple`."""
+        k, fb = len(self.pairs), self.options.drift_feedback
+        evals = [None] * k
+        udot = np.zeros(self.nu)
+        if self.kernel is None:
+            # The couples work in plain floats: the frames' poses and twists converted once.
+            fposes = [float_pose(X) for X in poses]
+            ftwists = [(float_vec(w), float_vec(v)) for w, v in twists]
+            for i, st in enumerate(modes.pairs):
+                if st.mode != Mode.FAR:
+                    sl = self.couple_slice(i)
+                    ev = evals[i] = self.couple(i, u[sl], fposes, ftwists, st.sigma, t)
+                    udot[sl] = ev.udot + fb * ev.drift
+            return evals, udot
+        active = np.array([st.mode != Mode.FAR for st in modes.pairs], dtype=np.bool_)
+        if not active.any():
+            return evals, udot
+        sigma = np.array([st.sigma for st in modes.pairs], dtype=float)
+        out, udot = self.kernel.evaluate(np.array([X[0] for X in poses]),
+                                         np.array([X[1] for X in poses]),
+                                         np.array([V[0] for V in twists]),
+                                         np.array([V[1] for V in twists]), u, sigma, active,
+                                         drift_feedback=fb)
+        rel = out[:, KERNEL_DRIFT_REL]
+        if (rel > self.options.drift_tol).any():
+            i = int(np.argmax(rel > self.options.drift_tol))
+            raise DriftError(f"couple drift {rel[i]:.3e} of the domain span exceeds "
+                             f"drift_tol = {self.options.drift_tol:g}", time=t,
+                             couples=[self.pairs[i].name])
+        for i in np.flatnonzero(active).tolist():
+            evals[i] = self.kernel.couple_eval(out, i)
+        return evals, udot
 
     def row(self, i, ev, poses, ctx):
         """W^3, W^1, W^2 (Eq. 11) from Drake's point Jacobians and the bias terms (Eq. 52)."""
@@ -167,20 +211,11 @@ class PlantEvaluator:
         q, v, u = x[:self.nq], x[self.nq:self.nq + self.nv], x[self.nq + self.nv:self.ie]
         ctx = self.set_scratch(q, v)
         poses, twists = self.frame_kinematics(ctx)
-        # The couples work in plain floats: the frames' poses and twists converted once.
-        fposes = [float_pose(X) for X in poses]
-        ftwists = [(float_vec(w), float_vec(v)) for w, v in twists]
         k = len(self.pairs)
-        evals = [None] * k
-        udot = np.zeros(self.nu)
+        evals, udot = self.couples(t, u, poses, twists, modes)
         rows, row_pairs, smodes, dirs = [], [], [], []
         for i, st in enumerate(modes.pairs):
-            sl = self.couple_slice(i)
-            if st.mode == Mode.FAR:
-                continue
-            ev = self.couple(i, u[sl], fposes, ftwists, st.sigma, t)
-            evals[i] = ev
-            udot[sl] = ev.udot + self.options.drift_feedback * ev.drift
+            ev = evals[i]
             if st.mode.in_contact:
                 rows.append(self.row(i, ev, poses, ctx))
                 row_pairs.append(i)

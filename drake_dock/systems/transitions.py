@@ -11,6 +11,7 @@ from drake_dock.core import hybrid
 from drake_dock.core.constraints import select_modes
 from drake_dock.core.couple import closest_point_conditions, evaluate_couple
 from drake_dock.core.hybrid import Mode
+from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import seek_couple
@@ -92,8 +93,10 @@ class Transitions:
         ev, opt, p = self.ev, self.options, self.pairs[i]
         a, b = ev.fidx[i]
         try:
-            c = seek_couple(posed(p.patch1, *poses[a]), posed(p.patch2, *poses[b]),
-                            distance_rtol=opt.seek_rtol, rtol_beyond=opt.track_distance)
+            P1, P2 = posed(p.patch1, *poses[a]), posed(p.patch2, *poses[b])
+            seek = (compiled_seek.seek_couple if opt.compiled and compiled_seek.supported(P1, P2)
+                    else seek_couple)
+            c = seek(P1, P2, distance_rtol=opt.seek_rtol, rtol_beyond=opt.track_distance)
         except SeekingError as e:
             raise SeekingError(str(e), time=time, couples=[p.name]) from None
         st.ref_X21 = ev.far.reference(i, poses)

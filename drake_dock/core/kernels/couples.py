@@ -1,0 +1,281 @@
+"""Every tracked couple of a contact system in one compiled call (Sect. 7 of the paper).
+
+`evaluate_couples` is `drake_dock.core.couple.evaluate_couple` for a whole set of pairs over
+plain arrays: per pair, the closest-point conditions in contact form (Eq. 37-38), one Newton
+projection of the integrated couple, Eq. (47) for u*', the contact frame (Definition 2), the
+gap, the relative velocity (Eq. 23-25) and the velocity-product terms of Eq. (52). The
+operations are those of `evaluate_couple`, in the same order, except for the conditioning's row
+norms (a plain square root of the sum of squares instead of `math.hypot`, which only moves the
+conditioning, a threshold test, in its last bits).
+
+Patch 1 of every pair is a curve; patch 2 a curve (CC) or a surface (CS). The output has one
+row per pair, its fields at the offsets below (`ROW`); the rows of pairs not asked for are
+left zero.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from drake_dock.core.kernels.jets import jet
+
+# Row layout: u (3), drift (3), udot (3), residual, conditioning, p1 (3), p2 (3), n (3),
+# ta (3), tb (3), gap, v_rel (3), vn, vt (2), bias_n, bias_t (2), max |drift| / span, and the
+# integrated rate u*' = udot + drift_feedback * drift (3).
+U, DRIFT, UDOT, RESIDUAL, COND, P1, P2, N, TA, TB, GAP, VREL, VN, VT, BIAS_N, BIAS_T, \
+    DRIFT_REL, RATE = 0, 3, 6, 9, 10, 11, 14, 17, 20, 23, 26, 27, 30, 31, 33, 34, 36, 37
+ROW = 40
+_Z = (0.0, 0.0, 0.0)
+
+
+@njit(cache=True)
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True)
+def _cr(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@njit(cache=True)
+def _add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+@njit(cache=True)
+def _sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+@njit(cache=True)
+def _mul(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+@njit(cache=True)
+def _axpy(s, a, b):
+    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
+
+
+@njit(cache=True)
+def _rot(R, a):
+    return (R[0, 0] * a[0] + R[0, 1] * a[1] + R[0, 2] * a[2],
+            R[1, 0] * a[0] + R[1, 1] * a[1] + R[1, 2] * a[2],
+            R[2, 0] * a[0] + R[2, 1] * a[1] + R[2, 2] * a[2])
+
+
+@njit(cache=True)
+def _unit(a):
+    na = math.sqrt(_dot(a, a))
+    if na == 0.0:
+        return a, 1.0
+    return _mul(a, 1.0 / na), na
+
+
+@njit(cache=True)
+def _perp_rate(unit, rate, norm):
+    """d/dt (a/|a|) = (I - u u^T) a' / |a|."""
+    return _mul(_axpy(-_dot(unit, rate), unit, rate), 1.0 / norm)
+
+
+@njit(cache=True)
+def _geometry(kind, prm, R, u0, u1):
+    """The world-oriented jet (R r, R T, R K) of a patch."""
+    r, t0, t1, k00, k01, k11 = jet(kind, prm, u0, u1)
+    return _rot(R, r), _rot(R, t0), _rot(R, t1), _rot(R, k00), _rot(R, k01), _rot(R, k11)
+
+
+@njit(cache=True)
+def _residual(cc, d, T1, K1, T2, T2b, K2, K2ab, K2bb):
+    """F and Fu (Eq. 37-40) as three rows (the third zero for CC)."""
+    if cc:
+        t12 = _dot(T1, T2)
+        return ((_dot(T1, d), _dot(T2, d), 0.0),
+                (_dot(K1, d) + _dot(T1, T1), -t12, 0.0), (t12, _dot(K2, d) - _dot(T2, T2), 0.0),
+                _Z)
+    su, sv, suu, suv, svv = T2, T2b, K2, K2ab, K2bb
+    Nv = _cr(su, sv)
+    susv = _dot(su, sv)
+    return ((_dot(su, d), _dot(sv, d), _dot(T1, Nv)),
+            (_dot(su, T1), _dot(suu, d) - _dot(su, su), _dot(suv, d) - susv),
+            (_dot(sv, T1), _dot(suv, d) - susv, _dot(svv, d) - _dot(sv, sv)),
+            (_dot(K1, Nv), _dot(T1, _add(_cr(suu, sv), _cr(su, suv))),
+             _dot(T1, _add(_cr(suv, sv), _cr(su, svv)))))
+
+
+@njit(cache=True)
+def _det(n, A0, A1, A2):
+    if n == 2:
+        return A0[0] * A1[1] - A0[1] * A1[0]
+    return _dot(A0, _cr(A1, A2))
+
+
+@njit(cache=True)
+def _solve(n, A0, A1, A2, b):
+    """A x = b by Cramer's rule, n = 2 or 3 (`drake_dock.core.couple._solve`)."""
+    if n == 2:
+        a, c = A0[0], A0[1]
+        d, e = A1[0], A1[1]
+        det = a * e - c * d
+        return ((b[0] * e - c * b[1]) / det, (a * b[1] - b[0] * d) / det, 0.0)
+    c0 = _cr(A1, A2)
+    det = _dot(A0, c0)
+    c1, c2 = _cr(A2, A0), _cr(A0, A1)
+    return ((c0[0] * b[0] + c1[0] * b[1] + c2[0] * b[2]) / det,
+            (c0[1] * b[0] + c1[1] * b[1] + c2[1] * b[2]) / det,
+            (c0[2] * b[0] + c1[2] * b[1] + c2[2] * b[2]) / det)
+
+
+@njit(cache=True)
+def _row_norm(n, a):
+    s = a[0] * a[0] + a[1] * a[1]
+    if n == 3:
+        s += a[2] * a[2]
+    return math.sqrt(s)
+
+
+@njit(cache=True)
+def _conditioning(n, A0, A1, A2, T1, T2, T2b):
+    """|det Fu| / product of its row norms, its columns scaled by the tangent lengths."""
+    c0, c1, c2 = math.sqrt(_dot(T1, T1)), math.sqrt(_dot(T2, T2)), 1.0
+    if n == 3:
+        c2 = math.sqrt(_dot(T2b, T2b))
+    if min(c0, min(c1, c2)) > 0.0:
+        A0 = (A0[0] / c0, A0[1] / c1, A0[2] / c2)
+        A1 = (A1[0] / c0, A1[1] / c1, A1[2] / c2)
+        A2 = (A2[0] / c0, A2[1] / c1, A2[2] / c2)
+    den = _row_norm(n, A0) * _row_norm(n, A1)
+    if n == 3:
+        den *= _row_norm(n, A2)
+    return abs(_det(n, A0, A1, A2)) / den if den > 0 else 0.0
+
+
+@njit(cache=True)
+def _put(out, at, a):
+    out[at], out[at + 1], out[at + 2] = a[0], a[1], a[2]
+
+
+@njit(cache=True)
+def evaluate_one(cc, kind1, prm1, kind2, prm2, R1, o1, w1, v1, R2, o2, w2, v2, u_state,
+                 sigma, project, out):
+    """One couple (`evaluate_couple`) into the row ``out``."""
+    n = 2 if cc else 3
+    u = (u_state[0], u_state[1], u_state[2] if n == 3 else 0.0)
+    r1, T1, _, K1, _, _ = _geometry(kind1, prm1, R1, u[0], 0.0)
+    r2, T2, T2b, K2, K2ab, K2bb = _geometry(kind2, prm2, R2, u[1], u[2])
+    d = _sub(_add(r1, o1), _add(r2, o2))
+    F, A0, A1, A2 = _residual(cc, d, T1, K1, T2, T2b, K2, K2ab, K2bb)
+    ss = F[0] * F[0] + F[1] * F[1]
+    if n == 3:
+        ss += F[2] * F[2]
+    residual = math.sqrt(ss)
+    cond = _conditioning(n, A0, A1, A2, T1, T2, T2b)
+    du = _Z
+    if project and residual > 0.0 and cond > 1e-14:
+        x = _solve(n, A0, A1, A2, F)
+        du = (-x[0], -x[1], -x[2] if n == 3 else 0.0)
+        u = (u[0] + du[0], u[1] + du[1], u[2] + du[2] if n == 3 else 0.0)
+        big_du = max(abs(du[0]), abs(du[1]))
+        big_u = max(abs(u[0]), abs(u[1]))
+        if n == 3:
+            big_du, big_u = max(big_du, abs(du[2])), max(big_u, abs(u[2]))
+        if big_du > 1e-9 * (1.0 + big_u):
+            r1, T1, _, K1, _, _ = _geometry(kind1, prm1, R1, u[0], 0.0)
+            r2, T2, T2b, K2, K2ab, K2bb = _geometry(kind2, prm2, R2, u[1], u[2])
+            d = _sub(_add(r1, o1), _add(r2, o2))
+            F, A0, A1, A2 = _residual(cc, d, T1, K1, T2, T2b, K2, K2ab, K2bb)
+            cond = _conditioning(n, A0, A1, A2, T1, T2, T2b)
+        else:
+            # A round-off-sized correction: the points move along their tangents.
+            r1 = _axpy(du[0], T1, r1)
+            r2 = _axpy(du[1], T2, r2)
+            if n == 3:
+                r2 = _axpy(du[2], T2b, r2)
+            d = _sub(_add(r1, o1), _add(r2, o2))
+    x1, x2 = _add(r1, o1), _add(r2, o2)
+    v_rel = _sub(_add(v1, _cr(w1, r1)), _add(v2, _cr(w2, r2)))
+    w1t1 = _cr(w1, T1)
+    w2t2 = _cr(w2, T2)
+    su, sv = T2, T2b
+    Nv = _cr(su, sv)
+    w2su, w2sv = w2t2, _cr(w2, sv)
+    if cc:
+        Ft = (_dot(w1t1, d) + _dot(T1, v_rel), _dot(w2t2, d) + _dot(T2, v_rel), 0.0)
+    else:
+        Ft = (_dot(w2su, d) + _dot(su, v_rel), _dot(w2sv, d) + _dot(sv, v_rel),
+              _dot(w1t1, Nv) + _dot(T1, _cr(w2, Nv)))
+    # Eq. (47): u' = -J^-1 dF/dt (J = Fu, Eq. 40); zeros where J is singular.
+    udot = _Z
+    if cond > 1e-14:
+        udot = _solve(n, A0, A1, A2, (-Ft[0], -Ft[1], -Ft[2]))
+        if n == 2:
+            udot = (udot[0], udot[1], 0.0)
+    t1dot = _axpy(udot[0], K1, w1t1)
+    if cc:
+        t2dot = _axpy(udot[1], K2, w2t2)
+        n_hat, c_norm = _unit(_cr(T1, T2))
+        nv = _mul(n_hat, sigma)
+        ndot = _mul(_perp_rate(n_hat, _add(_cr(t1dot, T2), _cr(T1, t2dot)), c_norm), sigma)
+        ta, t2_norm = _unit(T2)
+        tadot = _perp_rate(ta, t2dot, t2_norm)
+        conv = _sub(_cr(w1, _mul(T1, udot[0])), _cr(w2, _mul(T2, udot[1])))
+    else:
+        suu, suv, svv = K2, K2ab, K2bb
+        sudot = _axpy(udot[2], suv, _axpy(udot[1], suu, w2su))
+        svdot = _axpy(udot[2], svv, _axpy(udot[1], suv, w2sv))
+        N_hat, N_norm = _unit(Nv)
+        nv = _mul(N_hat, sigma)
+        ndot = _mul(_perp_rate(N_hat, _add(_cr(sudot, sv), _cr(su, svdot)), N_norm), sigma)
+        ta, su_norm = _unit(su)
+        tadot = _perp_rate(ta, sudot, su_norm)
+        conv = _sub(_cr(w1, _mul(T1, udot[0])), _cr(w2, _axpy(udot[2], sv, _mul(su, udot[1]))))
+    tb = _cr(nv, ta)
+    tbdot = _add(_cr(ndot, ta), _cr(nv, tadot))
+    _put(out, U, u)
+    _put(out, DRIFT, du)
+    _put(out, UDOT, udot)
+    out[RESIDUAL], out[COND] = residual, cond
+    _put(out, P1, x1)
+    _put(out, P2, x2)
+    _put(out, N, nv)
+    _put(out, TA, ta)
+    _put(out, TB, tb)
+    out[GAP] = _dot(nv, d)
+    _put(out, VREL, v_rel)
+    out[VN] = _dot(nv, v_rel)
+    out[VT], out[VT + 1] = _dot(ta, v_rel), _dot(tb, v_rel)
+    out[BIAS_N] = _dot(nv, conv) + _dot(ndot, v_rel)
+    out[BIAS_T] = _dot(ta, conv) + _dot(tadot, v_rel)
+    out[BIAS_T + 1] = _dot(tb, conv) + _dot(tbdot, v_rel)
+
+
+@njit(cache=True)
+def evaluate_couples(cc, kind1, prm1, kind2, prm2, fidx, uoff, spans, R, o, w, v, u, sigma,
+                     active, project, drift_feedback, out, rate):
+    """Pairs i with ``active[i]``: their couples u[uoff[i]:uoff[i + 1]] evaluated into
+    ``out[i]`` (see the module docstring), with the frames' world rotations R (F, 3, 3),
+    origins o (F, 3) and twists w, v (F, 3); pair i's bodies are frames fidx[i]. Also the
+    largest drift relative to the domain spans (pair i's spans[i]), and the integrated rate,
+    also into ``rate`` (the layout of u)."""
+    for i in range(len(cc)):
+        if not active[i]:
+            continue
+        a, b = fidx[i, 0], fidx[i, 1]
+        ui = u[uoff[i]:uoff[i + 1]]
+        us = (ui[0], ui[1], ui[2] if len(ui) == 3 else 0.0)
+        row = out[i]
+        evaluate_one(cc[i], kind1[i], prm1[i], kind2[i], prm2[i],
+                     R[a], (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]),
+                     (v[a, 0], v[a, 1], v[a, 2]),
+                     R[b], (o[b, 0], o[b, 1], o[b, 2]), (w[b, 0], w[b, 1], w[b, 2]),
+                     (v[b, 0], v[b, 1], v[b, 2]), us, sigma[i], project, row)
+        m = len(ui)
+        rel = 0.0
+        for j in range(m):
+            rel = max(rel, abs(row[DRIFT + j]) / spans[i, j])
+            row[RATE + j] = row[UDOT + j] + drift_feedback * row[DRIFT + j]
+            rate[uoff[i] + j] = row[RATE + j]
+        row[DRIFT_REL] = rel

@@ -1,0 +1,132 @@
+"""Patch jets (r, T, K) of Definition 1 by kind code and parameter array, compiled.
+
+A patch is described to the kernels by an integer kind and a float64 parameter array
+(`patch_spec`); `jet` evaluates it at one parameter point with the same floating-point
+operations, in the same order, as the patch's own `jet` (drake_dock.core.patches), so that
+both give the same bits. The kinds:
+
+- CIRCLE  [radius, height]: `Circle`.
+- SEGMENT [a (3), b (3)]: `Segment`.
+- PLANE   [o (3), e0 (3), e1 (3)]: `PlaneRect`.
+- CONE    [R0, cot alpha]: `Cone`.
+- SINE_POLAR [A, sigma, phi, tan alpha1, R, alpha2]: a `PolarCurve` in the sine form of Eq. (14),
+  rho = A / sin(alpha2 + sigma (theta - phi)), z = (R - rho) tan alpha1 (a guide side).
+- PETAL [R0, cot alpha, phi0, cot alpha1, A, alpha2, R]: a `Cone` reparametrized across the
+  petal between two guide sides, theta = phi0 + theta_1(z) + s (pi/3 - 2 theta_1(z)) with
+  theta_1 of Eq. (13) (a guide surface).
+
+Each jet is returned as six 3-tuples (r, T0, T1, K00, K01, K11); a curve's T1, K01, K11 are
+zero.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from drake_dock.core.patches import Circle, Cone, PlaneRect, PolarCurve, Reparametrized, \
+    Segment
+
+CIRCLE, SEGMENT, PLANE, CONE, SINE_POLAR, PETAL = range(6)
+N_PARAMS = 9
+_Z = (0.0, 0.0, 0.0)
+
+
+def patch_spec(patch):
+    """(kind, parameters (N_PARAMS,)) of a patch, or None for a patch no kernel describes."""
+    prm = np.zeros(N_PARAMS)
+    if isinstance(patch, Circle):
+        kind, vals = CIRCLE, [patch.radius, patch.height]
+    elif isinstance(patch, Segment):
+        kind, vals = SEGMENT, [*patch.a, *patch.b]
+    elif isinstance(patch, PlaneRect):
+        kind, vals = PLANE, [*patch.o, *patch.e0, *patch.e1]
+    elif isinstance(patch, Cone):
+        kind, vals = CONE, [patch.R0, patch.cot]
+    elif isinstance(patch, PolarCurve) and patch.kernel_params is not None:
+        kind, vals = SINE_POLAR, list(patch.kernel_params)
+    elif (isinstance(patch, Reparametrized) and type(patch.base) is Cone
+          and getattr(patch.phi, "kernel_params", None) is not None):
+        kind, vals = PETAL, [patch.base.R0, patch.base.cot, *patch.phi.kernel_params]
+    else:
+        return None
+    prm[:len(vals)] = [float(v) for v in vals]
+    return kind, prm
+
+
+@njit(cache=True)
+def _polar(r, r1, r2, z, z1, z2, th):
+    c, s = math.cos(th), math.sin(th)
+    return ((r * c, r * s, z), (r1 * c - r * s, r1 * s + r * c, z1), _Z,
+            (r2 * c - 2 * r1 * s - r * c, r2 * s + 2 * r1 * c - r * s, z2), _Z, _Z)
+
+
+@njit(cache=True)
+def _cone(R0, cot, th, z):
+    rho = R0 - z * cot
+    c, s = math.cos(th), math.sin(th)
+    r_thz = (cot * s, -cot * c, 0.0)
+    return ((rho * c, rho * s, z), (-rho * s, rho * c, 0.0), (-cot * c, -cot * s, 1.0),
+            (-rho * c, -rho * s, 0.0), r_thz, _Z)
+
+
+@njit(cache=True)
+def _petal(prm, a, z):
+    """`_PetalMap.jet` composed with the cone's jet by `Reparametrized.jet`'s chain rule."""
+    cot, phi0, A, alpha2, R = prm[3], prm[2], prm[4], prm[5], prm[6]
+    rho = R - z * cot
+    x = A / rho
+    x1 = x * cot / rho
+    x2 = 2.0 * x * math.pow(cot, 2.0) / math.pow(rho, 2.0)
+    q = math.sqrt(1.0 - x * x)
+    t1 = math.asin(x) - alpha2
+    d1, d2 = x1 / q, x2 / q + x * math.pow(x1, 2.0) / math.pow(q, 3.0)
+    w = math.pi / 3 - 2 * t1
+    j00, j01, j10, j11 = w, d1 * (1 - 2 * a), 0.0, 1.0
+    h001 = -2 * d1
+    h011 = d2 * (1 - 2 * a)
+    rb, B0, B1, B00, B01, B11 = _cone(prm[0], prm[1], phi0 + t1 + a * w, z)
+    T0 = (B0[0] * j00 + B1[0] * j10, B0[1] * j00 + B1[1] * j10, B0[2] * j00 + B1[2] * j10)
+    T1 = (B0[0] * j01 + B1[0] * j11, B0[1] * j01 + B1[1] * j11, B0[2] * j01 + B1[2] * j11)
+    K00 = _second(B0, B1, B00, B01, B11, j00, j10, j00, j10, 0.0, 0.0)
+    K01 = _second(B0, B1, B00, B01, B11, j00, j10, j01, j11, h001, 0.0)
+    K11 = _second(B0, B1, B00, B01, B11, j01, j11, j01, j11, h011, 0.0)
+    return rb, T0, T1, K00, K01, K11
+
+
+@njit(cache=True)
+def _second(B0, B1, B00, B01, B11, ua0, ua1, ub0, ub1, h0, h1):
+    c00, c01, c10, c11 = ua0 * ub0, ua0 * ub1, ua1 * ub0, ua1 * ub1
+    return (B00[0] * c00 + B01[0] * (c01 + c10) + B11[0] * c11 + B0[0] * h0 + B1[0] * h1,
+            B00[1] * c00 + B01[1] * (c01 + c10) + B11[1] * c11 + B0[1] * h0 + B1[1] * h1,
+            B00[2] * c00 + B01[2] * (c01 + c10) + B11[2] * c11 + B0[2] * h0 + B1[2] * h1)
+
+
+@njit(cache=True)
+def jet(kind, prm, u0, u1):
+    """(r, T0, T1, K00, K01, K11) of the patch (kind, prm) at u = (u0[, u1])."""
+    if kind == CIRCLE:
+        R, h = prm[0], prm[1]
+        c, s = math.cos(u0), math.sin(u0)
+        return (R * c, R * s, h), (-R * s, R * c, 0.0), _Z, (-R * c, -R * s, 0.0), _Z, _Z
+    if kind == SEGMENT:
+        e = (prm[3] - prm[0], prm[4] - prm[1], prm[5] - prm[2])
+        return ((prm[0] + u0 * e[0], prm[1] + u0 * e[1], prm[2] + u0 * e[2]), e, _Z, _Z, _Z,
+                _Z)
+    if kind == PLANE:
+        e0 = (prm[3], prm[4], prm[5])
+        e1 = (prm[6], prm[7], prm[8])
+        return ((prm[0] + u0 * e0[0] + u1 * e1[0], prm[1] + u0 * e0[1] + u1 * e1[1],
+                 prm[2] + u0 * e0[2] + u1 * e1[2]), e0, e1, _Z, _Z, _Z)
+    if kind == CONE:
+        return _cone(prm[0], prm[1], u0, u1)
+    if kind == SINE_POLAR:
+        A, sigma, phi, tan1, R, alpha2 = prm[0], prm[1], prm[2], prm[3], prm[4], prm[5]
+        w = alpha2 + sigma * (u0 - phi)
+        sw, cw = math.sin(w), math.cos(w)
+        rho = A / sw
+        r1 = -sigma * A * cw / math.pow(sw, 2.0)
+        r2 = A * (1.0 + math.pow(cw, 2.0)) / math.pow(sw, 3.0)
+        return _polar(rho, r1, r2, (R - rho) * tan1, -r1 * tan1, -r2 * tan1, u0)
+    return _petal(prm, u0, u1)

@@ -1,0 +1,349 @@
+"""The seek of Sect. 5.1 compiled: the hierarchical grid and the bounded Newton finish of
+`drake_dock.core.seeking` (`hierarchical_seek`, `newton_closest`, `seek_couple`) over the
+kernels' patch descriptions (`jets.patch_spec`), with the same steps and tolerances.
+
+The grid distances are computed as |x1 - x2|^2 directly (the reference expands them), so a grid
+tie may be broken differently; the Newton finish then converges to the same couple (tests
+compare the couples and distances with the reference)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from drake_dock.core.kernels.jets import jet, patch_spec
+from drake_dock.core.seeking import Couple, is_interior
+from drake_dock.errors import SeekingError
+
+EPS8 = 8 * np.finfo(float).eps
+
+
+@njit(cache=True)
+def _point(kind, prm, R, o, u0, u1):
+    r = jet(kind, prm, u0, u1)[0]
+    return (R[0, 0] * r[0] + R[0, 1] * r[1] + R[0, 2] * r[2] + o[0],
+            R[1, 0] * r[0] + R[1, 1] * r[1] + R[1, 2] * r[2] + o[1],
+            R[2, 0] * r[0] + R[2, 1] * r[1] + R[2, 2] * r[2] + o[2])
+
+
+@njit(cache=True)
+def _positions(kind, prm, R, o, U):
+    X = np.empty((U.shape[0], 3))
+    for a in range(U.shape[0]):
+        X[a] = _point(kind, prm, R, o, U[a, 0], U[a, 1] if U.shape[1] == 2 else 0.0)
+    return X
+
+
+@njit(cache=True)
+def _d2(X1, X2):
+    D = np.empty((X1.shape[0], X2.shape[0]))
+    for i in range(X1.shape[0]):
+        for j in range(X2.shape[0]):
+            a, b, c = X1[i, 0] - X2[j, 0], X1[i, 1] - X2[j, 1], X1[i, 2] - X2[j, 2]
+            D[i, j] = a * a + b * b + c * c
+    return D
+
+
+@njit(cache=True)
+def _local_grid(c, hw, lower, upper, periodic, n):
+    """`seeking._local_grids` for one centre c."""
+    dim = c.shape[0]
+    lo, hi = c - hw, c + hw
+    for k in range(dim):
+        if not periodic[k]:
+            lo[k], hi[k] = max(lo[k], lower[k]), min(hi[k], upper[k])
+    t = np.linspace(0.0, 1.0, n)
+    G = np.empty((n ** dim, dim))
+    for a in range(n ** dim):
+        for k in range(dim):
+            j = a if dim == 1 else (a // n if k == 0 else a % n)
+            G[a, k] = lo[k] + (hi[k] - lo[k]) * t[j]
+            if periodic[k]:
+                span = upper[k] - lower[k]
+                G[a, k] = lower[k] + np.mod(G[a, k] - lower[k], span)
+    return G
+
+
+@njit(cache=True)
+def hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
+                 levels, n_fine, candidates):
+    """`seeking.hierarchical_seek`: up to ``candidates`` start couples (C, dim1 + dim2), best
+    first, from the coarse grids U1, U2."""
+    n_coarse1 = round(U1.shape[0] ** (1.0 / U1.shape[1]))
+    n_coarse2 = round(U2.shape[0] ** (1.0 / U2.shape[1]))
+    h1 = (hi1 - lo1) / (n_coarse1 - 1)
+    h2 = (hi2 - lo2) / (n_coarse2 - 1)
+    d2 = _d2(_positions(k1, p1, R1, o1, U1), _positions(k2, p2, R2, o2, U2))
+    dim1, dim2 = U1.shape[1], U2.shape[1]
+    C1, C2 = np.empty((candidates, dim1)), np.empty((candidates, dim2))
+    C = 0
+    for _ in range(candidates):
+        best, bi, bj = np.inf, -1, -1
+        for i in range(d2.shape[0]):
+            for j in range(d2.shape[1]):
+                if d2[i, j] < best:
+                    best, bi, bj = d2[i, j], i, j
+        if bi < 0:
+            break
+        C1[C], C2[C] = U1[bi], U2[bj]
+        C += 1
+        near1 = np.array([np.all(np.abs(U1[i] - U1[bi]) <= 2 * h1) for i in range(U1.shape[0])])
+        near2 = np.array([np.all(np.abs(U2[j] - U2[bj]) <= 2 * h2) for j in range(U2.shape[0])])
+        for i in range(d2.shape[0]):
+            if near1[i]:
+                for j in range(d2.shape[1]):
+                    if near2[j]:
+                        d2[i, j] = np.inf
+    g1, g2 = h1, h2
+    for _ in range(levels):
+        for c in range(C):
+            G1 = _local_grid(C1[c].copy(), 2 * g1, lo1, hi1, per1, n_fine)
+            G2 = _local_grid(C2[c].copy(), 2 * g2, lo2, hi2, per2, n_fine)
+            D = _d2(_positions(k1, p1, R1, o1, G1), _positions(k2, p2, R2, o2, G2))
+            a = np.argmin(D)
+            C1[c], C2[c] = G1[a // D.shape[1]], G2[a % D.shape[1]]
+        g1, g2 = 4 * g1 / (n_fine - 1), 4 * g2 / (n_fine - 1)
+    out = np.empty((C, dim1 + dim2))
+    out[:, :dim1], out[:, dim1:] = C1[:C], C2[:C]
+    return out
+
+
+@njit(cache=True)
+def _descent_step(H, g):
+    """`seeking._descent_step`: -|H|^-1 g, eigenvalues made positive and floored."""
+    n = g.shape[0]
+    if n == 1:
+        return np.array([-g[0] / max(abs(H[0, 0]), 1e-10 * max(1.0, abs(H[0, 0])))])
+    L = np.zeros((n, n))
+    det = 1.0
+    ok = True
+    for i in range(n):
+        for j in range(i + 1):
+            s = H[i, j]
+            for k in range(j):
+                s -= L[i, k] * L[j, k]
+            if i == j:
+                if not s > 0.0:
+                    ok = False
+                    break
+                L[i, i] = math.sqrt(s)
+                det *= s
+            else:
+                L[i, j] = s / L[j, j]
+        if not ok:
+            break
+    if ok:
+        tr = 0.0
+        for i in range(n):
+            tr += H[i, i]
+        if det / tr ** (n - 1) >= 1e-10 * max(1.0, tr):
+            y = np.zeros(n)
+            for i in range(n):
+                s = g[i]
+                for k in range(i):
+                    s -= L[i, k] * y[k]
+                y[i] = s / L[i, i]
+            x = np.zeros(n)
+            for i in range(n - 1, -1, -1):
+                s = y[i]
+                for k in range(i + 1, n):
+                    s -= L[k, i] * x[k]
+                x[i] = s / L[i, i]
+            return -x
+    w, V = np.linalg.eigh(H)
+    w = np.abs(w)
+    w = np.maximum(w, 1e-10 * max(1.0, w.max()))
+    return -(V @ ((V.T @ g) / w))
+
+
+@njit(cache=True)
+def _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, n1):
+    x1 = _point(k1, p1, R1, o1, u[0], 0.0)
+    x2 = _point(k2, p2, R2, o2, u[n1], u[n1 + 1] if u.shape[0] == n1 + 2 else 0.0)
+    return (x1[0] - x2[0], x1[1] - x2[1], x1[2] - x2[2]), x1, x2
+
+
+@njit(cache=True)
+def newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale, tol, max_iter,
+           distance_rtol, rtol_beyond):
+    """`seeking.newton_closest` from u (patch 1 a curve): (u, iterations, status), status 0
+    converged, 1 not converged (the reference raises `SeekingError`). ``distance_rtol`` < 0
+    means none."""
+    n1 = 1
+    n = u.shape[0]
+    u = u.copy()
+    gfree = np.zeros(n)
+    norm_J = norm_d = 0.0
+    it = 0
+    converged = False
+    for it in range(1, max_iter + 1):
+        j1 = jet(k1, p1, u[0], 0.0)
+        j2 = jet(k2, p2, u[1], u[2] if n == 3 else 0.0)
+        _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, n1)
+        d = np.array([x1[0] - x2[0], x1[1] - x2[1], x1[2] - x2[2]])
+        cols = np.empty((n, 3))
+        cols[0] = R1 @ np.array(j1[1])
+        cols[1] = -(R2 @ np.array(j2[1]))
+        if n == 3:
+            cols[2] = -(R2 @ np.array(j2[2]))
+        g = cols @ d
+        H = cols @ cols.T
+        d1, d2 = R1.T @ d, R2.T @ d
+        H[0, 0] += d1 @ np.array(j1[3])
+        K2 = (np.array(j2[3]), np.array(j2[4]), np.array(j2[5]))
+        if n == 2:
+            H[1, 1] -= d2 @ K2[0]
+        else:
+            H[1, 1] -= d2 @ K2[0]
+            H[1, 2] -= d2 @ K2[1]
+            H[2, 1] -= d2 @ K2[1]
+            H[2, 2] -= d2 @ K2[2]
+        norm_J = math.sqrt(np.sum(cols * cols))
+        norm_d = math.sqrt(d @ d)
+        d_roundoff = EPS8 * (max(abs(x1[0]), max(abs(x1[1]), abs(x1[2])))
+                             + max(abs(x2[0]), max(abs(x2[1]), abs(x2[2]))))
+        step = np.zeros(n)
+        free = np.zeros(n, dtype=np.bool_)
+        on_bounds = True
+        for i in range(n):
+            gi = g[i]
+            band = min(1e-3 * scale[i], abs(gi) / max(abs(H[i, i]), 1e-300))
+            if not periodic[i] and u[i] <= lower[i] + band and gi > 0:
+                step[i] = lower[i] - u[i]
+            elif not periodic[i] and u[i] >= upper[i] - band and gi < 0:
+                step[i] = upper[i] - u[i]
+            else:
+                free[i] = True
+                continue
+            on_bounds = on_bounds and step[i] == 0.0
+        gfree = np.where(free, g, 0.0)
+        norm_gfree = math.sqrt(gfree @ gfree)
+        if on_bounds and norm_gfree <= norm_J * max(1e-13 * norm_d, d_roundoff):
+            converged = True
+            break
+        if on_bounds and norm_gfree <= 1e-15 * norm_J ** 2:
+            converged = True
+            break
+        fi = np.flatnonzero(free)
+        if fi.shape[0] > 0:
+            sf = _descent_step(np.ascontiguousarray(H[fi][:, fi]), g[fi])
+            step[fi] = sf
+            reach = np.max(np.abs(step) / scale)
+            if reach > 0.25:
+                step = step * (0.25 / reach)
+        f0 = 0.5 * norm_d * norm_d
+        slope = g @ step
+        if -slope <= 1e-15 * f0:
+            converged = True
+            break
+        far = distance_rtol >= 0.0 and on_bounds and 2.0 * f0 > rtol_beyond ** 2
+        if far and -slope <= distance_rtol * 2.0 * f0:
+            converged = True
+            break
+        t = 1.0
+        un = u.copy()
+        fn = 0.0
+        accepted = False
+        while True:
+            for i in range(n):
+                a = u[i] + t * step[i]
+                un[i] = a if periodic[i] else min(max(a, lower[i]), upper[i])
+            dn = _gap(k1, p1, R1, o1, k2, p2, R2, o2, un, n1)[0]
+            fn = 0.5 * (dn[0] * dn[0] + dn[1] * dn[1] + dn[2] * dn[2])
+            if fn <= f0 + 1e-4 * (g @ (un - u)):
+                accepted = True
+                break
+            t *= 0.25
+            if t < 1e-12:
+                break
+        if not accepted:
+            converged = True
+            break
+        moved = np.max(np.abs(un - u) / scale)
+        u = un
+        if moved < tol:
+            converged = True
+            break
+        if far and f0 - fn <= distance_rtol * 2.0 * f0:
+            converged = True
+            break
+    status = 0
+    if not converged and math.sqrt(gfree @ gfree) > 1e-10 * norm_J * norm_d:
+        status = 1
+    for i in range(n):
+        if periodic[i]:
+            span = upper[i] - lower[i]
+            u[i] = lower[i] + np.mod(u[i] - lower[i], span)
+    return u, it, status
+
+
+@njit(cache=True)
+def _points(k1, p1, R1, o1, k2, p2, R2, o2, u):
+    _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, 1)
+    return np.array(x1), np.array(x2)
+
+
+def _spec(patch):
+    """(kind, parameters) of a patch, kept on it."""
+    hit = patch.__dict__.get("_kernel_spec")
+    if hit is None:
+        hit = patch.__dict__["_kernel_spec"] = patch_spec(patch)
+    return hit
+
+
+def supported(P1, P2) -> bool:
+    """True when the compiled seek applies: patch 1 a curve, both patches with a kernel
+    description."""
+    return P1.patch.dim == 1 and _spec(P1.patch) is not None and _spec(P2.patch) is not None
+
+
+def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, levels=2,
+                n_fine=21, candidates=3) -> Couple:
+    """`drake_dock.core.seeking.seek_couple` compiled, for posed patches P1 (a curve) and P2
+    with kernel descriptions (`supported`)."""
+    pa, pb = P1.patch, P2.patch
+    (k1, q1), (k2, q2) = _spec(pa), _spec(pb)
+    # Writable C-ordered copies: one compiled signature whatever the caller's arrays.
+    R1, o1 = np.array(P1.R, dtype=float, order="C"), np.array(P1.p, dtype=float)
+    R2, o2 = np.array(P2.R, dtype=float, order="C"), np.array(P2.p, dtype=float)
+    per1, per2 = np.array(pa.periodic), np.array(pb.periodic)
+    starts = hierarchical(k1, q1, R1, o1, np.array(pa.lower, dtype=float),
+                          np.array(pa.upper, dtype=float), per1,
+                          np.array(pa.grid_points(n_coarse)[0]), k2, q2, R2, o2,
+                          np.array(pb.lower, dtype=float), np.array(pb.upper, dtype=float), per2,
+                          np.array(pb.grid_points(n_coarse)[0]), levels, n_fine, candidates)
+    lower = np.concatenate([pa.lower, pb.lower])
+    upper = np.concatenate([pa.upper, pb.upper])
+    periodic = np.concatenate([per1, per2])
+    span = np.concatenate([pa.span, pb.span])
+    scale = np.maximum(span, 1e-300)
+    tol = 1e-9 * span
+    best, started = None, []
+    for u0 in starts:
+        # Two candidates refined onto the same grid couple: one Newton finish serves both.
+        if any(np.all(np.abs(u0 - s) <= tol) for s in started):
+            continue
+        started.append(u0)
+        u, it, status = newton(k1, q1, R1, o1, k2, q2, R2, o2, u0, lower, upper, periodic,
+                               scale, 1e-14, 50, -1.0 if distance_rtol is None
+                               else float(distance_rtol), float(rtol_beyond))
+        if status:
+            raise SeekingError("closest-couple Newton did not converge in 50 iterations")
+        x1, x2 = _points(k1, q1, R1, o1, k2, q2, R2, o2, u)
+        dist = float(np.linalg.norm(x1 - x2))
+        if best is None or dist < best.distance:
+            u1, u2 = u[:1], u[1:]
+            best = Couple(u1, u2, x1, x2, dist, it,
+                          is_interior(pa, u1) and is_interior(pb, u2))
+    return best
+
+
+def warm():
+    """Compiles or loads the seek's kernels: a curve against a curve and against a surface."""
+    from drake_dock.core.patches import Circle, PlaneRect, Segment, posed
+    eye, z = np.eye(3), np.zeros(3)
+    seg = posed(Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1)), eye, z)
+    seek_couple(seg, posed(Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0)), eye, z))
+    seek_couple(posed(Circle(0.3, 0.1), eye, z),
+                posed(PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)), eye, z))
