@@ -100,17 +100,23 @@ def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
     phi, sigma = side_phi(i), side_sigma(i)
     A = g.R * math.sin(g.alpha2)
     tan1 = math.tan(g.alpha1)
-    # The sine form holds for 0 < w < pi; beyond its reach, halfway from the domain's ends to
-    # those limits, rho is held (docs/model.md, "Degenerate couples").
+    # The sine form holds for 0 < w < pi (w modulo 2 pi); beyond its reach, halfway from the
+    # domain's ends to those limits, rho is held (docs/model.md, "Degenerate couples").
     w_lo, w_hi = 0.5 * g.alpha2, 0.5 * (g.alpha2 + g.theta_end + math.pi)
+    w_0 = 0.5 * (w_lo + w_hi) - math.pi      # w is taken in [w_0, w_0 + 2 pi)
 
     def radial(th):
         w = g.alpha2 + sigma * (th - phi)
         if isinstance(w, float):
             if not w_lo <= w <= w_hi:
-                return A / math.sin(min(max(w, w_lo), w_hi)), 0.0, 0.0
+                w = w_0 + (w - w_0) % (2.0 * math.pi)       # theta is an angle
+                if not w_lo <= w <= w_hi:
+                    return A / math.sin(min(max(w, w_lo), w_hi)), 0.0, 0.0
             sw, cw = math.sin(w), math.cos(w)
         else:
+            out = (w < w_lo) | (w > w_hi)
+            if out.any():
+                w = np.where(out, w_0 + np.mod(w - w_0, 2.0 * np.pi), w)
             held = (w < w_lo) | (w > w_hi)
             w = np.clip(w, w_lo, w_hi)
             sw, cw = np.sin(w), np.cos(w)

@@ -315,6 +315,22 @@ def test_small_scene_degenerate_poses():
         exercise(kind, a, X1, b, TARGET, rng)
 
 
+def test_finish_at_round_off_far_from_the_origin():
+    """A hoop resting on a large plane 50 m from the plane's origin: |F| stalls at its
+    round-off above the 1e-15 test, the steps vanish, and the couple is usable at the hoop's
+    lowest point (theta = 3 pi / 2 in its vertical plane)."""
+    hoop = Circle(0.05)
+    plane = PlaneRect([-50.0, -50.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], size=(100., 100.))
+    rng = np.random.default_rng(9)
+    for a in rng.uniform(0, 2 * np.pi, 4):
+        X1 = (rot_z(a) @ rot_x(np.pi / 2), np.array([0.25 * np.cos(a), 0.25 * np.sin(a),
+                                                      0.05 + 1e-10]))
+        f = exercise("CS", hoop, X1, plane, TARGET, rng)
+        assert f.usable
+        assert f.u[0] == pytest.approx(1.5 * np.pi, abs=1e-7)
+        np.testing.assert_allclose(f.u[1:] - 50.0, X1[1][:2], atol=1e-9)
+
+
 def test_patch_continuation_beyond_the_domain():
     """Beyond their reach the guide surface holds theta_1 and the guide side holds rho: values
     continuous across the reach, finite everywhere, and the derivatives there those of the held
