@@ -346,8 +346,9 @@ def contact_couple(kind, patch1, X1, patch2, X2, c: Couple, *, conditioning_min,
     Rules: the couple must be interior (`is_interior`) and isolated (J's conditioning above
     10 ``conditioning_min``); every Newton iterate must stay interior with J regular
     (conditioning above ``conditioning_min``), and the iteration must converge within
-    ``max_iter`` steps (F at its round-off floor, or steps below 1e-9 of the smallest span). Otherwise the couple is not usable and the seek's couple is returned
-    with the reason; no patch is evaluated outside its domain and no singular J is solved."""
+    ``max_iter`` steps (F at its round-off floor, or steps below 1e-9 of the smallest span).
+    Otherwise the couple is not usable and the seek's couple is returned with the reason; no
+    patch is evaluated outside its domain and no singular J is solved."""
     u0 = c.u
     n1 = patch1.dim
     if not c.interior:
