@@ -50,12 +50,20 @@ def patches_cross(gap: float, distance: float, sigma: float, gap_tol: float) -> 
     return abs(gap) > distance + gap_tol or sigma * gap < -gap_tol
 
 
+def intersecting(distance: float, finish_failed: bool, gap_tol: float) -> bool:
+    """Rule: an interior, isolated couple at a distance within ``gap_tol`` whose contact-form
+    finish failed (no contact-form couple inside the domain near it): a curve passes through
+    the other patch, the patches cross each other."""
+    return finish_failed and distance <= gap_tol
+
+
 def after_seek(distance: float, usable: bool, crossing: bool, was_contact: bool,
                track_distance: float, reseek_floor: float) -> tuple[Mode, float | None]:
     """The mode after a seek and, for a FAR pair, its clearance (the relative travel after which
     it is sought again; None for a tracked pair).
 
-    Rule: a couple that is interior and isolated (``usable``), not crossing and nearer than
+    Rule: a couple that is interior, isolated and finished on the contact form (``usable``,
+    `drake_dock.core.seeking.contact_couple`), not crossing and nearer than
     ``track_distance`` is TRACKED, unless the pair has just left a contact (a contact that runs
     off a patch end ends there). A FAR pair keeps half ``track_distance`` in hand (a crossing
     pair: half ``track_distance``), and never less than half its distance or ``reseek_floor``."""

@@ -3,7 +3,9 @@
 The paper's hierarchical grid: a coarse grid over both patches' parameters, then grids an order
 finer around the best cell, finished here by a bounded Newton iteration on the closest-point
 conditions (gradient of 0.5 |r1 - r2|^2 equal to zero, or its projection on active bounds).
-Everything is vectorised over the grid; only the pair asked for is searched.
+Everything is vectorised over the grid; only the pair asked for is searched. `contact_couple`
+finishes the couple on the contact form (Eq. 37-38) inside the domains, or says why it is not a
+potential contact (docs/model.md, "Degenerate couples").
 """
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ import math
 import numpy as np
 
 from drake_dock.core import vec3 as v3
-
+from drake_dock.core.couple import closest_point_conditions
 from drake_dock.errors import SeekingError
 
 
@@ -311,6 +313,8 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, **grid_options) 
         if best is None or dist < best.distance:
             best = Couple(u1, u2, p1, p2, dist, it,
                           is_interior(P1.patch, u1) and is_interior(P2.patch, u2))
+    if best is None or not math.isfinite(best.distance):
+        raise SeekingError("no finite distance between the patches (a non-finite pose)")
     return best
 
 
@@ -319,3 +323,61 @@ def is_interior(patch, u, rtol=1e-9) -> bool:
     domain end is not a potential contact of its pair: there the closest-point conditions (22)
     do not hold, and an edge or a tip touching is a contact of another pair (or none)."""
     return bool(np.all(patch.margin(u) > rtol * patch.span))
+
+
+@dataclasses.dataclass
+class ContactCouple:
+    """The couple a seek hands to tracking: ``u`` solves the contact form (Eq. 37-38) when
+    ``usable``; otherwise it is the seek's couple and ``reason`` says why it is not a potential
+    contact (docs/model.md, "Degenerate couples"). ``finish_failed``: the couple was interior
+    and isolated but its contact-form finish failed."""
+
+    u: np.ndarray
+    usable: bool
+    reason: str = ""
+    finish_failed: bool = False
+
+
+def contact_couple(kind, patch1, X1, patch2, X2, c: Couple, *, conditioning_min,
+                   max_iter=20) -> ContactCouple:
+    """The seek's couple ``c`` of patches on body poses X_i = (R_i, p_i), finished by Newton on
+    the contact form F(u) = 0 (Eq. 37-38; the distance's gradient is flat at a tangent touch).
+
+    Rules: the couple must be interior (`is_interior`) and isolated (J's conditioning above
+    10 ``conditioning_min``); every Newton iterate must stay interior with J regular
+    (conditioning above ``conditioning_min``), and the iteration must converge within
+    ``max_iter`` steps (F at its round-off floor, or steps below 1e-9 of the smallest span).
+    Otherwise the couple is not usable and the seek's couple is returned with the reason; no
+    patch is evaluated outside its domain and no singular J is solved."""
+    u0 = c.u
+    n1 = patch1.dim
+    if not c.interior:
+        return ContactCouple(u0, False, "the closest couple lies on a domain end")
+    _, _, cond = closest_point_conditions(kind, patch1, X1, patch2, X2, u0, conditioning=True)
+    if not cond > 10 * conditioning_min:
+        return ContactCouple(u0, False, f"the couple is not isolated (J conditioning "
+                                        f"{cond:.2e}, Eq. 40)")
+    uc = u0
+    step = np.inf
+    for _ in range(max_iter):
+        F, Fu, cond = closest_point_conditions(kind, patch1, X1, patch2, X2, uc,
+                                               conditioning=True)
+        if not cond > conditioning_min:
+            return ContactCouple(u0, False, f"J turns singular along the contact-form finish "
+                                            f"(conditioning {cond:.2e})", True)
+        un = uc - np.linalg.solve(Fu, F)
+        if not (np.all(np.isfinite(un)) and is_interior(patch1, un[:n1])
+                and is_interior(patch2, un[n1:])):
+            return ContactCouple(u0, False, "the contact-form finish leaves the domain: no "
+                                            "contact-form couple inside it near the seek's", True)
+        step = np.abs(un - uc).max()
+        uc = un
+        if np.abs(F).max() <= 1e-15 * (1.0 + np.abs(Fu).max()):
+            return ContactCouple(uc, True)
+    # F stalled at its round-off (far from the origin |F| cannot reach the test above) while
+    # the steps became negligible: converged.
+    span = np.concatenate([patch1.span, patch2.span]).min()
+    if step <= 1e-9 * span:
+        return ContactCouple(uc, True)
+    return ContactCouple(u0, False, f"the contact-form finish did not converge in {max_iter} "
+                                    f"Newton steps", True)

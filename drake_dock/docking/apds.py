@@ -100,12 +100,31 @@ def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
     phi, sigma = side_phi(i), side_sigma(i)
     A = g.R * math.sin(g.alpha2)
     tan1 = math.tan(g.alpha1)
+    # The sine form holds for 0 < w < pi (w modulo 2 pi); beyond its reach, halfway from the
+    # domain's ends to those limits, rho is held (docs/model.md, "Degenerate couples").
+    w_lo, w_hi = 0.5 * g.alpha2, 0.5 * (g.alpha2 + g.theta_end + math.pi)
+    w_0 = 0.5 * (w_lo + w_hi) - math.pi      # w is taken in [w_0, w_0 + 2 pi)
 
     def radial(th):
         w = g.alpha2 + sigma * (th - phi)
-        sw, cw = (math.sin(w), math.cos(w)) if isinstance(w, float) else (np.sin(w), np.cos(w))
+        if isinstance(w, float):
+            if not w_lo <= w <= w_hi:
+                w = w_0 + (w - w_0) % (2.0 * math.pi)       # theta is an angle
+                if not w_lo <= w <= w_hi:
+                    return A / math.sin(min(max(w, w_lo), w_hi)), 0.0, 0.0
+            sw, cw = math.sin(w), math.cos(w)
+        else:
+            out = (w < w_lo) | (w > w_hi)
+            if out.any():
+                w = np.where(out, w_0 + np.mod(w - w_0, 2.0 * np.pi), w)
+            held = (w < w_lo) | (w > w_hi)
+            w = np.clip(w, w_lo, w_hi)
+            sw, cw = np.sin(w), np.cos(w)
         rho = A / sw
-        return rho, -sigma * A * cw / sw**2, A * (1.0 + cw**2) / sw**3
+        r1, r2 = -sigma * A * cw / sw**2, A * (1.0 + cw**2) / sw**3
+        if not isinstance(w, float) and held.any():
+            r1, r2 = np.where(held, 0.0, r1), np.where(held, 0.0, r2)
+        return rho, r1, r2
 
     def axial_of(rho, r1, r2):
         return (g.R - rho) * tan1, -r1 * tan1, -r2 * tan1
@@ -133,27 +152,40 @@ class _PetalMap:
         self.A = g.R * math.sin(g.alpha2)
         # The map's parameters for the compiled kernels (kind PETAL).
         self.kernel_params = (self.phi0, self.cot1, self.A, g.alpha2, g.R)
+        # Eq. (13) holds while x = A / rho < 1, zeta < (R - A) tan(alpha1). Its reach is the
+        # domain grown at both ends by half the distance from zeta = H to that limit; beyond
+        # it theta_1 is held (docs/model.md, "Degenerate couples"): the surface continues as
+        # the cone between two fixed meridians.
+        grow = 0.5 * ((g.R - self.A) / self.cot1 - g.H)
+        self.z_reach = (-grow, g.H + grow)
 
     def _t1(self, z):
-        rho = self.g.R - z * self.cot1
+        lo, hi = self.z_reach
+        held = (z < lo) | (z > hi)
+        rho = self.g.R - np.clip(z, lo, hi) * self.cot1
         x = self.A / rho
         x1 = x * self.cot1 / rho                 # dx/dz
         x2 = 2.0 * x * self.cot1**2 / rho**2     # d2x/dz2
         q = np.sqrt(1.0 - x**2)
         t1 = np.arcsin(x) - self.g.alpha2
-        return t1, x1 / q, x2 / q + x * x1**2 / q**3
+        d1, d2 = x1 / q, x2 / q + x * x1**2 / q**3
+        if np.any(held):
+            d1, d2 = np.where(held, 0.0, d1), np.where(held, 0.0, d2)
+        return t1, d1, d2
 
     def jet(self, s):
         """(value, jac, hess) at one point, as nested tuples of floats."""
         a, z = float(s[0]), float(s[1])
         cot = self.cot1
-        rho = self.g.R - z * cot
+        lo, hi = self.z_reach
+        inside = lo <= z <= hi
+        rho = self.g.R - (z if inside else min(max(z, lo), hi)) * cot
         x = self.A / rho
         x1 = x * cot / rho
         x2 = 2.0 * x * cot**2 / rho**2
         q = math.sqrt(1.0 - x * x)
         t1 = math.asin(x) - self.g.alpha2
-        d1, d2 = x1 / q, x2 / q + x * x1**2 / q**3
+        d1, d2 = (x1 / q, x2 / q + x * x1**2 / q**3) if inside else (0.0, 0.0)
         w = math.pi / 3 - 2 * t1
         return ((self.phi0 + t1 + a * w, z), ((w, d1 * (1 - 2 * a)), (0.0, 1.0)),
                 (((0.0, -2 * d1), (-2 * d1, d2 * (1 - 2 * a))), ((0.0, 0.0), (0.0, 0.0))))

@@ -9,12 +9,12 @@ import numpy as np
 
 from drake_dock.core import hybrid
 from drake_dock.core.constraints import select_modes
-from drake_dock.core.couple import closest_point_conditions, evaluate_couple
+from drake_dock.core.couple import evaluate_couple
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.core.patches import posed
-from drake_dock.core.seeking import seek_couple
+from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import (InputError, NumericalError, SeekingError, SingularCoupleError,
                                ZenoError)
 
@@ -101,32 +101,27 @@ class Transitions:
             raise SeekingError(str(e), time=time, couples=[p.name]) from None
         st.ref_X21 = ev.far.reference(i, poses)
         st.distance = c.distance
-        _, _, cond = closest_point_conditions(p.kind, p.patch1, poses[a], p.patch2, poses[b],
-                                              c.u, conditioning=True)
-        usable = c.interior and cond > 10 * opt.conditioning_min     # interior and isolated
-        uc = c.u
-        crossing = False
+        # Interior, isolated and finished on the contact form inside the domain, else not a
+        # potential contact (docs/model.md, "Degenerate couples").
+        f = contact_couple(p.kind, p.patch1, poses[a], p.patch2, poses[b], c,
+                           conditioning_min=opt.conditioning_min)
+        usable, uc = f.usable, f.u
+        crossing = hybrid.intersecting(c.distance, f.finish_failed, opt.impact_gap_tol)
         if usable:
-            # Finish on the contact form (the distance's gradient is flat at a tangent touch).
-            for _ in range(20):
-                F, Fu = closest_point_conditions(p.kind, p.patch1, poses[a], p.patch2,
-                                                 poses[b], uc)
-                uc = uc - np.linalg.solve(Fu, F)
-                if np.abs(F).max() <= 1e-15 * (1.0 + np.abs(Fu).max()):
-                    break
             gap = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
                                   poses[b], (np.zeros(3),) * 2, uc, 1.0, project=False).gap
             sigma = hybrid.couple_sigma(p.sigma, gap)
             crossing = hybrid.patches_cross(gap, c.distance, sigma, opt.impact_gap_tol)
-            if initial and p.sigma is not None and (sigma * gap < -opt.impact_gap_tol or (
-                    crossing and c.distance <= opt.impact_gap_tol)):
-                # The scene declares the sides: a couple on the wrong side, or patches that
-                # intersect, is a body started inside another.
-                value = (f"signed gap {sigma * gap:.6g} m" if sigma * gap < 0.0
-                         else f"patches intersecting (distance {c.distance:.3g} m)")
-                raise InputError(f"initial state of pair {p.name}", value,
-                                 f"signed gap >= -impact_gap_tol = {-opt.impact_gap_tol:g} m",
-                                 "the bodies start interpenetrating")
+        if initial and p.sigma is not None and (
+                (usable and sigma * gap < -opt.impact_gap_tol)
+                or (crossing and c.distance <= opt.impact_gap_tol)):
+            # The scene declares the sides: a couple on the wrong side, or patches that
+            # intersect, is a body started inside another.
+            value = (f"signed gap {sigma * gap:.6g} m" if usable and sigma * gap < 0.0
+                     else f"patches intersecting (distance {c.distance:.3g} m)")
+            raise InputError(f"initial state of pair {p.name}", value,
+                             f"signed gap >= -impact_gap_tol = {-opt.impact_gap_tol:g} m",
+                             "the bodies start interpenetrating")
         u[ev.couple_slice(i)] = uc
         mode, clearance = hybrid.after_seek(c.distance, usable, crossing, was_contact,
                                             opt.track_distance, opt.reseek_floor)

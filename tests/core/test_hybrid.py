@@ -34,6 +34,11 @@ def test_sigma_and_crossing_by_hand():
     # Round-off on either side of the tolerance.
     assert not hybrid.patches_cross(-0.5 * tol, 0.0, 1.0, tol)
     assert hybrid.patches_cross(-2 * tol, 0.0, 1.0, tol)
+    # A failed contact-form finish at zero distance: a curve through a surface; at 1 mm, or a
+    # finish that was not tried (a domain end), no crossing.
+    assert hybrid.intersecting(1e-16, True, tol)
+    assert not hybrid.intersecting(1e-3, True, tol)
+    assert not hybrid.intersecting(0.0, False, tol)
 
 
 @pytest.mark.parametrize("distance, usable, crossing, was_contact, expected", [

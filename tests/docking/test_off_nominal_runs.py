@@ -1,0 +1,33 @@
+"""Off-nominal runs that used to crash in seeking (docs/model.md, "Degenerate couples"): the
+ring-surface seek's contact-form finish went far outside the petal's domain (a math domain
+error at t = 0.206 s) or solved a singular J (LinAlgError at t = 0.167 s). With the ring's
+circle through the petal, the pair is now classed crossing and the run goes on."""
+from pathlib import Path
+
+import pytest
+
+from drake_dock.docking.scenario import load_scenario
+from drake_dock.docking.simulate import simulate
+
+MODELS = Path(__file__).resolve().parents[2] / "models"
+
+
+def _misaligned():
+    """The paper example inside the IDSS box: roll 4 deg, closing at 0.1 m/s, off-axis and
+    tilted, with lateral and angular rates."""
+    s = load_scenario(MODELS / "paper_example.yaml")
+    ic = s.initial
+    ic.target_yaw_deg, ic.chaser_speed = 4.0, 0.1
+    ic.lateral_offset, ic.tilt_deg = [-0.0563, 0.0827], [4.0, 4.0]
+    ic.lateral_velocity, ic.angular_velocity_deg_s = [0.04, 0.0], [0.2, -0.2, 0.2]
+    return s
+
+
+@pytest.mark.parametrize("make, crashed_at", [
+    (_misaligned, 0.206),
+    (lambda: load_scenario(MODELS / "idss_box_corner.yaml"), 0.167)],
+    ids=["misaligned", "idss_box_corner"])
+def test_runs_past_the_former_seek_crash(make, crashed_at):
+    duration = crashed_at + 0.02
+    result = simulate(make(), duration=duration)
+    assert result.outcome == "timeout" and result.end_time == pytest.approx(duration)
