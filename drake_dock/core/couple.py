@@ -39,21 +39,11 @@ import math
 
 import numpy as np
 
-# One couple is evaluated in plain floats (3-tuples).
+# One couple is evaluated in plain floats (3-tuples); its frame and the frame's rates by the
+# compiled code the couple kernels share (`drake_dock.core.kernels.frames`).
+from drake_dock.core.kernels.frames import frame_rates_cc, frame_rates_cs
 from drake_dock.core.vec3 import add as _add, axpy as _axpy, cross as _cr, dot as _dot, \
-    mul as _mul, rot as _rot, sub as _sub
-
-
-def _unit(a):
-    na = math.sqrt(_dot(a, a))
-    if na == 0.0:     # degenerate (parallel curves): reported by `conditioning`, no NaN
-        return a, 1.0
-    return _mul(a, 1.0 / na), na
-
-
-def _perp_rate(unit, rate, norm):
-    """d/dt (a/|a|) = (I - u u^T) a' / |a|."""
-    return _mul(_axpy(-_dot(unit, rate), unit, rate), 1.0 / norm)
+    rot as _rot, sub as _sub
 
 
 def _solve(A, b):
@@ -233,23 +223,15 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
     t1dot = _axpy(u1d[0], k1, w1t1)
     if kind == "CC":
         t2dot = _axpy(u2d[0], k2, w2t2)
-        n_hat, c_norm = _unit(_cr(t1, t2))
-        n = _mul(n_hat, sigma)
-        ndot = _mul(_perp_rate(n_hat, _add(_cr(t1dot, t2), _cr(t1, t2dot)), c_norm), sigma)
-        ta, t2_norm = _unit(t2)
-        tadot = _perp_rate(ta, t2dot, t2_norm)
-        conv = _sub(_cr(w1, _mul(t1, u1d[0])), _cr(w2, _mul(t2, u2d[0])))
+        n, ndot, ta, tadot, conv = frame_rates_cc(
+            *map(tuple, (t1, t2, t1dot, t2dot, w1, w2)), u1d[0], u2d[0], float(sigma))
     else:
         (suu, suv), (_, svv) = K2
         sudot = _axpy(u2d[1], suv, _axpy(u2d[0], suu, w2su))
         svdot = _axpy(u2d[1], svv, _axpy(u2d[0], suv, w2sv))
-        N_hat, N_norm = _unit(N)
-        n = _mul(N_hat, sigma)
-        ndot = _mul(_perp_rate(N_hat, _add(_cr(sudot, sv), _cr(su, svdot)), N_norm), sigma)
-        ta, su_norm = _unit(su)
-        tadot = _perp_rate(ta, sudot, su_norm)
-        conv = _sub(_cr(w1, _mul(t1, u1d[0])),
-                    _cr(w2, _axpy(u2d[1], sv, _mul(su, u2d[0]))))
+        n, ndot, ta, tadot, conv = frame_rates_cs(
+            *map(tuple, (t1, su, sv, sudot, svdot, N, w1, w2)), u1d[0], u2d[0], u2d[1],
+            float(sigma))
     tb = _cr(n, ta)
     tbdot = _add(_cr(ndot, ta), _cr(n, tadot))
     # Three arrays, the fields views of their rows (one numpy call each, not eleven).

@@ -16,9 +16,10 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
+from drake_dock.core.kernels.frames import (add as _add, axpy as _axpy, cross as _cr, dot as _dot,
+                                             frame_rates_cc, frame_rates_cs, sub as _sub)
 from drake_dock.core.kernels.jets import jet
 
 # Row layout: u (3), drift (3), udot (3), residual, conditioning, p1 (3), p2 (3), n (3),
@@ -31,54 +32,10 @@ _Z = (0.0, 0.0, 0.0)
 
 
 @njit(cache=True)
-def _dot(a, b):
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-@njit(cache=True)
-def _cr(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-@njit(cache=True)
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-@njit(cache=True)
-def _sub(a, b):
-    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
-
-
-@njit(cache=True)
-def _mul(a, s):
-    return (a[0] * s, a[1] * s, a[2] * s)
-
-
-@njit(cache=True)
-def _axpy(s, a, b):
-    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
-
-
-@njit(cache=True)
 def _rot(R, a):
     return (R[0, 0] * a[0] + R[0, 1] * a[1] + R[0, 2] * a[2],
             R[1, 0] * a[0] + R[1, 1] * a[1] + R[1, 2] * a[2],
             R[2, 0] * a[0] + R[2, 1] * a[1] + R[2, 2] * a[2])
-
-
-@njit(cache=True)
-def _unit(a):
-    na = math.sqrt(_dot(a, a))
-    if na == 0.0:
-        return a, 1.0
-    return _mul(a, 1.0 / na), na
-
-
-@njit(cache=True)
-def _perp_rate(unit, rate, norm):
-    """d/dt (a/|a|) = (I - u u^T) a' / |a|."""
-    return _mul(_axpy(-_dot(unit, rate), unit, rate), 1.0 / norm)
 
 
 @njit(cache=True)
@@ -216,22 +173,14 @@ def evaluate_one(cc, kind1, prm1, kind2, prm2, R1, o1, w1, v1, R2, o2, w2, v2, u
     t1dot = _axpy(udot[0], K1, w1t1)
     if cc:
         t2dot = _axpy(udot[1], K2, w2t2)
-        n_hat, c_norm = _unit(_cr(T1, T2))
-        nv = _mul(n_hat, sigma)
-        ndot = _mul(_perp_rate(n_hat, _add(_cr(t1dot, T2), _cr(T1, t2dot)), c_norm), sigma)
-        ta, t2_norm = _unit(T2)
-        tadot = _perp_rate(ta, t2dot, t2_norm)
-        conv = _sub(_cr(w1, _mul(T1, udot[0])), _cr(w2, _mul(T2, udot[1])))
+        nv, ndot, ta, tadot, conv = frame_rates_cc(T1, T2, t1dot, t2dot, w1, w2, udot[0],
+                                                   udot[1], sigma)
     else:
         suu, suv, svv = K2, K2ab, K2bb
         sudot = _axpy(udot[2], suv, _axpy(udot[1], suu, w2su))
         svdot = _axpy(udot[2], svv, _axpy(udot[1], suv, w2sv))
-        N_hat, N_norm = _unit(Nv)
-        nv = _mul(N_hat, sigma)
-        ndot = _mul(_perp_rate(N_hat, _add(_cr(sudot, sv), _cr(su, svdot)), N_norm), sigma)
-        ta, su_norm = _unit(su)
-        tadot = _perp_rate(ta, sudot, su_norm)
-        conv = _sub(_cr(w1, _mul(T1, udot[0])), _cr(w2, _axpy(udot[2], sv, _mul(su, udot[1]))))
+        nv, ndot, ta, tadot, conv = frame_rates_cs(T1, su, sv, sudot, svdot, Nv, w1, w2,
+                                                   udot[0], udot[1], udot[2], sigma)
     tb = _cr(nv, ta)
     tbdot = _add(_cr(ndot, ta), _cr(nv, tadot))
     _put(out, U, u)

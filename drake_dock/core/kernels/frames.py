@@ -1,0 +1,80 @@
+"""The contact frame and its rates along a couple (Definition 2; the Eq. 52 bias terms), in
+compiled code shared by the compiled couple kernel (`couples.py`) and the Python couple
+evaluation (`drake_dock.core.couple`): one implementation of the frame, whichever path computed
+the couple. 3-vectors are tuples of floats."""
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+
+@njit(cache=True)
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(cache=True)
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@njit(cache=True)
+def add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+@njit(cache=True)
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+@njit(cache=True)
+def mul(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
+
+
+@njit(cache=True)
+def axpy(s, a, b):
+    return (s * a[0] + b[0], s * a[1] + b[1], s * a[2] + b[2])
+
+
+@njit(cache=True)
+def unit(a):
+    na = math.sqrt(dot(a, a))
+    if na == 0.0:
+        return a, 1.0
+    return mul(a, 1.0 / na), na
+
+
+@njit(cache=True)
+def perp_rate(unit, rate, norm):
+    """d/dt (a/|a|) = (I - u u^T) a' / |a|."""
+    return mul(axpy(-dot(unit, rate), unit, rate), 1.0 / norm)
+
+
+@njit(cache=True)
+def frame_rates_cc(t1, t2, t1dot, t2dot, w1, w2, u1dot, u2dot, sigma):
+    """C-C: n = sigma t1 x t2 / |t1 x t2|, ta = t2 / |t2| and their rates from the tangents'
+    rates; conv, the part of the contact points' relative acceleration due to the couple's
+    motion along the bodies, w1 x t1 u1' - w2 x t2 u2'. Returns (n, n', ta, ta', conv)."""
+    n_hat, c_norm = unit(cross(t1, t2))
+    n = mul(n_hat, sigma)
+    ndot = mul(perp_rate(n_hat, add(cross(t1dot, t2), cross(t1, t2dot)), c_norm), sigma)
+    ta, t2_norm = unit(t2)
+    tadot = perp_rate(ta, t2dot, t2_norm)
+    conv = sub(cross(w1, mul(t1, u1dot)), cross(w2, mul(t2, u2dot)))
+    return n, ndot, ta, tadot, conv
+
+
+@njit(cache=True)
+def frame_rates_cs(t1, su, sv, sudot, svdot, N, w1, w2, u1dot, u2dot_a, u2dot_b, sigma):
+    """C-S: n = sigma N / |N| (N = su x sv), ta = su / |su| and their rates; conv as for C-C
+    with the surface point moving along su u2a' + sv u2b'. Returns (n, n', ta, ta', conv)."""
+    N_hat, N_norm = unit(N)
+    n = mul(N_hat, sigma)
+    ndot = mul(perp_rate(N_hat, add(cross(sudot, sv), cross(su, svdot)), N_norm), sigma)
+    ta, su_norm = unit(su)
+    tadot = perp_rate(ta, sudot, su_norm)
+    conv = sub(cross(w1, mul(t1, u1dot)), cross(w2, axpy(u2dot_b, sv, mul(su, u2dot_a))))
+    return n, ndot, ta, tadot, conv
