@@ -6,8 +6,9 @@ Batches go out through a bounded window of futures in flight (twice the workers'
 that a campaign of any size keeps the scheduler small. Crash isolation
 (`CRASH_ISOLATION`): a task whose worker process dies is not retried on another worker
 (``allowed-failures: 0``) and no task waits queued behind it on that worker
-(``worker-saturation: 1.0``). The samples of a batch lost that way are sent again one per task;
-a sample whose worker dies alone is its row's error, with the cause, and the campaign goes on.
+(``worker-saturation: 1.0``). The samples of a batch lost that way are sent again one per task,
+and a single sample lost so is run once more with nothing else in flight: a sample whose
+worker dies then is its row's error, with the cause, and the campaign goes on.
 For a cluster started by hand the scheduler must be given the same settings (docs/campaigns.md).
 """
 from __future__ import annotations
@@ -73,32 +74,42 @@ def worker_death(spec, error) -> dict:
 def run_on_dask(client, runner, base, batches, on_rows, *, window: int | None = None):
     """Submits ``runner(base, batch) -> rows`` for each batch of sample specs, at most
     ``window`` in flight (default: twice the cluster's threads), and calls ``on_rows(rows)`` in
-    the driver as each finishes. A batch lost with its worker is split into single samples; a
-    single sample lost so is recorded as an error row."""
+    the driver as each finishes. A batch lost with its worker is split into single samples. A
+    single sample lost so may have shared its worker with the one that killed it: it is run
+    again alone, with nothing else in flight, and only a sample whose worker dies then is
+    recorded as an error row."""
     from distributed import as_completed
     pending = collections.deque(batches)
+    suspects = collections.deque()
     window = window or 2 * threads(client)
-    inflight = {}
+    inflight, alone = {}, set()
     done = as_completed()
+
+    def send(batch):
+        future = client.submit(runner, base, batch, pure=False)
+        inflight[future.key] = batch
+        done.add(future)
+        return future.key
 
     def submit():
         while pending and len(inflight) < window:
-            batch = pending.popleft()
-            future = client.submit(runner, base, batch, pure=False)
-            inflight[future.key] = batch
-            done.add(future)
+            send(pending.popleft())
+        if suspects and not pending and not inflight:
+            alone.add(send([suspects.popleft()]))
 
     submit()
     for future in done:
         batch = inflight.pop(future.key)
+        rows = []
         try:
             rows = future.result()
         except Exception as e:  # noqa: BLE001 - a worker that died (KilledWorker) and such
             if len(batch) > 1:
                 pending.extendleft([spec] for spec in reversed(batch))
-                rows = []
-            else:
+            elif future.key in alone:
                 rows = [worker_death(batch[0], e)]
+            else:
+                suspects.append(batch[0])
         finally:
             future.release()
         if rows:
