@@ -8,7 +8,7 @@ runs, all measured in this run; and the same example with Drake's plain witness 
 coarser step cap (``--coarse-step``), which is the output spacing, for its cost; and with the
 couples evaluated in Python instead of the compiled kernels (`ContactOptions.compiled`), with
 the difference of the capture times. Also the set-up (the initial state: the first-contact
-placement, its seeks) and the kernels' cold and warm start (a fresh process that compiles them
+placement, its seeks, and their number) and the kernels' cold and warm start (a fresh process that compiles them
 into an empty cache directory, then one that loads them from it).
 
     python bench/paper_example.py [SCENARIO.yaml]
@@ -27,7 +27,7 @@ from pydrake.systems.framework import DiagramBuilder
 from drake_dock.docking.diagram import build_docking_diagram
 from drake_dock.docking.plant import add_docking_plant, set_initial_state
 from drake_dock.core.kernels.compile_cache import warm
-from drake_dock.docking.scene import initial_state
+from drake_dock.docking.scene import contact_approach, first_contact_seeks, initial_state
 from drake_dock.docking.simulate import simulate
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.systems.simulator import make_simulator
@@ -86,6 +86,7 @@ def main():
     t0 = time.perf_counter()
     state = initial_state(scenario)
     t_state = time.perf_counter() - t0
+    seeks = first_contact_seeks(scenario.geometry, contact_approach(scenario)[0])
     t0 = time.perf_counter()
     dd = build_docking_diagram(scenario)
     t_build = time.perf_counter() - t0
@@ -125,6 +126,7 @@ def main():
         print(f"compiled kernels: cold start {starts[0]:.2f} s (compiling into an empty cache), "
               f"warm start {starts[1]:.2f} s (loading it), each a fresh process")
     print(f"set-up: {t_state:.4f} s")
+    print(f"set-up seeks: {seeks} (the first-contact search on its final approach)")
     print(f"diagram build (excluded): {t_build:.2f} s")
     print(f"simulated {r.end_time:.4f} s (captured: {r.captured}); impacts {len(r.impacts)}; "
           f"mode changes {r.mode_changes}")

@@ -9,6 +9,8 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
+from drake_dock.core import covers
+from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import Patch, posed
 from drake_dock.core.seeking import seek_couple
@@ -118,7 +120,7 @@ def pair_couples(pairs, poses, **grid):
     return out
 
 
-def _gaps_at(pairs, approach, d, refs):
+def signed_gaps(pairs, approach, d, refs):
     """Signed gaps of the pairs at ring-face distance d. A pair is a potential contact only
     while its couple is interior (see `is_interior`); otherwise its gap is +inf and its side
     reference is dropped. The sign is fixed by the side the couple lies on when the pair becomes
@@ -148,33 +150,111 @@ def first_contact(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13)
     """Line parameter lam at which the first of the pairs closes when the chaser comes along
     ``approach`` from far away; returns (lam, names of the pairs that close within 1e-9). The
     search steps the ring-face distance by 1 cm, or by 1/100 of its start distance for a larger
-    APDS (H > 0.475 m), so that it takes at most about 100 steps. Remembered per geometry and
+    APDS (H > 0.475 m), so that it takes at most about 100 steps; a pair is sought only at the
+    ends of the steps its patches can touch in (`touch_steps`). Remembered per geometry and
     approach (a pure function of them)."""
-    lam_c, names = _first_contact(dataclasses.astuple(g), approach, step, xtol)
+    lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, step, xtol)
     return lam_c, list(names)
+
+
+def first_contact_seeks(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13) -> int:
+    """The number of seeks `first_contact` takes (or took) for this geometry and approach."""
+    return _first_contact(dataclasses.astuple(g), approach, step, xtol)[2]
+
+
+def travel_grid(g: ApdsGeometry, approach: Approach, step=None):
+    """The search's travel points lam_0 > lam_1 > ... (lam_{k+1} = lam_k - step), from the
+    height 2 H + 0.05 where every pair is apart (petals do not overlap axially) to the first
+    point at a height of -H or below."""
+    per_height = 1.0 / approach.height(1.0)
+    d = (2.0 * g.H + 0.05) * per_height
+    step = max(1e-2, (2.0 * g.H + 0.05) / 100) * per_height if step is None else step
+    grid = [d]
+    while approach.height(d) > -g.H:
+        d = d - step
+        grid.append(d)
+    return grid
+
+
+# Covers of the search (`drake_dock.core.covers`): cells per parameter and per block.
+COVER_CELLS = {1: (256, 16), 2: (32, 8)}
+
+
+def pair_covers(pr: PairSpec):
+    """The covers of a pair's two patches (`COVER_CELLS`), compiled where the patches have
+    kernel descriptions."""
+    out = []
+    for patch in (pr.patch1, pr.patch2):
+        cells = COVER_CELLS[patch.dim]
+        out.append(compiled_cover.patch_cover(patch, *cells) or covers.patch_cover(patch, *cells))
+    return out
+
+
+def touch_steps(pairs, approach: Approach, grid):
+    """Booleans (pairs, steps): the covers of pair j's patches can touch between grid[k] and
+    grid[k + 1] (`drake_dock.core.covers.touch_steps`); elsewhere the pair is apart."""
+    R, p0 = approach.pose(0.0)
+    e = -(approach.pose(1.0)[1] - p0)            # the chaser's points move by -lam e
+    grid = np.asarray(grid, dtype=float)
+    out = np.zeros((len(pairs), len(grid) - 1), dtype=bool)
+    for j, pr in enumerate(pairs):
+        c1, c2 = pair_covers(pr)
+        moving, fixed = (c1, c2) if pr.body1 == CHASER_APDS else (c2, c1)
+        out[j] = compiled_cover.touch_steps(moving.posed(R, p0), fixed, e, grid)
+    return out
+
+
+class _Gaps:
+    """The signed gaps (`signed_gaps`) of the pairs at the travel grid's points, sought on demand
+    and counted. A pair's side is continued from the grid point before when it was sought
+    there; otherwise the pair was apart since its last seek and keeps the side it lies on."""
+
+    def __init__(self, pairs, approach, grid):
+        self.pairs, self.approach, self.grid = pairs, approach, grid
+        self.at = {}                                   # (j, k) -> (gap, direction)
+        self.seeks = 0
+
+    def gap(self, j, k):
+        hit = self.at.get((j, k))
+        if hit is None:
+            before = self.at.get((j, k - 1))
+            ref = None if before is None else before[1]
+            gaps, dirs = signed_gaps([self.pairs[j]], self.approach, self.grid[k], [ref])
+            self.seeks += 1
+            hit = self.at[(j, k)] = (gaps[0], dirs[0])
+        return hit[0]
+
+    def root(self, j, k, xtol):
+        """brentq on the step from grid[k] down to grid[k + 1] for pair j, its side from
+        grid[k]; the two ends are the grid's gaps."""
+        ref = self.at[(j, k)][1]
+        ends = {self.grid[k]: self.gap(j, k), self.grid[k + 1]: self.gap(j, k + 1)}
+
+        def f(dd):
+            if dd in ends:
+                return ends[dd]
+            self.seeks += 1
+            return signed_gaps([self.pairs[j]], self.approach, dd, [ref])[0][0]
+
+        return brentq(f, self.grid[k + 1], self.grid[k], xtol=xtol, rtol=1e-15)
 
 
 @functools.lru_cache(maxsize=64)
 def _first_contact(geometry: tuple, approach: Approach, step, xtol):
     g = ApdsGeometry(*geometry)
     pairs = apds_pairs(g)
-    per_height = 1.0 / approach.height(1.0)
-    d = (2.0 * g.H + 0.05) * per_height   # petals do not overlap axially: every pair is apart
-    step = max(1e-2, (2.0 * g.H + 0.05) / 100) * per_height if step is None else step
-    gaps, refs = _gaps_at(pairs, approach, d, [None] * len(pairs))
-    while approach.height(d) > -g.H:
-        d_lo = d - step
-        gaps_lo, refs_lo = _gaps_at(pairs, approach, d_lo, refs)
-        closing = np.flatnonzero((gaps_lo <= 0) & np.isfinite(gaps))
-        if closing.size:
-            roots = {}
-            for j in closing:
-                def f(dd, j=j):
-                    return _gaps_at([pairs[j]], approach, dd, [refs[j]])[0][0]
-                roots[pairs[j].name] = brentq(f, d_lo, d, xtol=xtol, rtol=1e-15)
+    grid = travel_grid(g, approach, step)
+    touch = touch_steps(pairs, approach, grid)
+    gaps = _Gaps(pairs, approach, grid)
+    for k in range(len(grid) - 1):
+        # A pair closes on the step when its gap is finite at grid[k] and <= 0 at grid[k + 1].
+        closing = [j for j in np.flatnonzero(touch[:, k])
+                   if np.isfinite(gaps.gap(j, k)) and gaps.gap(j, k + 1) <= 0]
+        if closing:
+            roots = {pairs[j].name: gaps.root(j, k, xtol) for j in closing}
             d_c = max(roots.values())
-            return d_c, tuple(sorted(n for n, r in roots.items() if r >= d_c - 1e-9))
-        d, gaps, refs = d_lo, gaps_lo, refs_lo
+            names = tuple(sorted(n for n, r in roots.items() if r >= d_c - 1e-9))
+            return d_c, names, gaps.seeks
     raise NumericalError(f"no pair closes on the approach {approach}")
 
 

@@ -57,6 +57,7 @@ def cache_dir() -> pathlib.Path:
 
 def warm() -> None:
     """Compiles (or loads from the cache) every kernel by evaluating the kernels once."""
-    from drake_dock.core.kernels import seek, tracked
+    from drake_dock.core.kernels import cover, seek, tracked
     tracked.warm()
     seek.warm()
+    cover.warm()

@@ -1,0 +1,113 @@
+"""The bounding-sphere covers of `drake_dock.core.covers` compiled: the cell spheres from the
+patches' jets (`jets.jet`) and the steps of a travel grid in which two covers can touch, with
+the same bounds (tests compare them with the reference)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from drake_dock.core.covers import Cover, block_layout
+from drake_dock.core.kernels.jets import jet, patch_spec
+
+
+@njit(cache=True)
+def _norm(v):
+    return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+
+
+@njit(cache=True)
+def cell_spheres(kind, prm, U, half):
+    """Centres r(u_c) (N, 3) and radii rho_c (N,) of the cells centred at U (N, dim) with
+    half-widths ``half`` (`drake_dock.core.covers.cell_radii`)."""
+    n, dim = U.shape
+    C, rho = np.empty((n, 3)), np.empty(n)
+    for c in range(n):
+        r, T0, T1, K00, K01, K11 = jet(kind, prm, U[c, 0], U[c, 1] if dim == 2 else 0.0)
+        C[c, 0], C[c, 1], C[c, 2] = r
+        h0 = half[0]
+        if dim == 1:
+            rho[c] = h0 * (_norm(T0) + h0 * _norm(K00))
+        else:
+            h1 = half[1]
+            rho[c] = (h0 * (_norm(T0) + h0 * _norm(K00) + h1 * _norm(K01))
+                      + h1 * (_norm(T1) + h0 * _norm(K01) + h1 * _norm(K11)))
+    return C, rho
+
+
+@njit(cache=True)
+def _interval(c1, c2, r, e, ee):
+    """`covers._intervals` for one sphere pair: (lo, hi, ok)."""
+    w0, w1, w2 = c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]
+    b = w0 * e[0] + w1 * e[1] + w2 * e[2]
+    D = b * b - ee * (w0 * w0 + w1 * w1 + w2 * w2 - r * r)
+    if not D >= 0.0:
+        return 0.0, 0.0, False
+    s = math.sqrt(D)
+    return (b - s) / ee, (b + s) / ee, True
+
+
+@njit(cache=True)
+def touched_steps(mc, mr, mbc, mbr, mblocks, fc, fr, fbc, fbr, fblocks, e, grid, slack):
+    """`covers.touched_steps` of `covers.touch_set`: the steps of the decreasing grid in which
+    the moving cover (cells mc, mr; blocks mbc, mbr, mblocks), translated by -lam e, can touch
+    the fixed one."""
+    K = grid.shape[0] - 1
+    neg = -grid
+    marks = np.zeros(K + 1, dtype=np.int64)
+    ee = e[0] * e[0] + e[1] * e[1] + e[2] * e[2]
+    lam_lo, lam_hi = grid[K], grid[0]
+    for I in range(mbc.shape[0]):
+        for J in range(fbc.shape[0]):
+            lo, hi, ok = _interval(mbc[I], fbc[J], mbr[I] + fbr[J], e, ee)
+            if not ok or lo > lam_hi + slack or hi < lam_lo - slack:
+                continue
+            for a in mblocks[I]:
+                for b in fblocks[J]:
+                    lo, hi, ok = _interval(mc[a], fc[b], mr[a] + fr[b], e, ee)
+                    if not ok:
+                        continue
+                    first = max(np.searchsorted(neg, -(hi + slack)) - 1, 0)
+                    last = min(np.searchsorted(neg, -(lo - slack), side="right") - 1, K - 1)
+                    if first <= last:
+                        marks[first] += 1
+                        marks[last + 1] -= 1
+    out = np.empty(K, dtype=np.bool_)
+    acc = 0
+    for k in range(K):
+        acc += marks[k]
+        out[k] = acc > 0
+    return out
+
+
+def patch_cover(patch, n: int, block: int):
+    """`drake_dock.core.covers.patch_cover` from the compiled jets, or None for a patch no
+    kernel describes; kept on the patch."""
+    cache = patch.__dict__.setdefault("_compiled_covers", {})
+    if (n, block) in cache:
+        return cache[(n, block)]
+    spec = patch_spec(patch)
+    hit = None
+    if spec is not None:
+        U, half, blocks = block_layout(patch, n, block)
+        centres, radii = cell_spheres(spec[0], spec[1], U, half)
+        hit = Cover.from_cells(centres, radii, blocks)
+    cache[(n, block)] = hit
+    return hit
+
+
+def touch_steps(moving, fixed, e, grid, slack=1e-9):
+    """Booleans (K,): the steps of ``grid`` in which the posed covers can touch."""
+    return touched_steps(moving.centres, moving.radii, moving.block_centres, moving.block_radii,
+                         moving.blocks, fixed.centres, fixed.radii, fixed.block_centres,
+                         fixed.block_radii, fixed.blocks, np.asarray(e, dtype=float),
+                         np.asarray(grid, dtype=float), float(slack))
+
+
+def warm():
+    """Compiles or loads the covers' kernels: a curve and a surface against each other."""
+    from drake_dock.core.patches import Circle, PlaneRect
+    plane = patch_cover(PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)), 4, 2)
+    circle = patch_cover(Circle(0.3, 0.1), 4, 2)
+    touch_steps(circle, plane, np.array([0.0, 0.0, -1.0]), np.array([0.3, 0.2, 0.1, 0.0]))

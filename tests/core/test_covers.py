@@ -1,0 +1,107 @@
+"""The bounding-sphere covers (`drake_dock.core.covers`, compiled in
+`drake_dock.core.kernels.cover`): every sampled point of a cell lies in its sphere, every cell in
+its block's sphere; the compiled covers and touched steps equal the reference; the touched steps
+equal a brute force over every sphere pair and step (the exact least distance of a sphere pair
+over a step); and the covers' distance bound lies below the seek's distance."""
+import math
+
+import numpy as np
+import pytest
+
+from drake_dock.core import covers
+from drake_dock.core.kernels import cover as compiled
+from drake_dock.core.kernels import seek as compiled_seek
+from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
+from drake_dock.docking.apds import ApdsGeometry
+from drake_dock.docking.scene import (CHASER_APDS, COVER_CELLS, Approach, apds_pairs, travel_grid,
+                                      touch_steps)
+
+
+def _patches():
+    pairs = apds_pairs(ApdsGeometry())
+    apds = {id(p): p for pr in pairs for p in (pr.patch1, pr.patch2)}
+    return list(apds.values()) + [Circle(0.3, 0.1), Cone(0.6, 0.8, (0.1, 1.2), (0.0, 0.2)),
+                                  PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)),
+                                  Segment((0, 0, 0), (1, 2, 3))]
+
+
+@pytest.mark.parametrize("patch", _patches(), ids=lambda p: type(p).__name__)
+def test_cells_enclose_the_patch(patch):
+    n, block = COVER_CELLS[patch.dim]
+    ref = covers.patch_cover(patch, n, block)
+    got = compiled.patch_cover(patch, n, block)
+    np.testing.assert_allclose(got.centres, ref.centres, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got.radii, ref.radii, rtol=1e-12, atol=1e-15)
+    U, half, blocks = covers.block_layout(patch, n, block)
+    rng = np.random.default_rng(0)
+    for i in range(20):                      # points all over every cell, corners first
+        t = rng.choice([-1.0, 1.0], U.shape) if i < 4 else rng.uniform(-1, 1, U.shape)
+        x = patch.position(U + t * half)
+        assert np.all(np.linalg.norm(x - ref.centres, axis=1) <= ref.radii)
+    inside = (np.linalg.norm(ref.centres[blocks] - ref.block_centres[:, None], axis=-1)
+              + ref.radii[blocks])
+    assert np.all(inside <= ref.block_radii[:, None] * (1 + 1e-15))
+
+
+def _posed_covers(pr, approach):
+    R, p0 = approach.pose(0.0)
+    c1, c2 = (covers.patch_cover(p, *COVER_CELLS[p.dim]) for p in (pr.patch1, pr.patch2))
+    moving, fixed = (c1, c2) if pr.body1 == CHASER_APDS else (c2, c1)
+    return moving.posed(R, p0), fixed, -(approach.pose(1.0)[1] - p0)
+
+
+APPROACHES = [Approach(math.radians(5.0)),
+              Approach(0.05, (0.04, -0.03), (0.06, 0.02), (0.3, -0.2, -0.932737905308882))]
+
+
+@pytest.mark.parametrize("approach", APPROACHES)
+def test_compiled_touch_steps_equal_the_reference(approach):
+    g = ApdsGeometry()
+    pairs = apds_pairs(g)
+    grid = np.array(travel_grid(g, approach))
+    got = touch_steps(pairs, approach, grid)
+    for j, pr in enumerate(pairs):
+        np.testing.assert_array_equal(got[j], covers.touch_steps(*_posed_covers(pr, approach),
+                                                                 grid), pr.name)
+
+
+@pytest.mark.parametrize("name", ["cc_T2_C4", "cs_Cring_T1"])
+def test_touch_steps_equal_a_brute_force(name):
+    """A step is touched iff some sphere pair's least distance over the step is <= 0: that
+    distance is |w - lam* e| - r at the clamped projection lam* of w on e."""
+    g = ApdsGeometry()
+    approach = APPROACHES[0]
+    pr = next(p for p in apds_pairs(g) if p.name == name)
+    moving, fixed, e = _posed_covers(pr, approach)
+    grid = np.array(travel_grid(g, approach))
+    w = (moving.centres[:, None, :] - fixed.centres[None, :, :]).reshape(-1, 3)
+    r = (moving.radii[:, None] + fixed.radii[None, :]).ravel()
+    lam = np.clip((w @ e) / (e @ e), grid[1:, None], grid[:-1, None])   # (steps, pairs)
+    least = np.linalg.norm(w[None] - lam[..., None] * e, axis=-1) - r
+    brute = (least <= 1e-9).any(axis=1)
+    np.testing.assert_array_equal(covers.touch_steps(moving, fixed, e, grid), brute)
+
+
+def test_bound_lies_below_the_seek_distance():
+    """At every grid point of the paper's approach: the covers' least distance (min over sphere
+    pairs of |c1 - c2| - r1 - r2) <= the compiled seek's distance of every pair, and > 0 at both
+    ends of every step that is not touched."""
+    g = ApdsGeometry()
+    approach = APPROACHES[0]
+    pairs = apds_pairs(g)
+    grid = np.array(travel_grid(g, approach))[::3]
+    touched = touch_steps(pairs, approach, grid)
+    for j, pr in enumerate(pairs):
+        moving, fixed, e = _posed_covers(pr, approach)
+        for k, lam in enumerate(grid):
+            c = moving.centres - lam * e
+            bound = (np.linalg.norm(c[:, None] - fixed.centres[None], axis=-1)
+                     - moving.radii[:, None] - fixed.radii[None]).min()
+            R, p = approach.pose(lam)
+            poses = {CHASER_APDS: (R, p), "target_apds": (np.eye(3), np.zeros(3))}
+            cp = compiled_seek.seek_couple(posed(pr.patch1, *poses[pr.body1]),
+                                           posed(pr.patch2, *poses[pr.body2]))
+            assert bound <= cp.distance + 1e-12, (pr.name, lam)
+            near = touched[j, max(k - 1, 0):k + 1]
+            if not near.any():
+                assert bound > 0.0, (pr.name, lam)
