@@ -8,7 +8,7 @@ relative acceleration is Wt^T v' + bt), each couple takes one mode:
 - ``stick``:  g'' = 0 and Wt^T v' + bt = 0, force (lam_n, lam_t) inside the static cone
   |lam_t| <= mu_s lam_n (Eq. 51);
 - ``slide``:  g'' = 0, lam_t = -mu lam_n s with s the unit sliding direction (Eq. 50), lam_n >= 0;
-- ``detach``: no force, g'' >= 0.
+- ``detach``: no force, g'' + 2 omega g' + omega^2 g >= 0.
 
 M v' = tau + sum (Wn lam_n + Wt lam_t). The normal constraint is stabilised (Baumgarte):
 g'' + 2 omega g' + omega^2 g = 0, so that the gap's drift decays instead of growing (omega = 0
@@ -16,15 +16,23 @@ gives Eq. 52 as printed). The sticking condition a_t = 0 is not stabilised: its 
 velocity (of the order of the integration error) and is removed at every mode change by the
 contact system's velocity projection, while a feedback term would bias the friction force.
 
+The normal complementarity is stated on that stabilised row on both sides: lam_n >= 0 holding
+it at zero, or no force with it >= 0. One couple of normal inverse mass A > 0 then always has
+exactly one consistent normal mode (lam_n = -(its free value) / A). A detached couple tested on
+g'' alone would leave a window, 0 < g'' + 2 omega g' + omega^2 g < 2 omega g' + omega^2 g, where
+both modes fail: a couple whose gap has drifted open by g as it unloads (at omega = 20 rad/s a
+drift of 1e-8 m opens 4e-6 m/s^2, past ``TIE_RTOL`` of the 1 m/s^2 floor). Once detached, its
+drift is watched by its gap witness.
+
 `select_modes` enumerates the modes of the contact set (3^k choices, k <= 8) and keeps the
 consistent ones, within ``rtol`` of the force and acceleration scales (each with a floor of
-1 N and 1 m/s^2). At a transition, such as a couple unloading to zero force as it lifts off,
-round-off can leave the contact mode with lambda_n = -3e-8 N and the detached mode with
-g'' = -3e-9 m/s^2: then the modes consistent within ``TIE_RTOL`` (1e-6) of those scales are
-taken, with the same preferences. None consistent even so, or several with different accelerations that differ in their
-normal modes, is the Painleve paradox of a rigid model: it raises `PainleveError` with the time
-and the couples. Several consistent choices that differ only in stick against start-of-sliding
-(possible when mu_s > mu) are resolved by preferring stick: a couple at rest stays at rest.
+1 N and 1 m/s^2). At a transition round-off can leave every mode just outside ``rtol``: then the
+modes consistent within ``TIE_RTOL`` (1e-6) of those scales are taken, with the same
+preferences. None consistent even so, or several with different accelerations that differ in
+their normal modes, is the Painleve paradox of a rigid model: it raises `PainleveError` with the
+time and the couples. Several consistent choices that differ only in stick against
+start-of-sliding (possible when mu_s > mu) are resolved by preferring stick: a couple at rest
+stays at rest.
 """
 from __future__ import annotations
 
@@ -165,10 +173,20 @@ def _slide_start(Minv, a0, rows, modes, dirs, i_start, omega, time, max_iter=200
     return sol, ok
 
 
-def _consistent(sol, rows, starting, tol_f, tol_a):
+def stabilised_gddot(sol, rows, omega) -> np.ndarray:
+    """(k,) g'' + 2 omega g' + omega^2 g: the normal row the contact modes hold at zero
+    (Eq. 52, stabilised)."""
+    return sol.gddot + np.array([2 * omega * r.vn + omega ** 2 * r.gap for r in rows])
+
+
+def _consistent(sol, rows, omega, tol_f, tol_a):
+    """Complementarity on the stabilised normal row (lambda_n >= 0 in contact, Eq. 50-51;
+    g'' + 2 omega g' + omega^2 g >= 0 detached, Eq. 52) and the static cone (Eq. 51), within
+    ``tol_f`` (N) and ``tol_a`` (m/s^2)."""
+    stab = stabilised_gddot(sol, rows, omega)
     for i, (r, m) in enumerate(zip(rows, sol.modes)):
         if m == DETACH:
-            if sol.gddot[i] < -tol_a:
+            if stab[i] < -tol_a:
                 return False
         else:
             if sol.lam_n[i] < -tol_f:
@@ -230,9 +248,9 @@ def select_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9
         except SingularContactError:
             continue
         f_scale = 1.0 + float(np.abs(sol.lam_n).max())
-        if _consistent(sol, rows, starting, rtol * f_scale, rtol * a_scale):
+        if _consistent(sol, rows, omega, rtol * f_scale, rtol * a_scale):
             found.append(sol)
-        elif _consistent(sol, rows, starting, TIE_RTOL * f_scale, TIE_RTOL * a_scale):
+        elif _consistent(sol, rows, omega, TIE_RTOL * f_scale, TIE_RTOL * a_scale):
             near.append(sol)
     found = found or near
     if not found:

@@ -31,3 +31,16 @@ def test_runs_past_the_former_seek_crash(make, crashed_at):
     duration = crashed_at + 0.02
     result = simulate(make(), duration=duration)
     assert result.outcome == "timeout" and result.end_time == pytest.approx(duration)
+
+
+def test_idss_sample_139_lifts_off_and_is_captured():
+    """Sample 139 of the IDSS plan: the sliding couple cc_T3_C3 unloads at t = 1.965 s with its
+    gap drifted 8e-9 m open; it detaches there (the stabilised normal row of Eq. 52,
+    `drake_dock.core.constraints`) and the run ends captured."""
+    from drake_dock.campaign.plan import load_plan
+    from drake_dock.campaign.sample import sample_scenario
+    from drake_dock.campaign.sampling import sample_specs
+    plan, base, fields = load_plan(MODELS / "idss_envelope.yaml")
+    (_, _, values), = sample_specs(plan, fields, [139])
+    result = simulate(sample_scenario(base, values))
+    assert result.outcome == "captured" and result.end_time > 1.97
