@@ -37,10 +37,19 @@ class PairSpec:
     patch2: Patch
 
 
-def apds_pairs(g: ApdsGeometry) -> list[PairSpec]:
-    """The paper's 12 pairs: six guide side vs guide side (C-C, Body 1 = the chaser's side, as
-    in Sect. 3.2), three chaser-ring vs target-surface and three target-ring vs chaser-surface
-    (C-S, Body 1 = the ring)."""
+# `contact.pairs`: the paper's 12 pairs, or those and the edge and face pairs they leave out.
+PAIR_SETS = ("paper", "complete")
+
+
+def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
+    """The contact pairs of the set ``which`` (`PAIR_SETS`). ``paper``: the 12 pairs of Sect.
+    2.2 and 8.1, six guide side vs guide side (C-C, Body 1 = the chaser's side, as in Sect. 3.2),
+    three chaser-ring vs target-surface and three target-ring vs chaser-surface (C-S, Body 1 =
+    the ring). ``complete`` adds, for each APDS against the other (`edge_pairs`): the ring's
+    inside circle vs each guide side and each tip arc (C-C), and the ring's outside circle vs
+    the other ring's face (C-S)."""
+    if which not in PAIR_SETS:
+        raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)
     pairs = [PairSpec(f"cc_T{i}_C{j}", "CC", CHASER_APDS, P.sides[j], TARGET_APDS, P.sides[i])
              for i, j in CC_SIDE_PAIRS]
@@ -48,7 +57,21 @@ def apds_pairs(g: ApdsGeometry) -> list[PairSpec]:
               for k in (1, 2, 3)]
     pairs += [PairSpec(f"cs_Tring_C{k}", "CS", TARGET_APDS, P.ring, CHASER_APDS, P.surfaces[k])
               for k in (1, 2, 3)]
+    if which == "complete":
+        pairs += edge_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
+        pairs += edge_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
     return pairs
+
+
+def edge_pairs(P, one, other) -> list[PairSpec]:
+    """The pairs of APDS ``one``'s ring (Body 1) against APDS ``other``'s petal edges and face;
+    ``one`` and ``other`` are (letter, body). Names: cc_<X>ring_<Y><i> (inside circle vs guide
+    side i), cc_<X>ring_<Y>tip<k> (vs tip arc k), cs_<X>rim_<Y>face (outside circle vs face)."""
+    (x, b1), (y, b2) = one, other
+    out = [PairSpec(f"cc_{x}ring_{y}{i}", "CC", b1, P.ring, b2, P.sides[i]) for i in range(1, 7)]
+    out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
+    out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
+    return out
 
 
 def rot_z(a):
