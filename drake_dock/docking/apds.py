@@ -31,6 +31,10 @@ import numpy as np
 from drake_dock.core.patches import Annulus, Arc, Circle, Cone, PolarCurve, Reparametrized
 from drake_dock.errors import InputError
 
+# The contact sets a docking scene names (`contact.pairs`; `drake_dock.docking.scene.apds_pairs`):
+# the paper's 12 pairs, or those and the edge and face pairs they leave out.
+PAIR_SETS = ("paper", "complete")
+
 
 @dataclasses.dataclass
 class ApdsGeometry:
