@@ -18,7 +18,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from drake_dock.docking.replay import replay_html
-from drake_dock.docking.scene import apds_pairs
+from drake_dock.docking.scene import scenario_pairs
 from drake_dock.docking.results import (momenta, momentum_reference_point, relative_text, summary,
                                         timeseries)
 from drake_dock.docking.simulate import simulate
@@ -99,7 +99,7 @@ def _run(scenario, out_dir, progress, state, dd, full, log):
     with atomic_directory(out_dir) as tmp:
         (tmp / "timeseries.npz").write_bytes(_npz_bytes(ts))
         records = run_figures(ts, summ, (P, L), tmp, focus_couples=result.initial.closing_pairs,
-                              pairs=apds_pairs(scenario.geometry))
+                              pairs=scenario_pairs(scenario))
         poses = {n: (ts["R_WA"][0, j], ts["p_WA"][0, j])
                  for j, n in enumerate(ts["apds_names"].tolist())}
         cn = ts["couple_names"].tolist()

@@ -145,6 +145,60 @@ class Circle(Patch):
         return (R * c, R * s, self.height), ((-R * s, R * c, 0.0),), (((-R * c, -R * s, 0.0),),)
 
 
+class Arc(Circle):
+    """Arc of the circle of radius ``radius`` in the plane z = ``height`` of its frame, centred
+    on the z axis, for theta in ``theta_range`` (a petal's tip arc); u = (theta,), bounded."""
+
+    periodic = (False,)
+
+    def __init__(self, radius: float, height: float, theta_range):
+        super().__init__(radius, height)
+        self.lower = np.array([min(theta_range)], dtype=float)
+        self.upper = np.array([max(theta_range)], dtype=float)
+
+
+class Annulus(Patch):
+    """The plane region r_in <= rho <= r_out of the plane z = ``height`` (a ring's face),
+    u = (rho, theta), theta periodic on [0, 2 pi); its normal N = r_rho x r_theta is +z."""
+
+    dim = 2
+    periodic = (False, True)
+
+    def __init__(self, r_in: float, r_out: float, height: float = 0.0):
+        self.height = float(height)
+        self.lower = np.array([float(r_in), 0.0])
+        self.upper = np.array([float(r_out), 2.0 * np.pi])
+
+    def position(self, u):
+        u = np.asarray(u, dtype=float)
+        rho, th = u[..., 0], u[..., 1]
+        return np.stack([rho * np.cos(th), rho * np.sin(th), np.full_like(th, self.height)],
+                        axis=-1)
+
+    def first(self, u):
+        u = np.asarray(u, dtype=float)
+        rho, th = u[..., 0], u[..., 1]
+        c, s, z = np.cos(th), np.sin(th), np.zeros_like(th)
+        return np.stack([np.stack([c, s, z], -1), np.stack([-rho * s, rho * c, z], -1)], -1)
+
+    def second(self, u):
+        u = np.asarray(u, dtype=float)
+        rho, th = u[..., 0], u[..., 1]
+        c, s, z = np.cos(th), np.sin(th), np.zeros_like(th)
+        r_rt = np.stack([-s, c, z], axis=-1)
+        out = np.zeros(th.shape + (3, 2, 2))
+        out[..., 0, 1] = out[..., 1, 0] = r_rt
+        out[..., 1, 1] = np.stack([-rho * c, -rho * s, z], axis=-1)
+        return out
+
+    def jet(self, u):
+        rho, th = float(u[0]), float(u[1])
+        c, s = math.cos(th), math.sin(th)
+        r_rt = (-s, c, 0.0)
+        return ((rho * c, rho * s, self.height), ((c, s, 0.0), (-rho * s, rho * c, 0.0)),
+                (((0.0, 0.0, 0.0), r_rt), (r_rt, (-rho * c, -rho * s, 0.0))))
+
+
 class Segment(Patch):
     """Straight segment a + u (b - a), u in [0, 1]."""
 

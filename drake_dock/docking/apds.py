@@ -15,6 +15,12 @@ APDS, ring face at zeta = 0, petals in 0 <= zeta <= H (docs/model.md, "APDS geom
       theta = phi_{2k-1} + theta_1(zeta) + s (pi/3 - 2 theta_1(zeta)),
   theta_1 as in Eq. (13). s = 0 and s = 1 are the two guide sides.
 - Inside circle of the guide ring, Eq. (16)-(17): rho = Rs, zeta = 0, theta in [0, 2 pi).
+
+Features beyond the paper's pairs (docs/model.md, "What the 12 pairs leave out"):
+- tip arc k: the petal's edge at zeta = H between the ends of sides 2k - 1 and 2k, the circle
+  rho = R - H cot(alpha1) for theta in [phi_{2k-1} + theta_end, phi_{2k-1} + pi/3 - theta_end];
+- outside circle of the ring: rho = R, zeta = 0;
+- ring face: the annulus Rs <= rho <= R at zeta = 0, u = (rho, theta).
 """
 
 import dataclasses
@@ -22,8 +28,12 @@ import math
 
 import numpy as np
 
-from drake_dock.core.patches import Circle, Cone, PolarCurve, Reparametrized
+from drake_dock.core.patches import Annulus, Arc, Circle, Cone, PolarCurve, Reparametrized
 from drake_dock.errors import InputError
+
+# The contact sets a docking scene names (`contact.pairs`; `drake_dock.docking.scene.apds_pairs`):
+# the paper's 12 pairs, or those and the edge and face pairs they leave out.
+PAIR_SETS = ("paper", "complete")
 
 
 @dataclasses.dataclass
@@ -230,16 +240,40 @@ def ring_circle(g: ApdsGeometry) -> Circle:
     return Circle(g.Rs, 0.0)
 
 
+def tip_arc(g: ApdsGeometry, k: int) -> Arc:
+    """The tip arc of petal k: where guide surface k (Eq. 12-13) meets zeta = H; u = (theta,),
+    theta from the end of side 2k - 1 to the end of side 2k (Eq. 14-15)."""
+    if k not in (1, 2, 3):
+        raise InputError("tip arc", k, "1..3")
+    phi0 = side_phi(2 * k - 1)
+    return Arc(g.R - g.H / math.tan(g.alpha1), g.H,
+               (phi0 + g.theta_end, phi0 + math.pi / 3 - g.theta_end))
+
+
+def ring_rim(g: ApdsGeometry) -> Circle:
+    """Outside circle of the guide ring, rho = R at zeta = 0."""
+    return Circle(g.R, 0.0)
+
+
+def ring_face(g: ApdsGeometry) -> Annulus:
+    """The ring's face, the annulus Rs <= rho <= R at zeta = 0; u = (rho, theta), normal +e3."""
+    return Annulus(g.Rs, g.R, 0.0)
+
+
 @dataclasses.dataclass
 class ApdsPatches:
     sides: dict      # i -> guide side n_i
     surfaces: dict   # k -> guide surface k
-    ring: Circle
+    ring: Circle     # inside circle of the ring (Eq. 16-17)
+    tips: dict       # k -> tip arc of petal k
+    rim: Circle      # outside circle of the ring
+    face: Annulus    # the ring's face
 
 
 def apds_patches(g: ApdsGeometry) -> ApdsPatches:
     return ApdsPatches({i: guide_side(g, i) for i in range(1, 7)},
-                       {k: guide_surface(g, k) for k in (1, 2, 3)}, ring_circle(g))
+                       {k: guide_surface(g, k) for k in (1, 2, 3)}, ring_circle(g),
+                       {k: tip_arc(g, k) for k in (1, 2, 3)}, ring_rim(g), ring_face(g))
 
 
 # Visual mesh --------------------------------------------------------------------------------

@@ -22,7 +22,7 @@ from pydrake.systems.framework import (DiagramBuilder, EventStatus, LeafSystem, 
 from drake_dock.systems.contact_system import ContactOptions, ContactPair, RigidContactSystem
 from drake_dock.systems.simulator import tolerances
 from drake_dock.docking.plant import DockingPlant, StewartDamperPower, make_docking_plant
-from drake_dock.docking.scene import apds_pairs
+from drake_dock.docking.scene import scenario_pairs
 
 
 @dataclasses.dataclass
@@ -78,7 +78,7 @@ def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagra
     dp = make_docking_plant(scenario, scene_graph)
     frames = dp.apds_frames
     pairs = [ContactPair(p.name, p.kind, frames[p.body1], p.patch1, frames[p.body2], p.patch2)
-             for p in apds_pairs(scenario.geometry)]
+             for p in scenario_pairs(scenario)]
     if options is None:
         # LZB's accuracy follows the simulator's (`drake_dock.systems.simulator.tolerances`).
         options = ContactOptions(impact_rtol=tolerances(scenario.simulator_config).impact_rtol)

@@ -19,7 +19,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_dock.docking.plant import add_docking_plant
 from drake_dock.docking.replay_marks import add_marks, overlay_html
-from drake_dock.docking.scene import apds_pairs
+from drake_dock.docking.scene import scenario_pairs
 
 CAMERA_DISTANCE = 2.8     # m from the rings' midpoint, outside the hulls (radius 1.2 m)
 CAMERA_FOV = 26.0         # deg, vertical
@@ -100,7 +100,7 @@ def replay_html(scenario, t, Q, *, fps=30.0, slow_motion=10.0, meshcat=None, ts=
     _frame_camera(meshcat, dp, Qf[0], scenario.geometry.R)
     overlay = ""
     if ts is not None:
-        lines = add_marks(meshcat, ts, apds_pairs(scenario.geometry), t_frame, fps,
+        lines = add_marks(meshcat, ts, scenario_pairs(scenario), t_frame, fps,
                           slow_motion)
         overlay = overlay_html(float(t[0]), fps, slow_motion, lines)
     meshcat.StopRecording()

@@ -21,7 +21,7 @@ from drake_dock.core.hybrid import Mode
 from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
                                       stewart_potential)
-from drake_dock.docking.scene import CHASER_APDS, apds_pairs
+from drake_dock.docking.scene import CHASER_APDS, scenario_pairs
 
 IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or sticking)
 
@@ -86,7 +86,7 @@ def rigid_chaser_force(result):
     `RunResult`, from the couples' lambda_n, lambda_t and frames."""
     rec = result.record
     sign = np.array([1.0 if p.body1 == CHASER_APDS else -1.0
-                     for p in apds_pairs(result.scenario.geometry)])
+                     for p in scenario_pairs(result.scenario)])
     t = np.asarray(rec.t)
     C = np.asarray(rec.couples)
     frames = C[:, :, COUPLE_SLICES["frame"]].reshape(len(t), -1, 3, 3)

@@ -15,7 +15,7 @@ from pydrake.common.yaml import yaml_load_typed
 from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.core.contact_law import ContactLaw
-from drake_dock.docking.apds import ApdsGeometry
+from drake_dock.docking.apds import PAIR_SETS, ApdsGeometry
 from drake_dock.errors import InputError
 
 MODELS_DIR = Path(__file__).resolve().parent.parent / "models"   # package data; ./models links here
@@ -78,6 +78,22 @@ class InitialCondition:
 
 
 @dataclasses.dataclass
+class DockingContact(ContactLaw):
+    """The contact law (`ContactLaw`) and the scene's contact set ``pairs``: ``paper``, the 12
+    pairs of Sect. 2.2 and 8.1, or ``complete``, those and the pairs of a ring's circles against
+    the other APDS's guide sides, tip arcs and ring face (`drake_dock.docking.scene.apds_pairs`;
+    docs/model.md, "Facing and the contact pairs")."""
+
+    pairs: str = "paper"
+
+    def validate(self, where: str = "contact") -> "DockingContact":
+        super().validate(where)
+        if self.pairs not in PAIR_SETS:
+            raise InputError(f"{where}.pairs", self.pairs, f"one of {', '.join(PAIR_SETS)}")
+        return self
+
+
+@dataclasses.dataclass
 class SimulationParams:
     duration: float = 10.0           # the timeout (s): a run ends earlier at a named outcome
     jam_time: float = 2.0            # s without 1 mm of progress of the rings: "jammed"
@@ -111,7 +127,7 @@ class Scenario:
     bodies: Bodies = dataclasses.field(default_factory=Bodies)
     stewart: StewartParams = dataclasses.field(default_factory=StewartParams)
     chaser_apds_offset: list[float] = dataclasses.field(default_factory=lambda: [0.0, 0.0, 1.9])
-    contact: ContactLaw = dataclasses.field(default_factory=ContactLaw)
+    contact: DockingContact = dataclasses.field(default_factory=DockingContact)
     initial: InitialCondition = dataclasses.field(default_factory=InitialCondition)
     simulation: SimulationParams = dataclasses.field(default_factory=SimulationParams)
     simulator_config: SimulatorConfig = dataclasses.field(

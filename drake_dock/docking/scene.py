@@ -14,7 +14,7 @@ from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import Patch, posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.apds import ApdsGeometry, apds_patches
+from drake_dock.docking.apds import PAIR_SETS, ApdsGeometry, apds_patches
 from drake_dock.errors import InputError, NumericalError
 
 TARGET_APDS = "target_apds"
@@ -37,10 +37,15 @@ class PairSpec:
     patch2: Patch
 
 
-def apds_pairs(g: ApdsGeometry) -> list[PairSpec]:
-    """The paper's 12 pairs: six guide side vs guide side (C-C, Body 1 = the chaser's side, as
-    in Sect. 3.2), three chaser-ring vs target-surface and three target-ring vs chaser-surface
-    (C-S, Body 1 = the ring)."""
+def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
+    """The contact pairs of the set ``which`` (`PAIR_SETS`). ``paper``: the 12 pairs of Sect.
+    2.2 and 8.1, six guide side vs guide side (C-C, Body 1 = the chaser's side, as in Sect. 3.2),
+    three chaser-ring vs target-surface and three target-ring vs chaser-surface (C-S, Body 1 =
+    the ring). ``complete`` adds, for each APDS against the other (`edge_pairs`): the ring's
+    inside circle vs each guide side and each tip arc (C-C), and the ring's outside circle vs
+    the other ring's face (C-S)."""
+    if which not in PAIR_SETS:
+        raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)
     pairs = [PairSpec(f"cc_T{i}_C{j}", "CC", CHASER_APDS, P.sides[j], TARGET_APDS, P.sides[i])
              for i, j in CC_SIDE_PAIRS]
@@ -48,7 +53,26 @@ def apds_pairs(g: ApdsGeometry) -> list[PairSpec]:
               for k in (1, 2, 3)]
     pairs += [PairSpec(f"cs_Tring_C{k}", "CS", TARGET_APDS, P.ring, CHASER_APDS, P.surfaces[k])
               for k in (1, 2, 3)]
+    if which == "complete":
+        pairs += edge_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
+        pairs += edge_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
     return pairs
+
+
+def scenario_pairs(scenario) -> list[PairSpec]:
+    """The pairs of the scenario's contact set (`contact.pairs`)."""
+    return apds_pairs(scenario.geometry, scenario.contact.pairs)
+
+
+def edge_pairs(P, one, other) -> list[PairSpec]:
+    """The pairs of APDS ``one``'s ring (Body 1) against APDS ``other``'s petal edges and face;
+    ``one`` and ``other`` are (letter, body). Names: cc_<X>ring_<Y><i> (inside circle vs guide
+    side i), cc_<X>ring_<Y>tip<k> (vs tip arc k), cs_<X>rim_<Y>face (outside circle vs face)."""
+    (x, b1), (y, b2) = one, other
+    out = [PairSpec(f"cc_{x}ring_{y}{i}", "CC", b1, P.ring, b2, P.sides[i]) for i in range(1, 7)]
+    out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
+    out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
+    return out
 
 
 def rot_z(a):
@@ -146,20 +170,23 @@ def first_contact_distance(g: ApdsGeometry, yaw_deg: float, *, step=None, xtol=1
     return first_contact(g, Approach(math.radians(yaw_deg)), step=step, xtol=xtol)
 
 
-def first_contact(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13):
-    """Line parameter lam at which the first of the pairs closes when the chaser comes along
-    ``approach`` from far away; returns (lam, names of the pairs that close within 1e-9). The
+def first_contact(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13,
+                  which="paper"):
+    """Line parameter lam at which the first of the pairs of the set ``which`` (`apds_pairs`)
+    closes when the chaser comes along ``approach`` from far away; returns (lam, names of the
+    pairs that close within 1e-9). The
     search steps the ring-face distance by 1 cm, or by 1/100 of its start distance for a larger
     APDS (H > 0.475 m), so that it takes at most about 100 steps; a pair is sought only at the
     ends of the steps its patches can touch in (`touch_steps`). Remembered per geometry and
     approach (a pure function of them)."""
-    lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, step, xtol)
+    lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, step, xtol, which)
     return lam_c, list(names)
 
 
-def first_contact_seeks(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13) -> int:
+def first_contact_seeks(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13,
+                        which="paper") -> int:
     """The number of seeks `first_contact` takes (or took) for this geometry and approach."""
-    return _first_contact(dataclasses.astuple(g), approach, step, xtol)[2]
+    return _first_contact(dataclasses.astuple(g), approach, step, xtol, which)[2]
 
 
 def travel_grid(g: ApdsGeometry, approach: Approach, step=None):
@@ -240,9 +267,9 @@ class _Gaps:
 
 
 @functools.lru_cache(maxsize=64)
-def _first_contact(geometry: tuple, approach: Approach, step, xtol):
+def _first_contact(geometry: tuple, approach: Approach, step, xtol, which):
     g = ApdsGeometry(*geometry)
-    pairs = apds_pairs(g)
+    pairs = apds_pairs(g, which)
     grid = travel_grid(g, approach, step)
     touch = touch_steps(pairs, approach, grid)
     gaps = _Gaps(pairs, approach, grid)
@@ -314,12 +341,14 @@ def initial_state(scenario) -> InitialState:
 
 def contact_approach(scenario):
     """The scenario's straight approach and its first contact: (Approach, lam_c, closing
-    pairs). The lateral offset is the ring centre's at first contact. With a lateral velocity
+    pairs of the scenario's contact set). The lateral offset is the ring centre's at first
+    contact. With a lateral velocity
     the aim point (where the path meets the target's ring-face plane) is
     aim = offset + s v_lateral / chaser_speed, where s, the ring-face distance at contact, solves
     s = h_c(aim(s)) (brentq to 1e-10 m)."""
     ic = scenario.initial
     g = scenario.geometry
+    which = scenario.contact.pairs
     yaw = math.radians(ic.target_yaw_deg)
     tilt = tuple(math.radians(t) for t in ic.tilt_deg)
     v = np.array([*ic.lateral_velocity, -ic.chaser_speed])
@@ -332,12 +361,12 @@ def contact_approach(scenario):
 
     def mismatch(s):
         a = approach(s)
-        return a.height(first_contact(g, a)[0]) - s
+        return a.height(first_contact(g, a, which=which)[0]) - s
 
     s = 0.0
     if slope.any():
         s_max = 2.0 * g.H + 0.05           # no pair is closed above this ring-face distance
         s = brentq(mismatch, 0.0, s_max, xtol=1e-10)
     a = approach(s)
-    lam_c, closing = first_contact(g, a)
+    lam_c, closing = first_contact(g, a, which=which)
     return a, lam_c, closing

@@ -11,6 +11,8 @@ both give the same bits. The kinds:
 - CONE    [R0, cot alpha]: `Cone`.
 - SINE_POLAR [A, sigma, phi, tan alpha1, R, alpha2]: a `PolarCurve` in the sine form of Eq. (14),
   rho = A / sin(alpha2 + sigma (theta - phi)), z = (R - rho) tan alpha1 (a guide side).
+- ANNULUS [height]: `Annulus`, u = (rho, theta). An `Arc` is a CIRCLE (its domain is the
+  patch's, not the kernel's).
 - PETAL [R0, cot alpha, phi0, cot alpha1, A, alpha2, R]: a `Cone` reparametrized across the
   petal between two guide sides, theta = phi0 + theta_1(z) + s (pi/3 - 2 theta_1(z)) with
   theta_1 of Eq. (13) (a guide surface).
@@ -25,10 +27,10 @@ import math
 import numpy as np
 from numba import njit
 
-from drake_dock.core.patches import Circle, Cone, PlaneRect, PolarCurve, Reparametrized, \
-    Segment
+from drake_dock.core.patches import Annulus, Circle, Cone, PlaneRect, PolarCurve, \
+    Reparametrized, Segment
 
-CIRCLE, SEGMENT, PLANE, CONE, SINE_POLAR, PETAL = range(6)
+CIRCLE, SEGMENT, PLANE, CONE, SINE_POLAR, PETAL, ANNULUS = range(7)
 N_PARAMS = 9
 _Z = (0.0, 0.0, 0.0)
 
@@ -42,6 +44,8 @@ def patch_spec(patch):
         kind, vals = SEGMENT, [*patch.a, *patch.b]
     elif isinstance(patch, PlaneRect):
         kind, vals = PLANE, [*patch.o, *patch.e0, *patch.e1]
+    elif isinstance(patch, Annulus):
+        kind, vals = ANNULUS, [patch.height]
     elif isinstance(patch, Cone):
         kind, vals = CONE, [patch.R0, patch.cot]
     elif isinstance(patch, PolarCurve) and patch.kernel_params is not None:
@@ -129,4 +133,9 @@ def jet(kind, prm, u0, u1):
         r1 = -sigma * A * cw / math.pow(sw, 2.0)
         r2 = A * (1.0 + math.pow(cw, 2.0)) / math.pow(sw, 3.0)
         return _polar(rho, r1, r2, (R - rho) * tan1, -r1 * tan1, -r2 * tan1, u0)
+    if kind == ANNULUS:
+        c, s = math.cos(u1), math.sin(u1)
+        r_rt = (-s, c, 0.0)
+        return ((u0 * c, u0 * s, prm[0]), (c, s, 0.0), (-u0 * s, u0 * c, 0.0), _Z, r_rt,
+                (-u0 * c, -u0 * s, 0.0))
     return _petal(prm, u0, u1)

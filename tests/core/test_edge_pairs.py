@@ -1,0 +1,198 @@
+"""The edge and face pairs (`contact.pairs: complete`) in closed form (tests/edge_scenes.py): a
+ring's circle over a straight edge and over a tip arc (C-C), a tilted rim over a ring face (C-S)
+and the hand-over at a petal-like tip, tracked by Eq. (47) through prescribed motions to 1e-8;
+the compiled kernels against the Python reference to 1e-12."""
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from drake_dock.core.couple import evaluate_couple
+from drake_dock.core.kernels import seek as compiled_seek
+from drake_dock.core.kernels.jets import jet, patch_spec
+from drake_dock.core.kernels.tracked import TrackedCouples
+from drake_dock.core.patches import posed
+from drake_dock.core.seeking import contact_couple, seek_couple
+from drake_dock.docking.apds import ApdsGeometry, apds_patches
+from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec
+from edge_scenes import CORNER, rim_over_face, ring_over_arc, ring_over_segment, tip_handover
+
+SCENES = {"ring_over_segment": ring_over_segment, "ring_over_arc": ring_over_arc,
+          "rim_over_face": rim_over_face}
+TIMES = np.linspace(0.0, 1.0, 11)
+
+
+def _wrap(du, scene):
+    """Parameter differences with the periodic ones taken modulo 2 pi."""
+    per = list(scene.patch1.periodic) + list(scene.patch2.periodic)
+    return np.array([(d + math.pi) % (2 * math.pi) - math.pi if p else d
+                     for d, p in zip(du, per)])
+
+
+def _evaluate(scene, t, u, sigma=1.0, project=True):
+    X1, V1, X2, V2 = scene.poses(t)
+    return evaluate_couple(scene.kind, scene.patch1, X1, V1, scene.patch2, X2, V2, u, sigma,
+                           project=project)
+
+
+def _track(scene, t_span, u0, events=None):
+    def rhs(t, u):
+        return _evaluate(scene, t, u, project=False).udot
+
+    ts = [t for t in TIMES if t_span[0] <= t <= t_span[1]]
+    sol = solve_ivp(rhs, t_span, u0, method="DOP853", rtol=1e-12, atol=1e-14, t_eval=ts,
+                    events=events)
+    assert sol.success
+    return sol
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_seek_finds_the_closed_form_couple(name):
+    """At t = 0 the seek (Python and compiled) finds the closed-form couple, interior, and the
+    contact-form finish keeps it (a ring over a straight edge crosses it twice at the same
+    distance: either couple)."""
+    s = SCENES[name]()
+    exact = [s.exact(0.0, b) for b in s.branches]
+    X1, _, X2, _ = s.poses(0.0)
+    P1, P2 = posed(s.patch1, *X1), posed(s.patch2, *X2)
+    for seek in (seek_couple, compiled_seek.seek_couple):
+        c = seek(P1, P2)
+        assert c.interior
+        u, gap = min(exact, key=lambda e: np.abs(_wrap(c.u - e[0], s)).max())[:2]
+        assert c.distance == pytest.approx(gap, abs=1e-12)
+        np.testing.assert_allclose(_wrap(c.u - u, s), 0.0, atol=1e-8)
+    cc = contact_couple(s.kind, s.patch1, X1, s.patch2, X2, c, conditioning_min=1e-10)
+    assert cc.usable
+    np.testing.assert_allclose(_wrap(cc.u - u, s), 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_eq47_tracks_the_closed_form_couple(name):
+    """u* integrated by Eq. (47) over 1 s equals the closed-form couple to 1e-8; the gap, the
+    points and the normal (+z of Body 2, from Body 2 to Body 1) to 1e-10 once projected, and
+    the normal velocity equals the rate of the closed-form gap. sigma is fixed at t = 0 by the
+    side Body 1 lies on (docs/model.md, "Signed gap")."""
+    s = SCENES[name]()
+    u0 = s.exact(0.0)[0]
+    sigma = float(np.sign(_evaluate(s, 0.0, u0).gap))
+    sol = _track(s, (0.0, 1.0), u0)
+    errors = []
+    for k, t in enumerate(sol.t):
+        u, gap, p1, p2, n = s.exact(t)
+        errors.append(np.abs(_wrap(sol.y[:, k] - u, s)).max())
+        ev = _evaluate(s, t, sol.y[:, k], sigma)
+        assert ev.gap == pytest.approx(gap, abs=1e-10)
+        np.testing.assert_allclose(ev.p1, p1, atol=1e-10)
+        np.testing.assert_allclose(ev.p2, p2, atol=1e-10)
+        np.testing.assert_allclose(ev.n, n, atol=1e-10)
+        h = 1e-6
+        rate = (s.exact(t + h)[1] - s.exact(t - h)[1]) / (2 * h)
+        assert ev.vn == pytest.approx(rate, abs=1e-8)
+    assert max(errors) < 1e-8
+    print(f"{name}: max |u* - u_exact| = {max(errors):.2e}")
+
+
+def test_handover_at_the_tip_corner():
+    """The ring's crossing runs up the straight side to the corner Q and on along the tip arc.
+    The side's couple reaches its domain end u2 = 1 at the closed-form time t_h (|Q - c| = r)
+    by Eq. (47), where the arc's couple starts at its first end; the gap is continuous (both
+    equal the ring's height) and the normal is +z on both with the orientation
+    sigma = sign((t1 x t2) . z) of each pair, which the corner leaves unchanged (the edge
+    turns by less than the crossing angle)."""
+    side, arc, t_h = tip_handover()
+    end = lambda t, u: u[1] - 1.0
+    end.terminal = True
+    sol = _track(side, (0.0, 1.0), side.exact(0.0)[0], events=end)
+    assert sol.t_events[0][0] == pytest.approx(t_h, abs=1e-8)
+    for k, t in enumerate(sol.t):
+        np.testing.assert_allclose(_wrap(sol.y[:, k] - side.exact(t)[0], side), 0, atol=1e-8)
+    u_side = sol.y_events[0][0]
+    u_arc = arc.exact(t_h)[0]
+    assert u_arc[1] == pytest.approx(arc.patch2.lower[0], abs=1e-12)
+    np.testing.assert_allclose(arc.patch2.position(u_arc[1:]), CORNER, atol=1e-12)
+    sigmas = []
+    for s, u in ((side, u_side), (arc, u_arc)):
+        raw = _evaluate(s, t_h, u, project=False)
+        sigmas.append(float(np.sign(raw.n[2])))
+        ev = _evaluate(s, t_h, u, sigmas[-1], project=False)
+        assert ev.gap == pytest.approx(side.c[2](t_h), abs=1e-8)
+        np.testing.assert_allclose(ev.n, [0, 0, 1], atol=1e-8)
+    t1 = side.patch1.first(u_side[:1])[:, 0]
+    assert sigmas == [float(np.sign(np.cross(t1, side.patch2.b - side.patch2.a)[2])),
+                      float(np.sign(np.cross(t1, [-math.sin(0.3), math.cos(0.3), 0.0])[2]))]
+    sol = _track(arc, (t_h, 1.0), u_arc)
+    for k, t in enumerate(sol.t):
+        np.testing.assert_allclose(_wrap(sol.y[:, k] - arc.exact(t)[0], arc), 0, atol=1e-8)
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_kernels_equal_the_python_path(name):
+    """The compiled jets (the arc as a CIRCLE, the face as ANNULUS) and couple evaluation equal
+    the Python reference to 1e-12, at the couple and perturbed off it, both sigmas."""
+    s = SCENES[name]()
+    rng = np.random.default_rng(3)
+    for patch in (s.patch1, s.patch2):
+        kind, prm = patch_spec(patch)
+        for _ in range(10):
+            u = patch.lower + rng.random(patch.dim) * patch.span
+            r, T, K = patch.jet(u)
+            got = jet(kind, prm, u[0], u[1] if patch.dim == 2 else 0.0)
+            want = [r, T[0], K[0][0]] if patch.dim == 1 else [r, *T, K[0][0], K[0][1], K[1][1]]
+            got = [got[0], got[1], got[3]] if patch.dim == 1 else [got[0], *got[1:]]
+            np.testing.assert_allclose(np.array(got), np.array(want), rtol=0, atol=1e-15)
+    tc = TrackedCouples([(s.kind, s.patch1, s.patch2, (0, 1))])
+    assert tc.supported
+    for t in (0.1, 0.6):
+        X1, V1, X2, V2 = s.poses(t)
+        R, o = np.array([X1[0], X2[0]]), np.array([X1[1], X2[1]])
+        w, v = np.array([V1[0], V2[0]]), np.array([V1[1], V2[1]])
+        u0 = s.exact(t)[0]
+        for u, sigma in ((u0, 1.0), (u0 + 1e-3 * rng.normal(size=len(u0)), -1.0)):
+            out, _ = tc.evaluate(R, o, w, v, u, np.array([sigma]), np.ones(1, dtype=np.bool_))
+            ref = _evaluate(s, t, u, sigma)
+            got = tc.couple_eval(out, 0)
+            for f in ("u", "udot", "p1", "p2", "n", "ta", "tb", "gap", "vn", "vt", "bias_n",
+                      "bias_t"):
+                want = np.asarray(getattr(ref, f), dtype=float)
+                np.testing.assert_allclose(getattr(got, f), want, rtol=0,
+                                           atol=1e-12 * (1.0 + np.abs(want).max()), err_msg=f)
+
+
+def test_complete_set_names_and_patches(geom):
+    """`paper` is the 12 pairs; `complete` adds, per APDS, its ring's inside circle against the
+    other's 6 sides and 3 tip arcs and its rim against the other's face (20 pairs)."""
+    paper, complete = apds_pairs(geom), apds_pairs(geom, "complete")
+    assert [p.name for p in complete[:12]] == [p.name for p in paper] and len(paper) == 12
+    new = {p.name: p for p in complete[12:]}
+    assert len(new) == 20
+    P = apds_patches(geom)
+    assert new["cc_Cring_T3"].patch2 is not None and new["cc_Cring_T3"].kind == "CC"
+    assert new["cc_Tring_Ctip2"].body1 == "target_apds"
+    assert new["cs_Crim_Tface"].kind == "CS" and new["cs_Crim_Tface"].body2 == "target_apds"
+    # The tip arc is where the guide surface meets zeta = H, between its two sides' ends.
+    for k in (1, 2, 3):
+        tip, surf = P.tips[k], P.surfaces[k]
+        np.testing.assert_allclose(tip.position(tip.lower), surf.position([0.0, geom.H]),
+                                   atol=1e-15)
+        np.testing.assert_allclose(tip.position(tip.upper), surf.position([1.0, geom.H]),
+                                   atol=1e-15)
+    with pytest.raises(ValueError, match="contact.pairs"):
+        apds_pairs(geom, "all")
+
+
+@pytest.mark.parametrize("g", [ApdsGeometry(), ApdsGeometry(R=0.9, Rs=0.55, H=0.3,
+                                                            alpha1_deg=50.0, alpha2_deg=25.0)])
+@pytest.mark.parametrize("d", [0.12, 0.02, -0.05])
+def test_complete_pairs_compiled_seek_equals_python(g, d):
+    """The 20 new pairs, the chaser tilted, offset and at ring distance d: the compiled seek
+    gives the Python seek's distance to 1e-12 and the same interior flag."""
+    poses = {"target_apds": (np.eye(3), np.zeros(3)),
+             "chaser_apds": (rot_vec((0.03, -0.02, 0.01)) @ R_MATCHED,
+                             np.array([0.03, -0.02, d]))}
+    for pr in apds_pairs(g, "complete")[12:]:
+        P1, P2 = posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2])
+        assert compiled_seek.supported(P1, P2)
+        ref, got = seek_couple(P1, P2), compiled_seek.seek_couple(P1, P2)
+        assert got.distance == pytest.approx(ref.distance, rel=0, abs=1e-12), pr.name
+        assert got.interior == ref.interior, pr.name

@@ -1,0 +1,190 @@
+"""Small scenes of the edge and face pairs with closed-form couples along prescribed motions: a
+ring's circle over a straight edge and over a circular arc (C-C), a tilted ring rim over a ring
+face (C-S), and an edge made of a straight side and a tip arc meeting at a corner.
+
+Body 2 (the edge or face) turns about its z axis by chi(t) and translates by p2(t); Body 1 (the
+ring) is posed relative to it by R_rel = Rz(beta) Rx(tau) Rz(psi) and its centre c (Body 2's
+frame). All curves of Body 2 lie in its plane z = 0, so a horizontal ring at height c_z is at
+least c_z from them, with equality where its projection crosses them: the couple."""
+import math
+
+import numpy as np
+
+from drake_dock.core.patches import Annulus, Arc, Circle, Segment
+from drake_dock.docking.scene import rot_x, rot_z
+
+EZ = np.array([0.0, 0.0, 1.0])
+
+
+class Wave:
+    """f(t) = a + b sin(w t + p) + v t, with f'(t)."""
+
+    def __init__(self, a, b=0.0, w=1.0, p=0.0, v=0.0):
+        self.a, self.b, self.w, self.p, self.v = a, b, w, p, v
+
+    def __call__(self, t):
+        return self.a + self.b * math.sin(self.w * t + self.p) + self.v * t
+
+    def rate(self, t):
+        return self.b * self.w * math.cos(self.w * t + self.p) + self.v
+
+
+class EdgeScene:
+    """A pair of Body 1 (a ring's circle, radius r) against Body 2 along a prescribed motion;
+    ``exact(t)`` gives the couple, gap and points in closed form."""
+
+    def __init__(self, kind, patch1, patch2, c, psi, tau=Wave(0.0), beta=Wave(0.0),
+                 chi=Wave(0.0, 0.2, 1.1), p2=(Wave(0.0, 0.01, 1.0), Wave(0.0, v=-0.02),
+                                             Wave(0.0, 0.005, 2.0))):
+        self.kind, self.patch1, self.patch2 = kind, patch1, patch2
+        self.c, self.psi, self.tau, self.beta, self.chi, self.p2 = c, psi, tau, beta, chi, p2
+        self.r = patch1.radius
+        self.branches = (1,)          # the closed-form couples at the least distance
+
+    def relative(self, t):
+        R = rot_z(self.beta(t)) @ rot_x(self.tau(t)) @ rot_z(self.psi(t))
+        w = (self.beta.rate(t) * EZ + self.tau.rate(t) * (rot_z(self.beta(t)) @ [1.0, 0, 0])
+             + self.psi.rate(t) * (rot_z(self.beta(t)) @ rot_x(self.tau(t)) @ EZ))
+        return R, w, np.array([f(t) for f in self.c]), np.array([f.rate(t) for f in self.c])
+
+    def poses(self, t):
+        """World poses X_i = (R_i, p_i) and twists V_i = (w_i, v_i) of the two bodies."""
+        R2, p2 = rot_z(self.chi(t)), np.array([f(t) for f in self.p2])
+        w2, v2 = self.chi.rate(t) * EZ, np.array([f.rate(t) for f in self.p2])
+        Rr, wr, c, cd = self.relative(t)
+        p1 = p2 + R2 @ c
+        v1 = v2 + np.cross(w2, R2 @ c) + R2 @ cd
+        return (R2 @ Rr, p1), (w2 + R2 @ wr, v1), (R2, p2), (w2, v2)
+
+    def world(self, t, x1, x2):
+        """Body 2's frame points x1 (on the ring) and x2 to the world."""
+        R2, p2 = rot_z(self.chi(t)), np.array([f(t) for f in self.p2])
+        return p2 + R2 @ x1, p2 + R2 @ x2
+
+
+def ring_angle(scene, t, x):
+    """The ring's parameter of its point above x (Body 2's frame) for a horizontal ring."""
+    c = np.array([f(t) for f in scene.c])
+    return (math.atan2(x[1] - c[1], x[0] - c[0]) - scene.psi(t) - scene.beta(t)) % (2 * math.pi)
+
+
+def line_crossing(scene, t, a, b, branch):
+    """The ring's projection crossing the line a + s (b - a): (s, point), the larger root s for
+    branch +1."""
+    c = np.array([f(t) for f in scene.c])
+    w, e = a[:2] - c[:2], b[:2] - a[:2]
+    ee, we = e @ e, w @ e
+    s = (-we + branch * math.sqrt(we * we - ee * (w @ w - scene.r ** 2))) / ee
+    return s, a + s * (b - a)
+
+
+def arc_crossing(scene, t, radius, branch):
+    """The ring's projection crossing the circle |x| = radius about Body 2's axis: (theta,
+    point), on the side +1 or -1 of the line from the axis to the ring's centre."""
+    c = np.array([f(t) for f in scene.c])
+    D = math.hypot(c[0], c[1])
+    e = c[:2] / D
+    ell = (radius ** 2 - scene.r ** 2 + D * D) / (2 * D)
+    h = math.sqrt(radius ** 2 - ell * ell)
+    x = ell * e + branch * h * np.array([-e[1], e[0]])
+    return math.atan2(x[1], x[0]), np.array([x[0], x[1], 0.0])
+
+
+def exact_cc(scene, t, u2, x2):
+    """(u, gap, p1, p2, n) of a horizontal ring above the Body 2 point x2 (parameter u2)."""
+    cz = scene.c[2](t)
+    x1 = x2 + cz * EZ
+    p1, p2 = scene.world(t, x1, x2)
+    return np.array([ring_angle(scene, t, x2), u2]), cz, p1, p2, EZ
+
+
+def ring_over_segment():
+    """A ring (radius 0.4) at 30 mm +- 10 mm over the straight edge x in [-1, 1] of Body 2,
+    crossing it at an angle while both bodies turn and translate."""
+    seg = Segment((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0))
+    s = EdgeScene("CC", Circle(0.4), seg,
+                  (Wave(0.0, 0.1, 0.7), Wave(0.15, v=0.1), Wave(0.03, 0.01, 1.3)),
+                  Wave(0.0, 0.5, 0.9))
+
+    def exact(t, branch=+1):
+        u2, x2 = line_crossing(s, t, seg.a, seg.b, branch)
+        return exact_cc(s, t, u2, x2)
+
+    s.exact, s.branches = exact, (1, -1)      # two crossings at the same distance
+    return s
+
+
+def ring_over_arc():
+    """A ring (radius 0.4) at 25 mm +- 10 mm over a tip-like arc (radius 0.45, theta in
+    [0.2, 1.4]); its projection crosses the arc once inside that range."""
+    arc = Arc(0.45, 0.0, (0.2, 1.4))
+    s = EdgeScene("CC", Circle(0.4), arc,
+                  (Wave(0.19, 0.02, 0.8), Wave(-0.06, 0.03, 1.1), Wave(0.025, 0.01, 1.7)),
+                  Wave(0.3, 0.4, 0.6))
+
+    def exact(t, branch=+1):
+        th, x2 = arc_crossing(s, t, arc.radius, branch)
+        return exact_cc(s, t, th, x2)
+
+    s.exact = exact
+    return s
+
+
+def rim_over_face():
+    """A ring rim (radius 0.6) tilted by tau ~ 0.1 rad about an axis turned by beta, its
+    centre offset ~0.1 m, over a ring face (0.4 <= rho <= 0.6): the couple is the rim's lowest
+    point, at height c_z - r sin(tau), above the face."""
+    face = Annulus(0.4, 0.6, 0.0)
+    s = EdgeScene("CS", Circle(0.6), face,
+                  (Wave(0.02, 0.01, 0.9), Wave(0.1, 0.01, 1.2), Wave(0.09, 0.01, 1.4)),
+                  Wave(0.2, 0.6, 0.8), tau=Wave(0.1, 0.02, 1.0), beta=Wave(0.05, 0.1, 0.7))
+
+    def exact(t, branch=+1):
+        tau, beta = s.tau(t), s.beta(t)
+        c = np.array([f(t) for f in s.c])
+        x1 = c + rot_z(beta) @ np.array([0.0, -s.r * math.cos(tau), -s.r * math.sin(tau)])
+        x2 = np.array([x1[0], x1[1], 0.0])
+        u = np.array([(-0.5 * math.pi - s.psi(t)) % (2 * math.pi), math.hypot(x2[0], x2[1]),
+                      math.atan2(x2[1], x2[0]) % (2 * math.pi)])
+        p1, p2 = s.world(t, x1, x2)
+        return u, x1[2], p1, p2, EZ
+
+    s.exact = exact
+    return s
+
+
+# The petal-like tip: a straight side from A on the outer circle (radius 0.6) to the corner Q
+# on the tip circle (radius 0.4), then the tip arc from Q (a corner, as at an APDS petal tip).
+TIP_RADIUS, THETA_Q = 0.4, 0.3
+CORNER = np.array([TIP_RADIUS * math.cos(THETA_Q), TIP_RADIUS * math.sin(THETA_Q), 0.0])
+SIDE_START = np.array([0.6, 0.0, 0.0])
+
+
+def tip_handover():
+    """A ring (radius 0.4) at 20 mm +- 5 mm whose projection crosses the side, the crossing
+    running up to the corner Q and on along the tip arc (the ring moves along the bisector of
+    the two edges' directions at Q): (side scene, arc scene, closed-form hand-over time, when
+    |Q - c| = r)."""
+    side = Segment(SIDE_START, CORNER)
+    arc = Arc(TIP_RADIUS, 0.0, (THETA_Q, THETA_Q + 0.8))
+    c = (Wave(0.6995, v=-0.127), Wave(-0.2683, v=0.1546), Wave(0.02, 0.005, 1.5))
+    psi = Wave(0.1, 0.3, 1.2)
+    scenes = [EdgeScene("CC", Circle(0.4), side, c, psi),
+              EdgeScene("CC", Circle(0.4), arc, c, psi)]
+
+    def exact_side(t):
+        u2, x2 = line_crossing(scenes[0], t, side.a, side.b, +1)
+        return exact_cc(scenes[0], t, u2, x2)
+
+    def exact_arc(t):
+        th, x2 = arc_crossing(scenes[1], t, TIP_RADIUS, +1)
+        return exact_cc(scenes[1], t, th, x2)
+
+    scenes[0].exact, scenes[1].exact = exact_side, exact_arc
+    # |Q - c(t)|^2 = r^2 with c linear in t: a quadratic; its root in [0, 1].
+    q0 = CORNER[:2] - np.array([c[0].a, c[1].a])
+    v = -np.array([c[0].v, c[1].v])           # Q - c(t) = q0 + v t
+    A, B, C = v @ v, 2 * q0 @ v, q0 @ q0 - 0.16
+    roots = [(-B + k * math.sqrt(B * B - 4 * A * C)) / (2 * A) for k in (-1, 1)]
+    (t_h,) = [x for x in roots if 0.0 <= x <= 1.0]
+    return scenes[0], scenes[1], t_h
