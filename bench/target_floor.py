@@ -11,8 +11,8 @@ wall time 10x would need, and that time against two floors measured here:
   (drake_dock's architecture: a custom LeafSystem supplies the contact forces). No
   implementation in that architecture that needs as many evaluations runs below it.
 
-Also each metric's contact effect: its change from t = 0 to capture relative to its value at
-capture; a tolerance that is a large share of it is met by runs that barely resolve contact.
+Errors are relative to each metric's contact effect, as in the study
+(`drake_dock.studies.docking_metrics`).
 
     python bench/target_floor.py [--repeats 5]
 """
@@ -31,7 +31,8 @@ from drake_dock.studies.compliant import (CompliantConfig, hunt_crossley_dissipa
 from drake_dock.docking.scene import initial_state
 from drake_dock.docking.simulate import simulate
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.studies.speed_accuracy import METRICS, rigid_metrics
+from drake_dock.studies.docking_metrics import (METRICS, compliant_metrics, contact_effect,
+                                                errors, rigid_metrics, scene_start)
 from drake_dock.systems.simulator import make_simulator
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -74,13 +75,14 @@ def main():
     tol = args.tolerance
     scenario = load_scenario(PAPER_EXAMPLE)
     state = initial_state(scenario)
-    e3 = state.X_WB["target_apds"][0][:, 2].copy()
+    start = scene_start(scenario, state)
     sc = copy.deepcopy(scenario)
     sc.simulator_config.accuracy = 1e-8
-    ref = rigid_metrics(simulate(sc, state=state), e3)
+    ref = rigid_metrics(simulate(sc, state=state), start)
+    effect = contact_effect(ref, start)
 
     def err(m):
-        return {k: abs(m[k] - ref[k]) / abs(ref[k]) for k in METRICS}
+        return errors(m, ref, effect)
 
     fast = copy.deepcopy(scenario)
     fast.simulator_config.accuracy = 1e-3
@@ -88,7 +90,7 @@ def main():
     runs = [simulate(fast, state=state) for _ in range(args.repeats)]
     t_dd = float(np.median([r.wall_time for r in runs]))
     evals = runs[0].evaluations
-    e_dd = err(rigid_metrics(runs[0], e3))
+    e_dd = err(rigid_metrics(runs[0], start))
     d_hc = hunt_crossley_dissipation(scenario.contact.restitution,
                                      scenario.initial.chaser_speed)
     rows = []
@@ -96,19 +98,10 @@ def main():
         for h in (1e-2, 3e-3):
             cfg = CompliantConfig("point", k_c, h, dissipation=d_hc)
             r = run_compliant(scenario, state, cfg, t_max=2 * ref["capture_time"])
-            m = {"capture_time": r.capture_time, "apds_spin_rate": r.apds_spin_rate,
-                 "chaser_axial_velocity": r.chaser_axial_velocity,
-                 "peak_contact_force": r.peak_force}
+            m = compliant_metrics(r, start)
             rows.append((cfg.label(), r.wall_time, err(m) if r.captured else None))
     leaf = empty_leaf_cost(scenario.simulator_config.integration_scheme)
     t_free = free_flight(fast, state, ref["capture_time"])
-    w0 = state.V_WB["target_apds"][0] @ e3
-    v0 = state.V_WB["chaser"][1] @ e3
-    effect = {"capture_time": None,
-              "apds_spin_rate": abs(ref["apds_spin_rate"] - w0) / abs(ref["apds_spin_rate"]),
-              "chaser_axial_velocity": abs(ref["chaser_axial_velocity"] - v0)
-              / abs(ref["chaser_axial_velocity"]),
-              "peak_contact_force": None}
     print("coarse compliant runs (point contact, SAP), errors against drake_dock at 1e-8:")
     for label, wall, e in rows:
         es = ("no capture" if e is None else
@@ -125,7 +118,7 @@ def main():
           f"{1e3 * floor:.2f} ms (drake_dock now: {t_dd / floor:.0f}x the floor)")
     for k in METRICS:
         ok = [(w, label) for label, w, e in rows if e is not None and e[k] <= tol]
-        eff = "" if effect[k] is None else f"; contact effect {effect[k]:.3g}"
+        eff = f"; contact effect {effect[k]:.4g}"
         if not ok:
             print(f"target {k}: no coarse compliant run within {tol:g}{eff}")
             continue

@@ -20,10 +20,11 @@ dissipation ``dissipation`` (s/m) and Coulomb friction (mu_s, mu). Time stepping
 at ``time_step`` > 0, or continuous (``time_step`` = 0) with error-controlled Runge-Kutta 3 at
 ``accuracy``.
 
-Capture and the study's metrics are read by a simulator monitor after every step: the axial
-ring-centre distance, the chaser's velocity and the APDS's angular velocity, and the net contact
-force on the chaser from its momentum change over the step (the chaser feels no other force: no
-gravity, no Stewart element). The capture time and the states at capture are interpolated
+A simulator monitor records the time, the axial ring-centre distance (for capture) and the
+plant's state after every step. After the run (outside its wall time) the states give the
+chaser's velocity, the APDS's angular velocity, the Stewart stroke, and the net contact force
+on the chaser from its momentum change over each step (the chaser feels no other force: no
+gravity, no Stewart element). The capture time and the values at capture are interpolated
 linearly between the two steps around it.
 """
 import dataclasses
@@ -45,7 +46,8 @@ from scipy.spatial import ConvexHull
 
 from drake_dock.docking.apds import guide_surface
 from drake_dock.docking.diagram import axial_ring_distance
-from drake_dock.docking.plant import DockingPlant, populate_plant, set_initial_state
+from drake_dock.docking.plant import (DockingPlant, populate_plant, set_initial_state,
+                                      stewart_deflection)
 from drake_dock.errors import InputError
 from drake_dock.systems.simulator import make_simulator
 
@@ -205,11 +207,14 @@ class CompliantRun:
     apds_spin_rate: float | None       # target APDS angular velocity . e3 at capture [rad/s]
     chaser_axial_velocity: float | None   # chaser velocity . e3 at capture [m/s]
     peak_force: float | None           # peak |net contact force on the chaser| in [t_c/2, t_c]
+    chaser_velocity: np.ndarray | None   # at capture [m/s]
+    stroke_at_capture: float | None    # |Stewart deflection| at capture [m]
     wall_time: float
     steps: int
     t: np.ndarray                      # step ends
     force: np.ndarray                  # [N, 3] net contact force on the chaser over each step
     ring_distance: np.ndarray
+    stroke: np.ndarray                 # |Stewart deflection| at the step ends [m]
     error: str | None = None
     stopped: bool = False              # ended by the wall-time limit
 
@@ -226,17 +231,15 @@ def run_compliant(scenario, state, cfg: CompliantConfig, *, t_max: float,
         dp, plant.GetMyMutableContextFromRoot(root), state))
     root = sim.get_mutable_context()
     e3 = state.X_WB["target_apds"][0][:, 2].copy()
-    chaser, apds = dp.bodies["chaser"], dp.bodies["target_apds"]
     m_c = scenario.bodies.chaser.mass
     cap = scenario.simulation.capture_distance
-    rec = {"t": [], "d": [], "v": [], "w": []}
+    rec = {"t": [], "d": [], "x": []}
 
     def sample():
         c = plant.GetMyContextFromRoot(root)
         rec["t"].append(root.get_time())
         rec["d"].append(axial_ring_distance(dp, c))
-        rec["v"].append(plant.EvalBodySpatialVelocityInWorld(c, chaser).translational().copy())
-        rec["w"].append(plant.EvalBodySpatialVelocityInWorld(c, apds).rotational().copy())
+        rec["x"].append(plant.GetPositionsAndVelocities(c))
 
     stopped = [False]
 
@@ -261,18 +264,33 @@ def run_compliant(scenario, state, cfg: CompliantConfig, *, t_max: float,
     wall = _time.perf_counter() - w0
     t = np.array(rec["t"])
     d = np.array(rec["d"])
-    v = np.array(rec["v"])
-    w = np.array(rec["w"])
+    v, w, stroke = _step_ends(dp, rec["x"])
     force = m_c * np.diff(v, axis=0) / np.maximum(np.diff(t), 1e-300)[:, None]
     captured = len(d) > 1 and d[-1] <= cap < d[-2]
-    t_c = spin = vax = peak = None
+    t_c = spin = v_c = s_c = peak = None
     if captured:
         a = (d[-2] - cap) / (d[-2] - d[-1])
         t_c = float(t[-2] + a * (t[-1] - t[-2]))
         spin = float(((1 - a) * w[-2] + a * w[-1]) @ e3)
-        vax = float(((1 - a) * v[-2] + a * v[-1]) @ e3)
+        v_c = (1 - a) * v[-2] + a * v[-1]
+        s_c = float((1 - a) * stroke[-2] + a * stroke[-1])
         tm = 0.5 * (t[1:] + t[:-1])
         win = (tm >= 0.5 * t_c) & (tm <= t_c)
         peak = float(np.linalg.norm(force[win], axis=1).max()) if win.any() else None
-    return CompliantRun(cfg, captured, t_c, spin, vax, peak, wall, len(t) - 1, t, force, d,
-                        error, stopped[0])
+    return CompliantRun(cfg, captured, t_c, spin, None if v_c is None else float(v_c @ e3), peak,
+                        v_c, s_c, wall, len(t) - 1, t, force, d, stroke, error, stopped[0])
+
+
+def _step_ends(dp, X):
+    """The chaser's velocity [N, 3], the target APDS's angular velocity [N, 3] and the
+    Stewart element's |deflection| [N] at the recorded plant states X."""
+    plant = dp.plant
+    pc = plant.CreateDefaultContext()
+    n = len(X)
+    v, w, stroke = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n)
+    for k, x in enumerate(X):
+        plant.SetPositionsAndVelocities(pc, x)
+        v[k] = plant.EvalBodySpatialVelocityInWorld(pc, dp.bodies["chaser"]).translational()
+        w[k] = plant.EvalBodySpatialVelocityInWorld(pc, dp.bodies["target_apds"]).rotational()
+        stroke[k] = np.linalg.norm(stewart_deflection(dp, pc)[0])
+    return v, w, stroke
