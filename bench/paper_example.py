@@ -86,7 +86,8 @@ def main():
     t0 = time.perf_counter()
     state = initial_state(scenario)
     t_state = time.perf_counter() - t0
-    seeks = first_contact_seeks(scenario.geometry, contact_approach(scenario)[0])
+    seeks = first_contact_seeks(scenario.geometry, contact_approach(scenario)[0],
+                                which=scenario.contact.pairs)
     t0 = time.perf_counter()
     dd = build_docking_diagram(scenario)
     t_build = time.perf_counter() - t0

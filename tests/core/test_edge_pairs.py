@@ -167,7 +167,11 @@ def test_complete_set_names_and_patches(geom):
     new = {p.name: p for p in complete[12:]}
     assert len(new) == 20
     P = apds_patches(geom)
-    assert new["cc_Cring_T3"].patch2 is not None and new["cc_Cring_T3"].kind == "CC"
+    side = new["cc_Cring_T3"]
+    assert side.kind == "CC" and type(side.patch2) is type(P.sides[3])
+    for patch, expected in ((side.patch2, P.sides[3]), (side.patch1, P.ring)):
+        for u in np.linspace(patch.lower, patch.upper, 5):
+            assert np.array_equal(patch.position(u), expected.position(u))
     assert new["cc_Tring_Ctip2"].body1 == "target_apds"
     assert new["cs_Crim_Tface"].kind == "CS" and new["cs_Crim_Tface"].body2 == "target_apds"
     # The tip arc is where the guide surface meets zeta = H, between its two sides' ends.

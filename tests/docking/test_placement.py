@@ -52,10 +52,9 @@ def test_search_equals_the_full_scan(name):
     approach = APPROACHES[name]
     try:
         expected = full_scan(g, approach)
-    except NumericalError as e:
+    except NumericalError:
         with pytest.raises(NumericalError, match="no pair closes"):
             first_contact(g, approach)
-        assert "no pair closes" in str(e)
         return
     lam, names = first_contact(g, approach)
     assert (lam, names) == expected[:2]

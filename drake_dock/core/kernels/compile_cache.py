@@ -10,16 +10,23 @@ directory is, in order:
 3. otherwise (a read-only install) ``$XDG_CACHE_HOME/drake_dock/numba``, by default
    ``~/.cache/drake_dock/numba``.
 
-`configure` sets ``NUMBA_CACHE_DIR`` for case 3 before numba is imported; `cache_dir` says which
-directory is in use. ``python -m drake_dock.core.kernels`` compiles (or loads)
+Inside it the kernels go to ``drake_dock-<key>``, where the key is a digest of the sources of
+``drake_dock/core`` and numba's version (`source_key`): numba checks only a kernel's own file,
+so without the key a kernel whose callee in another module changed would load stale machine
+code. `configure` sets ``NUMBA_CACHE_DIR`` to that directory before numba is imported;
+`cache_dir` says which directory is in use. ``python -m drake_dock.core.kernels`` compiles (or loads)
 every kernel once and prints the directory.
 """
 from __future__ import annotations
 
+import hashlib
+import importlib.metadata
 import os
 import pathlib
 
 _HERE = pathlib.Path(__file__).resolve().parent
+_CORE = _HERE.parent
+PREFIX = "drake_dock-"
 
 
 def user_cache_dir() -> pathlib.Path:
@@ -37,13 +44,28 @@ def _writable(path: pathlib.Path) -> bool:
     return os.access(probe, os.W_OK)
 
 
+def source_key(root: pathlib.Path = _CORE) -> str:
+    """A digest of every Python source under ``root`` (their paths and bytes) and of numba's
+    version: it changes whenever a kernel or a module a kernel calls changes."""
+    digest = hashlib.sha256(importlib.metadata.version("numba").encode())
+    for path in sorted(root.rglob("*.py")):
+        digest.update(path.relative_to(root).as_posix().encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
 def configure() -> None:
-    """Sets ``NUMBA_CACHE_DIR`` to the user cache directory when it is not set and the package
-    directory is not writable (and numba's config, in case numba was imported before)."""
-    if os.environ.get("NUMBA_CACHE_DIR") or _writable(_HERE):
-        return
-    path = user_cache_dir()
-    path.mkdir(parents=True, exist_ok=True)
+    """Sets ``NUMBA_CACHE_DIR`` (and numba's config, in case numba was imported before) to
+    ``drake_dock-<source_key()>`` inside the directory of the module docstring's rules."""
+    base = os.environ.get("NUMBA_CACHE_DIR")
+    if base and pathlib.Path(base).name.startswith(PREFIX):
+        base = str(pathlib.Path(base).parent)      # set by this function in a parent process
+    if not base:
+        base = str(_HERE / "__pycache__") if _writable(_HERE) else str(user_cache_dir())
+    path = pathlib.Path(base) / f"{PREFIX}{source_key()}"
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        pass                               # numba then compiles without caching
     os.environ["NUMBA_CACHE_DIR"] = str(path)
     from numba.core import config      # numba reads the variable once, at its import
     config.CACHE_DIR = str(path)
