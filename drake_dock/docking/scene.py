@@ -266,10 +266,18 @@ class _Gaps:
         return brentq(f, self.grid[k + 1], self.grid[k], xtol=xtol, rtol=1e-15)
 
 
+@functools.lru_cache(maxsize=16)
+def search_pairs(geometry: tuple, which: str) -> tuple:
+    """The pairs of the set ``which`` for the geometry ``dataclasses.astuple(g)``, built once
+    per geometry and set: what their patches keep (covers, coarse grids, kernel descriptions)
+    serves every approach the search is asked about."""
+    return tuple(apds_pairs(ApdsGeometry(*geometry), which))
+
+
 @functools.lru_cache(maxsize=64)
 def _first_contact(geometry: tuple, approach: Approach, step, xtol, which):
     g = ApdsGeometry(*geometry)
-    pairs = apds_pairs(g, which)
+    pairs = search_pairs(geometry, which)
     grid = travel_grid(g, approach, step)
     touch = touch_steps(pairs, approach, grid)
     gaps = _Gaps(pairs, approach, grid)

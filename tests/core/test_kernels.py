@@ -8,7 +8,7 @@ import pytest
 
 from drake_dock.core.couple import evaluate_couple
 from drake_dock.core.kernels import couples as K
-from drake_dock.core.kernels.jets import jet, patch_spec
+from drake_dock.core.kernels.jets import jet, patch_spec, position
 from drake_dock.core.kernels.tracked import TrackedCouples
 from drake_dock.core.patches import Circle, Cone, PlaneRect, PolarCurve, Segment, posed
 from drake_dock.core.seeking import seek_couple
@@ -42,6 +42,20 @@ def test_jets_equal_the_patches(g):
             got = jet(kind, prm, u[0], u[1] if patch.dim == 2 else 0.0)
             got = [got[0], got[1]] + ([got[3]] if patch.dim == 1 else [got[2], *got[3:]])
             np.testing.assert_allclose(np.array(got), np.array(want), rtol=1e-12, atol=1e-13)
+
+
+@pytest.mark.parametrize("g", GEOMETRIES)
+def test_position_is_the_jets_point(g):
+    """`position` (the seek's grids) gives the bits of the jet's r, for every kind, at random
+    points of each domain and on its ends."""
+    P = apds_patches(g)
+    rng = np.random.default_rng(2)
+    for patch in _patches(g) + [*P.tips.values(), P.rim, P.face]:
+        kind, prm = patch_spec(patch)
+        U = patch.lower + rng.random((200, patch.dim)) * patch.span
+        for u in np.concatenate([U, [patch.lower, patch.upper]]):
+            u1 = u[1] if patch.dim == 2 else 0.0
+            assert position(kind, prm, u[0], u1) == jet(kind, prm, u[0], u1)[0], (patch, u)
 
 
 def test_patch_spec_declines_an_undescribed_curve():

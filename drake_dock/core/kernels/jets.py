@@ -18,7 +18,8 @@ both give the same bits. The kinds:
   theta_1 of Eq. (13) (a guide surface).
 
 Each jet is returned as six 3-tuples (r, T0, T1, K00, K01, K11); a curve's T1, K01, K11 are
-zero.
+zero. `position` is r alone, with the same operations as `jet` (the same bits) and none of the
+derivatives: the seek's grids need only points.
 """
 from __future__ import annotations
 
@@ -139,3 +140,29 @@ def jet(kind, prm, u0, u1):
         return ((u0 * c, u0 * s, prm[0]), (c, s, 0.0), (-u0 * s, u0 * c, 0.0), _Z, r_rt,
                 (-u0 * c, -u0 * s, 0.0))
     return _petal(prm, u0, u1)
+
+
+@njit(cache=True)
+def position(kind, prm, u0, u1):
+    """r of `jet` (the same operations, the same bits) without the derivatives."""
+    if kind == CIRCLE:
+        return prm[0] * math.cos(u0), prm[0] * math.sin(u0), prm[1]
+    if kind == SEGMENT:
+        return (prm[0] + u0 * (prm[3] - prm[0]), prm[1] + u0 * (prm[4] - prm[1]),
+                prm[2] + u0 * (prm[5] - prm[2]))
+    if kind == PLANE:
+        return (prm[0] + u0 * prm[3] + u1 * prm[6], prm[1] + u0 * prm[4] + u1 * prm[7],
+                prm[2] + u0 * prm[5] + u1 * prm[8])
+    if kind == CONE:
+        rho = prm[0] - u1 * prm[1]
+        return rho * math.cos(u0), rho * math.sin(u0), u1
+    if kind == SINE_POLAR:
+        rho = prm[0] / math.sin(prm[5] + prm[1] * (u0 - prm[2]))
+        return rho * math.cos(u0), rho * math.sin(u0), (prm[4] - rho) * prm[3]
+    if kind == ANNULUS:
+        return u0 * math.cos(u1), u0 * math.sin(u1), prm[0]
+    # PETAL (`_petal`): theta across the petal (Eq. 13), then the cone (Eq. 12).
+    t1 = math.asin(prm[4] / (prm[6] - u1 * prm[3])) - prm[5]
+    th = prm[2] + t1 + u0 * (math.pi / 3 - 2 * t1)
+    rho = prm[0] - u1 * prm[1]
+    return rho * math.cos(th), rho * math.sin(th), u1

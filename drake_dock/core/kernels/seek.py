@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numba import njit
 
-from drake_dock.core.kernels.jets import jet, patch_spec
+from drake_dock.core.kernels.jets import jet, patch_spec, position
 from drake_dock.core.seeking import Couple, is_interior
 from drake_dock.errors import SeekingError
 
@@ -21,7 +21,7 @@ EPS8 = 8 * np.finfo(float).eps
 
 @njit(cache=True)
 def _point(kind, prm, R, o, u0, u1):
-    r = jet(kind, prm, u0, u1)[0]
+    r = position(kind, prm, u0, u1)
     return (R[0, 0] * r[0] + R[0, 1] * r[1] + R[0, 2] * r[2] + o[0],
             R[1, 0] * r[0] + R[1, 1] * r[1] + R[1, 2] * r[2] + o[1],
             R[2, 0] * r[0] + R[2, 1] * r[1] + R[2, 2] * r[2] + o[2])
@@ -29,9 +29,16 @@ def _point(kind, prm, R, o, u0, u1):
 
 @njit(cache=True)
 def _positions(kind, prm, R, o, U):
+    """The points R r(u) + o (Eq. 20) at the rows u of U, as `_point` computes them."""
     X = np.empty((U.shape[0], 3))
+    r00, r01, r02, r10, r11, r12 = R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2]
+    r20, r21, r22, o0, o1, o2 = R[2, 0], R[2, 1], R[2, 2], o[0], o[1], o[2]
+    two = U.shape[1] == 2
     for a in range(U.shape[0]):
-        X[a] = _point(kind, prm, R, o, U[a, 0], U[a, 1] if U.shape[1] == 2 else 0.0)
+        r = position(kind, prm, U[a, 0], U[a, 1] if two else 0.0)
+        X[a, 0] = r00 * r[0] + r01 * r[1] + r02 * r[2] + o0
+        X[a, 1] = r10 * r[0] + r11 * r[1] + r12 * r[2] + o1
+        X[a, 2] = r20 * r[0] + r21 * r[1] + r22 * r[2] + o2
     return X
 
 
@@ -43,6 +50,22 @@ def _d2(X1, X2):
             a, b, c = X1[i, 0] - X2[j, 0], X1[i, 1] - X2[j, 1], X1[i, 2] - X2[j, 2]
             D[i, j] = a * a + b * b + c * c
     return D
+
+
+@njit(cache=True)
+def _argmin_d2(X1, X2):
+    """(i, j) of np.argmin(_d2(X1, X2)) without the matrix: the first least entry, or the
+    first NaN."""
+    best, bi, bj = np.inf, 0, 0
+    for i in range(X1.shape[0]):
+        for j in range(X2.shape[0]):
+            a, b, c = X1[i, 0] - X2[j, 0], X1[i, 1] - X2[j, 1], X1[i, 2] - X2[j, 2]
+            d = a * a + b * b + c * c
+            if d < best:
+                best, bi, bj = d, i, j
+            elif d != d:
+                return i, j
+    return bi, bj
 
 
 @njit(cache=True)
@@ -63,6 +86,15 @@ def _local_grid(c, hw, lower, upper, periodic, n):
                 span = upper[k] - lower[k]
                 G[a, k] = lower[k] + np.mod(G[a, k] - lower[k], span)
     return G
+
+
+@njit(cache=True)
+def _within(u, c, w):
+    """All |u - c| <= w."""
+    for k in range(u.shape[0]):
+        if not abs(u[k] - c[k]) <= w[k]:
+            return False
+    return True
 
 
 @njit(cache=True)
@@ -88,21 +120,18 @@ def hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, p
             break
         C1[C], C2[C] = U1[bi], U2[bj]
         C += 1
-        near1 = np.array([np.all(np.abs(U1[i] - U1[bi]) <= 2 * h1) for i in range(U1.shape[0])])
-        near2 = np.array([np.all(np.abs(U2[j] - U2[bj]) <= 2 * h2) for j in range(U2.shape[0])])
         for i in range(d2.shape[0]):
-            if near1[i]:
+            if _within(U1[i], U1[bi], 2 * h1):
                 for j in range(d2.shape[1]):
-                    if near2[j]:
+                    if _within(U2[j], U2[bj], 2 * h2):
                         d2[i, j] = np.inf
     g1, g2 = h1, h2
     for _ in range(levels):
         for c in range(C):
             G1 = _local_grid(C1[c].copy(), 2 * g1, lo1, hi1, per1, n_fine)
             G2 = _local_grid(C2[c].copy(), 2 * g2, lo2, hi2, per2, n_fine)
-            D = _d2(_positions(k1, p1, R1, o1, G1), _positions(k2, p2, R2, o2, G2))
-            a = np.argmin(D)
-            C1[c], C2[c] = G1[a // D.shape[1]], G2[a % D.shape[1]]
+            i, j = _argmin_d2(_positions(k1, p1, R1, o1, G1), _positions(k2, p2, R2, o2, G2))
+            C1[c], C2[c] = G1[i], G2[j]
         g1, g2 = 4 * g1 / (n_fine - 1), 4 * g2 / (n_fine - 1)
     out = np.empty((C, dim1 + dim2))
     out[:, :dim1], out[:, dim1:] = C1[:C], C2[:C]
@@ -279,9 +308,38 @@ def newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale, tol
 
 
 @njit(cache=True)
-def _points(k1, p1, R1, o1, k2, p2, R2, o2, u):
-    _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, 1)
-    return np.array(x1), np.array(x2)
+def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2, levels, n_fine,
+         candidates, distance_rtol, rtol_beyond):
+    """The start couples of `hierarchical`, each finished by `newton` unless an earlier one
+    started within 1e-9 of the spans (one finish serves both): the finished couples u (C, n),
+    their iterations, statuses and points x1, x2 (C, 3), in the order of the starts."""
+    starts = hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
+                          levels, n_fine, candidates)
+    lower, upper = np.concatenate((lo1, lo2)), np.concatenate((hi1, hi2))
+    periodic = np.concatenate((per1, per2))
+    span = upper - lower
+    scale = np.maximum(span, 1e-300)
+    tol = 1e-9 * span
+    C, n = starts.shape
+    U, its, status = np.empty((C, n)), np.zeros(C, dtype=np.int64), np.zeros(C, dtype=np.int64)
+    X1, X2 = np.empty((C, 3)), np.empty((C, 3))
+    started = np.zeros(C, dtype=np.bool_)
+    m = 0
+    for c in range(C):
+        dup = False
+        for s in range(c):
+            dup = dup or (started[s] and _within(starts[c], starts[s], tol))
+        if dup:
+            continue
+        started[c] = True
+        u, its[m], status[m] = newton(k1, p1, R1, o1, k2, p2, R2, o2, starts[c], lower, upper,
+                                      periodic, scale, 1e-14, 50, distance_rtol, rtol_beyond)
+        _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, 1)
+        U[m] = u
+        X1[m, 0], X1[m, 1], X1[m, 2] = x1
+        X2[m, 0], X2[m, 1], X2[m, 2] = x2
+        m += 1
+    return U[:m], its[:m], status[:m], X1[:m], X2[:m]
 
 
 def _spec(patch):
@@ -289,6 +347,18 @@ def _spec(patch):
     hit = patch.__dict__.get("_kernel_spec")
     if hit is None:
         hit = patch.__dict__["_kernel_spec"] = patch_spec(patch)
+    return hit
+
+
+def _domain(patch, n_coarse):
+    """(lower, upper, periodic, coarse grid) of a patch as the kernels take them (writable,
+    C-ordered: one compiled signature), kept on it."""
+    cache = patch.__dict__.setdefault("_kernel_domain", {})
+    hit = cache.get(n_coarse)
+    if hit is None:
+        hit = cache[n_coarse] = (np.array(patch.lower, dtype=float),
+                                 np.array(patch.upper, dtype=float), np.array(patch.periodic),
+                                 np.array(patch.grid_points(n_coarse)[0]))
     return hit
 
 
@@ -301,42 +371,27 @@ def supported(P1, P2) -> bool:
 def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, levels=2,
                 n_fine=21, candidates=3) -> Couple:
     """`drake_dock.core.seeking.seek_couple` compiled, for posed patches P1 (a curve) and P2
-    with kernel descriptions (`supported`)."""
+    with kernel descriptions (`supported`): one call of `seek`, then the nearest finished
+    couple."""
     pa, pb = P1.patch, P2.patch
     (k1, q1), (k2, q2) = _spec(pa), _spec(pb)
     # Writable C-ordered copies: one compiled signature whatever the caller's arrays.
     R1, o1 = np.array(P1.R, dtype=float, order="C"), np.array(P1.p, dtype=float)
     R2, o2 = np.array(P2.R, dtype=float, order="C"), np.array(P2.p, dtype=float)
-    per1, per2 = np.array(pa.periodic), np.array(pb.periodic)
-    starts = hierarchical(k1, q1, R1, o1, np.array(pa.lower, dtype=float),
-                          np.array(pa.upper, dtype=float), per1,
-                          np.array(pa.grid_points(n_coarse)[0]), k2, q2, R2, o2,
-                          np.array(pb.lower, dtype=float), np.array(pb.upper, dtype=float), per2,
-                          np.array(pb.grid_points(n_coarse)[0]), levels, n_fine, candidates)
-    lower = np.concatenate([pa.lower, pb.lower])
-    upper = np.concatenate([pa.upper, pb.upper])
-    periodic = np.concatenate([per1, per2])
-    span = np.concatenate([pa.span, pb.span])
-    scale = np.maximum(span, 1e-300)
-    tol = 1e-9 * span
-    best, started = None, []
-    for u0 in starts:
-        # Two candidates refined onto the same grid couple: one Newton finish serves both.
-        if any(np.all(np.abs(u0 - s) <= tol) for s in started):
-            continue
-        started.append(u0)
-        u, it, status = newton(k1, q1, R1, o1, k2, q2, R2, o2, u0, lower, upper, periodic,
-                               scale, 1e-14, 50, -1.0 if distance_rtol is None
-                               else float(distance_rtol), float(rtol_beyond))
-        if status:
-            raise SeekingError("closest-couple Newton did not converge in 50 iterations")
-        x1, x2 = _points(k1, q1, R1, o1, k2, q2, R2, o2, u)
-        dist = float(np.linalg.norm(x1 - x2))
-        if best is None or dist < best.distance:
-            u1, u2 = u[:1], u[1:]
-            best = Couple(u1, u2, x1, x2, dist, it,
-                          is_interior(pa, u1) and is_interior(pb, u2))
-    return best
+    U, its, status, X1, X2 = seek(k1, q1, R1, o1, *_domain(pa, n_coarse), k2, q2, R2, o2,
+                                  *_domain(pb, n_coarse), levels, n_fine, candidates,
+                                  -1.0 if distance_rtol is None else float(distance_rtol),
+                                  float(rtol_beyond))
+    if status.any():
+        raise SeekingError("closest-couple Newton did not converge in 50 iterations")
+    best, dist = 0, np.inf
+    for c in range(U.shape[0]):
+        d = float(np.linalg.norm(X1[c] - X2[c]))
+        if c == 0 or d < dist:
+            best, dist = c, d
+    u1, u2 = U[best, :1], U[best, 1:]
+    return Couple(u1, u2, X1[best], X2[best], dist, int(its[best]),
+                  is_interior(pa, u1) and is_interior(pb, u2))
 
 
 def warm():
