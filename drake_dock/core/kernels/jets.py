@@ -161,8 +161,20 @@ def position(kind, prm, u0, u1):
         return rho * math.cos(u0), rho * math.sin(u0), (prm[4] - rho) * prm[3]
     if kind == ANNULUS:
         return u0 * math.cos(u1), u0 * math.sin(u1), prm[0]
-    # PETAL (`_petal`): theta across the petal (Eq. 13), then the cone (Eq. 12).
-    t1 = math.asin(prm[4] / (prm[6] - u1 * prm[3])) - prm[5]
-    th = prm[2] + t1 + u0 * (math.pi / 3 - 2 * t1)
-    rho = prm[0] - u1 * prm[1]
-    return rho * math.cos(th), rho * math.sin(th), u1
+    return petal_point(prm, u0, u1, petal_row(prm, u1))
+
+
+@njit(cache=True)
+def petal_row(prm, z):
+    """What a PETAL's point at zeta = z shares with the others at that z (`_petal`): theta_1
+    (Eq. 13), the petal's angle pi/3 - 2 theta_1 and the cone's radius (Eq. 12)."""
+    t1 = math.asin(prm[4] / (prm[6] - z * prm[3])) - prm[5]
+    return t1, math.pi / 3 - 2 * t1, prm[0] - z * prm[1]
+
+
+@njit(cache=True)
+def petal_point(prm, s, z, row):
+    """A PETAL's r at (s, z) from its `petal_row` at z."""
+    t1, w, rho = row
+    th = prm[2] + t1 + s * w
+    return rho * math.cos(th), rho * math.sin(th), z

@@ -12,8 +12,8 @@ import math
 import numpy as np
 from numba import njit
 
-from drake_dock.core.kernels.jets import jet, patch_spec, position
-from drake_dock.core.seeking import Couple, is_interior
+from drake_dock.core.kernels.jets import PETAL, jet, patch_spec, petal_point, petal_row, position
+from drake_dock.core.seeking import Couple
 from drake_dock.errors import SeekingError
 
 EPS8 = 8 * np.finfo(float).eps
@@ -69,23 +69,55 @@ def _argmin_d2(X1, X2):
 
 
 @njit(cache=True)
-def _local_grid(c, hw, lower, upper, periodic, n):
-    """`seeking._local_grids` for one centre c."""
+def _local_axes(c, hw, lower, upper, periodic, n):
+    """`seeking._local_grids` for one centre c, as its axes (dim, n): the grid's row a is
+    (A[0, a // n], A[1, a % n]) (or A[0, a] for a curve)."""
     dim = c.shape[0]
     lo, hi = c - hw, c + hw
     for k in range(dim):
         if not periodic[k]:
             lo[k], hi[k] = max(lo[k], lower[k]), min(hi[k], upper[k])
     t = np.linspace(0.0, 1.0, n)
-    G = np.empty((n ** dim, dim))
-    for a in range(n ** dim):
-        for k in range(dim):
-            j = a if dim == 1 else (a // n if k == 0 else a % n)
-            G[a, k] = lo[k] + (hi[k] - lo[k]) * t[j]
+    A = np.empty((dim, n))
+    for k in range(dim):
+        for j in range(n):
+            A[k, j] = lo[k] + (hi[k] - lo[k]) * t[j]
             if periodic[k]:
                 span = upper[k] - lower[k]
-                G[a, k] = lower[k] + np.mod(G[a, k] - lower[k], span)
-    return G
+                A[k, j] = lower[k] + np.mod(A[k, j] - lower[k], span)
+    return A
+
+
+@njit(cache=True)
+def _axes_point(A, a):
+    """Row a of the grid of the axes A (`_local_axes`)."""
+    n = A.shape[1]
+    if A.shape[0] == 1:
+        return np.array([A[0, a]])
+    return np.array([A[0, a // n], A[1, a % n]])
+
+
+@njit(cache=True)
+def _axes_positions(kind, prm, R, o, A):
+    """`_positions` of the grid of the axes A; a petal's `petal_row` once per zeta."""
+    dim, n = A.shape
+    if kind != PETAL or dim == 1:
+        U = np.empty((n ** dim, dim))
+        for a in range(n ** dim):
+            U[a] = _axes_point(A, a)
+        return _positions(kind, prm, R, o, U)
+    X = np.empty((n * n, 3))
+    r00, r01, r02, r10, r11, r12 = R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2]
+    r20, r21, r22, o0, o1, o2 = R[2, 0], R[2, 1], R[2, 2], o[0], o[1], o[2]
+    for j in range(n):
+        row = petal_row(prm, A[1, j])
+        for i in range(n):
+            r = petal_point(prm, A[0, i], A[1, j], row)
+            a = i * n + j
+            X[a, 0] = r00 * r[0] + r01 * r[1] + r02 * r[2] + o0
+            X[a, 1] = r10 * r[0] + r11 * r[1] + r12 * r[2] + o1
+            X[a, 2] = r20 * r[0] + r21 * r[1] + r22 * r[2] + o2
+    return X
 
 
 @njit(cache=True)
@@ -128,10 +160,11 @@ def hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, p
     g1, g2 = h1, h2
     for _ in range(levels):
         for c in range(C):
-            G1 = _local_grid(C1[c].copy(), 2 * g1, lo1, hi1, per1, n_fine)
-            G2 = _local_grid(C2[c].copy(), 2 * g2, lo2, hi2, per2, n_fine)
-            i, j = _argmin_d2(_positions(k1, p1, R1, o1, G1), _positions(k2, p2, R2, o2, G2))
-            C1[c], C2[c] = G1[i], G2[j]
+            A1 = _local_axes(C1[c].copy(), 2 * g1, lo1, hi1, per1, n_fine)
+            A2 = _local_axes(C2[c].copy(), 2 * g2, lo2, hi2, per2, n_fine)
+            i, j = _argmin_d2(_axes_positions(k1, p1, R1, o1, A1),
+                              _axes_positions(k2, p2, R2, o2, A2))
+            C1[c], C2[c] = _axes_point(A1, i), _axes_point(A2, j)
         g1, g2 = 4 * g1 / (n_fine - 1), 4 * g2 / (n_fine - 1)
     out = np.empty((C, dim1 + dim2))
     out[:, :dim1], out[:, dim1:] = C1[:C], C2[:C]
@@ -312,7 +345,8 @@ def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
          candidates, distance_rtol, rtol_beyond):
     """The start couples of `hierarchical`, each finished by `newton` unless an earlier one
     started within 1e-9 of the spans (one finish serves both): the finished couples u (C, n),
-    their iterations, statuses and points x1, x2 (C, 3), in the order of the starts."""
+    their iterations, statuses, points x1, x2 (C, 3) and whether they are interior
+    (`seeking.is_interior` of both parts), in the order of the starts."""
     starts = hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
                           levels, n_fine, candidates)
     lower, upper = np.concatenate((lo1, lo2)), np.concatenate((hi1, hi2))
@@ -323,6 +357,7 @@ def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
     C, n = starts.shape
     U, its, status = np.empty((C, n)), np.zeros(C, dtype=np.int64), np.zeros(C, dtype=np.int64)
     X1, X2 = np.empty((C, 3)), np.empty((C, 3))
+    interior = np.zeros(C, dtype=np.bool_)
     started = np.zeros(C, dtype=np.bool_)
     m = 0
     for c in range(C):
@@ -338,8 +373,14 @@ def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
         U[m] = u
         X1[m, 0], X1[m, 1], X1[m, 2] = x1
         X2[m, 0], X2[m, 1], X2[m, 2] = x2
+        interior[m] = True
+        for k in range(n):
+            # is_interior: min(u - lower, upper - u) > 1e-9 span unless periodic (NaN: not).
+            inside = u[k] - lower[k] > 1e-9 * span[k] and upper[k] - u[k] > 1e-9 * span[k]
+            if not (periodic[k] or inside):
+                interior[m] = False
         m += 1
-    return U[:m], its[:m], status[:m], X1[:m], X2[:m]
+    return U[:m], its[:m], status[:m], X1[:m], X2[:m], interior[:m]
 
 
 def _spec(patch):
@@ -378,7 +419,7 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
     # Writable C-ordered copies: one compiled signature whatever the caller's arrays.
     R1, o1 = np.array(P1.R, dtype=float, order="C"), np.array(P1.p, dtype=float)
     R2, o2 = np.array(P2.R, dtype=float, order="C"), np.array(P2.p, dtype=float)
-    U, its, status, X1, X2 = seek(k1, q1, R1, o1, *_domain(pa, n_coarse), k2, q2, R2, o2,
+    U, its, status, X1, X2, interior = seek(k1, q1, R1, o1, *_domain(pa, n_coarse), k2, q2, R2, o2,
                                   *_domain(pb, n_coarse), levels, n_fine, candidates,
                                   -1.0 if distance_rtol is None else float(distance_rtol),
                                   float(rtol_beyond))
@@ -389,9 +430,8 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
         d = float(np.linalg.norm(X1[c] - X2[c]))
         if c == 0 or d < dist:
             best, dist = c, d
-    u1, u2 = U[best, :1], U[best, 1:]
-    return Couple(u1, u2, X1[best], X2[best], dist, int(its[best]),
-                  is_interior(pa, u1) and is_interior(pb, u2))
+    return Couple(U[best, :1], U[best, 1:], X1[best], X2[best], dist, int(its[best]),
+                  bool(interior[best]))
 
 
 def warm():
