@@ -63,7 +63,13 @@ def touched_steps(mc, mr, mbc, mbr, mblocks, fc, fr, fbc, fbr, fblocks, e, grid,
             lo, hi, ok = _interval(mbc[I], fbc[J], mbr[I] + fbr[J], e, ee)
             if not ok or lo > lam_hi + slack or hi < lam_lo - slack:
                 continue
+            # A moving cell whose sphere cannot meet block J's (grown by 1e-12 relative and
+            # absolute, far above round-off) in the range meets none of its cells there.
+            grown = fbr[J] * (1.0 + 1e-12) + 1e-12
             for a in mblocks[I]:
+                lo, hi, ok = _interval(mc[a], fbc[J], mr[a] + grown, e, ee)
+                if not ok or lo > lam_hi + slack or hi < lam_lo - slack:
+                    continue
                 for b in fblocks[J]:
                     lo, hi, ok = _interval(mc[a], fc[b], mr[a] + fr[b], e, ee)
                     if not ok:
