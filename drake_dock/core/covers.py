@@ -1,5 +1,6 @@
-"""Bounding-sphere covers of patches (Definition 1) and where two covers can touch along a
-straight relative translation: a lower bound on the distance of two patches that needs no seek.
+"""Bounding-sphere and slab covers of patches (Definition 1) and where two covers can touch
+along a straight relative translation: a lower bound on the distance of two patches that needs
+no seek.
 
 A cover splits the parameter box into n cells per parameter. Cell c, centre u_c and half-widths
 h, is enclosed by the sphere about r(u_c) of radius
@@ -19,6 +20,14 @@ c1, c2, radii rho1 + rho2 = r) can touch only for lam in the interval
     b = w . e,  D = b^2 - |e|^2 (|w|^2 - r^2) >= 0;
 
 outside the union of these intervals the patches are apart.
+
+A surface's cell is also enclosed by a slab about its tangent plane: with n_c the unit normal
+T_0 x T_1 / |T_0 x T_1| at u_c, |n_c . (r(u) - r(u_c))| <= kappa_c = sum_kl h_k h_l |K_kl(u_c)|
+over the cell (n_c . T = 0, so only the quadratic Taylor term is left; twice it, as for rho_c).
+A sphere (centre c1, radius rho1) can then touch the cell only where
+|n_c . (w - lam e)| <= rho1 + kappa_c, w = c1(0) - c2: an interval of lam (all or none when
+n_c . e = 0), intersected with the spheres'. Where a curve passes close to a surface but on one
+side of it (a ring just inside a petal's cone), the slab is far thinner than the sphere.
 """
 from __future__ import annotations
 
@@ -30,28 +39,36 @@ import numpy as np
 @dataclasses.dataclass(frozen=True)
 class Cover:
     """Cell spheres (``centres`` (n, 3), ``radii`` (n,)) and block spheres (``block_centres``
-    (m, 3), ``block_radii`` (m,)); ``blocks`` (m, b) lists each block's cells."""
+    (m, 3), ``block_radii`` (m,)); ``blocks`` (m, b) lists each block's cells. A surface's
+    cells also have slabs: unit ``normals`` (n, 3) and half-thicknesses ``flat`` (n,); a
+    curve's ``flat`` is +inf (no slab)."""
 
     centres: np.ndarray
     radii: np.ndarray
     block_centres: np.ndarray
     block_radii: np.ndarray
     blocks: np.ndarray
+    normals: np.ndarray
+    flat: np.ndarray
 
     @classmethod
-    def from_cells(cls, centres, radii, blocks) -> "Cover":
-        """The cover of the cell spheres with each block enclosed about its cells' mean."""
+    def from_cells(cls, centres, radii, blocks, normals=None, flat=None) -> "Cover":
+        """The cover of the cell spheres (and slabs, if given) with each block enclosed about
+        its cells' mean."""
         cells = centres[blocks]                              # (m, b, 3)
         block_centres = cells.mean(axis=1)
         block_radii = (np.linalg.norm(cells - block_centres[:, None], axis=-1)
                        + radii[blocks]).max(axis=1)
-        return cls(centres, radii, block_centres, block_radii, blocks)
+        if normals is None:
+            normals, flat = np.zeros_like(centres), np.full(len(radii), np.inf)
+        return cls(centres, radii, block_centres, block_radii, blocks, normals, flat)
 
     def posed(self, R, p) -> "Cover":
         """The cover of the patch placed by the body pose (R, p), Eq. (20)."""
         R, p = np.asarray(R, dtype=float), np.asarray(p, dtype=float)
         return dataclasses.replace(self, centres=self.centres @ R.T + p,
-                                   block_centres=self.block_centres @ R.T + p)
+                                   block_centres=self.block_centres @ R.T + p,
+                                   normals=self.normals @ R.T)
 
 
 def block_layout(patch, n: int, block: int):
@@ -78,15 +95,25 @@ def cell_radii(patch, U, half):
     return grow @ half
 
 
+def cell_slabs(patch, U, half):
+    """(n_c, kappa_c) of the module docstring at a surface's cell centres U (N, 2)."""
+    T = patch.first(U)                                  # (N, 3, 2)
+    K = patch.second(U)                                 # (N, 3, 2, 2)
+    n = np.cross(T[..., 0], T[..., 1])
+    n = n / np.linalg.norm(n, axis=-1, keepdims=True)
+    return n, np.einsum("nkl,k,l->n", np.linalg.norm(K, axis=1), half, half)
+
+
 def patch_cover(patch, n: int, block: int) -> Cover:
     """The cover of ``patch`` with n cells per parameter in blocks of ``block`` per parameter
-    (`block_layout`); kept on the patch."""
+    (`block_layout`), with slabs for a surface; kept on the patch."""
     cache = patch.__dict__.setdefault("_covers", {})
     hit = cache.get((n, block))
     if hit is None:
         U, half, blocks = block_layout(patch, n, block)
+        slabs = cell_slabs(patch, U, half) if patch.dim == 2 else (None, None)
         hit = cache[(n, block)] = Cover.from_cells(patch.position(U), cell_radii(patch, U, half),
-                                                   blocks)
+                                                   blocks, *slabs)
     return hit
 
 
@@ -101,18 +128,41 @@ def _intervals(w, r, e):
     return (b - s) / ee, (b + s) / ee, ok
 
 
+def _slab_intervals(w, r, n, flat, e):
+    """Per cell pair (rows of w = c1(0) - c2, the other cell's radius r, a slab's normal n and
+    half-thickness flat): the interval of lam where |n . (w - lam e)| <= r + flat, as
+    (lo, hi); (-inf, inf) for no slab (flat inf) and an empty one (inf, -inf) for none."""
+    nw = np.einsum("...k,...k->...", n, w)
+    ne = n @ e
+    t = r + flat
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a, b = (nw - t) / ne, (nw + t) / ne
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    flat_e = ne == 0.0
+    lo = np.where(flat_e, np.where(np.abs(nw) <= t, -np.inf, np.inf), lo)
+    hi = np.where(flat_e, np.where(np.abs(nw) <= t, np.inf, -np.inf), hi)
+    free = np.isinf(flat)
+    return np.where(free, -np.inf, lo), np.where(free, np.inf, hi)
+
+
 def touch_set(moving: Cover, fixed: Cover, e, lam_lo, lam_hi, slack=1e-9):
     """(lo, hi) arrays: intervals of lam in [lam_lo, lam_hi] outside whose union the patches of
     the two posed covers are apart, ``moving`` translated by -lam e. Blocks first, then the cells
-    of the block pairs that can touch in the range; each interval widened by ``slack``."""
+    of the block pairs that can touch in the range, each cell pair's sphere interval cut by the
+    cells' slabs; each interval widened by ``slack``."""
     e = np.asarray(e, dtype=float)
     w = moving.block_centres[:, None, :] - fixed.block_centres[None, :, :]
     lo, hi, ok = _intervals(w, moving.block_radii[:, None] + fixed.block_radii[None, :], e)
     I, J = np.nonzero(ok & (lo <= lam_hi + slack) & (hi >= lam_lo - slack))
     ci, cj = np.broadcast_arrays(moving.blocks[I][:, :, None], fixed.blocks[J][:, None, :])
     ci, cj = ci.ravel(), cj.ravel()
-    lo, hi, ok = _intervals(moving.centres[ci] - fixed.centres[cj],
-                            moving.radii[ci] + fixed.radii[cj], e)
+    w = moving.centres[ci] - fixed.centres[cj]
+    lo, hi, ok = _intervals(w, moving.radii[ci] + fixed.radii[cj], e)
+    for n, flat, r in ((fixed.normals[cj], fixed.flat[cj], moving.radii[ci]),
+                       (moving.normals[ci], moving.flat[ci], fixed.radii[cj])):
+        slo, shi = _slab_intervals(w, r, n, flat, e)
+        lo, hi = np.maximum(lo, slo), np.minimum(hi, shi)
+    ok &= lo <= hi + 2 * slack
     lo, hi = lo[ok] - slack, hi[ok] + slack
     keep = (lo <= lam_hi) & (hi >= lam_lo)
     return lo[keep], hi[keep]

@@ -1,8 +1,11 @@
 """The bounding-sphere covers (`drake_dock.core.covers`, compiled in
-`drake_dock.core.kernels.cover`): every sampled point of a cell lies in its sphere, every cell in
-its block's sphere; the compiled covers and touched steps equal the reference; the touched steps
-equal a brute force over every sphere pair and step (the exact least distance of a sphere pair
-over a step); and the covers' distance bound lies below the seek's distance."""
+`drake_dock.core.kernels.cover`): every sampled point of a cell lies in its sphere and its slab,
+every cell in its block's sphere; the compiled covers and touched steps equal the reference;
+without slabs the touched steps equal a brute force over every sphere pair and step (the exact
+least distance of a sphere pair over a step), with them they lie between that and the steps
+where the pointwise bound (spheres and slabs) reaches 0 at sampled travels; and the covers'
+distance bound lies below the seek's distance."""
+import dataclasses
 import math
 
 import numpy as np
@@ -32,12 +35,17 @@ def test_cells_enclose_the_patch(patch):
     got = compiled.patch_cover(patch, n, block)
     np.testing.assert_allclose(got.centres, ref.centres, rtol=0, atol=1e-12)
     np.testing.assert_allclose(got.radii, ref.radii, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(got.normals, ref.normals, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(got.flat, ref.flat, rtol=1e-12, atol=1e-15)
+    assert np.isinf(ref.flat).all() == (patch.dim == 1)
     U, half, blocks = covers.block_layout(patch, n, block)
     rng = np.random.default_rng(0)
     for i in range(20):                      # points all over every cell, corners first
         t = rng.choice([-1.0, 1.0], U.shape) if i < 4 else rng.uniform(-1, 1, U.shape)
         x = patch.position(U + t * half)
         assert np.all(np.linalg.norm(x - ref.centres, axis=1) <= ref.radii)
+        off_plane = np.abs(np.einsum("nk,nk->n", x - ref.centres, ref.normals))
+        assert np.all((off_plane <= ref.flat) | np.isinf(ref.flat))
     inside = (np.linalg.norm(ref.centres[blocks] - ref.block_centres[:, None], axis=-1)
               + ref.radii[blocks])
     assert np.all(inside <= ref.block_radii[:, None] * (1 + 1e-15))
@@ -65,10 +73,29 @@ def test_compiled_touch_steps_equal_the_reference(approach):
                                                                  grid), pr.name)
 
 
-@pytest.mark.parametrize("name", ["cc_T2_C4", "cs_Cring_T1"])
+def _spheres_only(cover):
+    return dataclasses.replace(cover, flat=np.full_like(cover.flat, np.inf))
+
+
+def _least_bound(moving, fixed, shift):
+    """min over cell pairs of the larger of their sphere and slab bounds on the distance, the
+    moving cover's centres shifted by ``shift``."""
+    w = (moving.centres + shift)[:, None] - fixed.centres[None]
+    rm, rf = moving.radii[:, None], fixed.radii[None]
+    bound = np.linalg.norm(w, axis=-1) - rm - rf
+    bound = np.maximum(bound, np.abs(np.einsum("ijk,jk->ij", w, fixed.normals)) - rm
+                       - fixed.flat[None])
+    bound = np.maximum(bound, np.abs(np.einsum("ijk,ik->ij", w, moving.normals)) - rf
+                       - moving.flat[:, None])
+    return bound.min()
+
+
+@pytest.mark.parametrize("name", ["cc_T2_C4", "cs_Cring_T1", "cs_Tring_C2"])
 def test_touch_steps_equal_a_brute_force(name):
-    """A step is touched iff some sphere pair's least distance over the step is <= 0: that
-    distance is |w - lam* e| - r at the clamped projection lam* of w on e."""
+    """Spheres only, a step is touched iff some sphere pair's least distance over the step is
+    <= 0: that distance is |w - lam* e| - r at the clamped projection lam* of w on e. With the
+    slabs, the touched steps are among those and include every step where the pointwise bound
+    of spheres and slabs is <= 0 at one of 17 travels spread over the step."""
     g = ApdsGeometry()
     approach = APPROACHES[0]
     pr = next(p for p in apds_pairs(g) if p.name == name)
@@ -79,13 +106,22 @@ def test_touch_steps_equal_a_brute_force(name):
     lam = np.clip((w @ e) / (e @ e), grid[1:, None], grid[:-1, None])   # (steps, pairs)
     least = np.linalg.norm(w[None] - lam[..., None] * e, axis=-1) - r
     brute = (least <= 1e-9).any(axis=1)
-    np.testing.assert_array_equal(covers.touch_steps(moving, fixed, e, grid), brute)
+    spheres = covers.touch_steps(_spheres_only(moving), _spheres_only(fixed), e, grid)
+    np.testing.assert_array_equal(spheres, brute)
+    got = covers.touch_steps(moving, fixed, e, grid)
+    assert not (got & ~spheres).any()
+    for k in np.flatnonzero(spheres & ~got):
+        for lam in np.linspace(grid[k + 1], grid[k], 17):
+            assert _least_bound(moving, fixed, -lam * e) > 0.0, (k, lam)
+    if name.startswith("cs"):
+        assert (spheres & ~got).any()      # the ring just inside the petal's cone
 
 
 def test_bound_lies_below_the_seek_distance():
-    """At every grid point of the paper's approach: the covers' least distance (min over sphere
-    pairs of |c1 - c2| - r1 - r2) <= the compiled seek's distance of every pair, and > 0 at both
-    ends of every step that is not touched."""
+    """At every grid point of the paper's approach: the covers' least distance (min over cell
+    pairs of the larger of |c1 - c2| - r1 - r2 and each slab's |n . (c1 - c2)| - r - kappa)
+    <= the compiled seek's distance of every pair, and > 0 at both ends of every step that is
+    not touched."""
     g = ApdsGeometry()
     approach = APPROACHES[0]
     pairs = apds_pairs(g)
@@ -94,9 +130,7 @@ def test_bound_lies_below_the_seek_distance():
     for j, pr in enumerate(pairs):
         moving, fixed, e = _posed_covers(pr, approach)
         for k, lam in enumerate(grid):
-            c = moving.centres - lam * e
-            bound = (np.linalg.norm(c[:, None] - fixed.centres[None], axis=-1)
-                     - moving.radii[:, None] - fixed.radii[None]).min()
+            bound = _least_bound(moving, fixed, -lam * e)
             R, p = approach.pose(lam)
             poses = {CHASER_APDS: (R, p), "target_apds": (np.eye(3), np.zeros(3))}
             cp = compiled_seek.seek_couple(posed(pr.patch1, *poses[pr.body1]),

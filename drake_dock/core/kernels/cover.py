@@ -1,4 +1,4 @@
-"""The bounding-sphere covers of `drake_dock.core.covers` compiled: the cell spheres from the
+"""The covers of `drake_dock.core.covers` compiled: the cell spheres and slabs from the
 patches' jets (`jets.jet`) and the steps of a travel grid in which two covers can touch, with
 the same bounds (tests compare them with the reference)."""
 from __future__ import annotations
@@ -20,9 +20,12 @@ def _norm(v):
 @njit(cache=True)
 def cell_spheres(kind, prm, U, half):
     """Centres r(u_c) (N, 3) and radii rho_c (N,) of the cells centred at U (N, dim) with
-    half-widths ``half`` (`drake_dock.core.covers.cell_radii`)."""
+    half-widths ``half`` (`drake_dock.core.covers.cell_radii`), and for a surface the slabs'
+    normals (N, 3) and half-thicknesses (N,) (`covers.cell_slabs`; zeros and inf for a
+    curve)."""
     n, dim = U.shape
     C, rho = np.empty((n, 3)), np.empty(n)
+    N, flat = np.zeros((n, 3)), np.full(n, np.inf)
     for c in range(n):
         r, T0, T1, K00, K01, K11 = jet(kind, prm, U[c, 0], U[c, 1] if dim == 2 else 0.0)
         C[c, 0], C[c, 1], C[c, 2] = r
@@ -33,7 +36,12 @@ def cell_spheres(kind, prm, U, half):
             h1 = half[1]
             rho[c] = (h0 * (_norm(T0) + h0 * _norm(K00) + h1 * _norm(K01))
                       + h1 * (_norm(T1) + h0 * _norm(K01) + h1 * _norm(K11)))
-    return C, rho
+            x = (T0[1] * T1[2] - T0[2] * T1[1], T0[2] * T1[0] - T0[0] * T1[2],
+                 T0[0] * T1[1] - T0[1] * T1[0])
+            m = _norm(x)
+            N[c, 0], N[c, 1], N[c, 2] = x[0] / m, x[1] / m, x[2] / m
+            flat[c] = h0 * h0 * _norm(K00) + 2.0 * h0 * h1 * _norm(K01) + h1 * h1 * _norm(K11)
+    return C, rho, N, flat
 
 
 @njit(cache=True)
@@ -49,10 +57,22 @@ def _interval(c1, c2, r, e, ee):
 
 
 @njit(cache=True)
-def touched_steps(mc, mr, mbc, mbr, mblocks, fc, fr, fbc, fbr, fblocks, e, grid, slack):
+def _slab(n, w0, w1, w2, t, e, lo, hi):
+    """[lo, hi] cut by the lam where |n . (w - lam e)| <= t (`covers._slab_intervals`)."""
+    nw = n[0] * w0 + n[1] * w1 + n[2] * w2
+    ne = n[0] * e[0] + n[1] * e[1] + n[2] * e[2]
+    if ne == 0.0:
+        return (lo, hi) if abs(nw) <= t else (np.inf, -np.inf)
+    a, b = (nw - t) / ne, (nw + t) / ne
+    return max(lo, min(a, b)), min(hi, max(a, b))
+
+
+@njit(cache=True)
+def touched_steps(mc, mr, mbc, mbr, mblocks, mn, mflat, fc, fr, fbc, fbr, fblocks, fn, fflat, e,
+                  grid, slack):
     """`covers.touched_steps` of `covers.touch_set`: the steps of the decreasing grid in which
-    the moving cover (cells mc, mr; blocks mbc, mbr, mblocks), translated by -lam e, can touch
-    the fixed one."""
+    the moving cover (cells mc, mr, slabs mn, mflat; blocks mbc, mbr, mblocks), translated by
+    -lam e, can touch the fixed one."""
     K = grid.shape[0] - 1
     neg = -grid
     marks = np.zeros(K + 1, dtype=np.int64)
@@ -73,6 +93,13 @@ def touched_steps(mc, mr, mbc, mbr, mblocks, fc, fr, fbc, fbr, fblocks, e, grid,
                 for b in fblocks[J]:
                     lo, hi, ok = _interval(mc[a], fc[b], mr[a] + fr[b], e, ee)
                     if not ok:
+                        continue
+                    w0, w1, w2 = mc[a, 0] - fc[b, 0], mc[a, 1] - fc[b, 1], mc[a, 2] - fc[b, 2]
+                    if fflat[b] < np.inf:
+                        lo, hi = _slab(fn[b], w0, w1, w2, mr[a] + fflat[b], e, lo, hi)
+                    if mflat[a] < np.inf:
+                        lo, hi = _slab(mn[a], w0, w1, w2, fr[b] + mflat[a], e, lo, hi)
+                    if not lo <= hi + 2 * slack:
                         continue
                     first = max(np.searchsorted(neg, -(hi + slack)) - 1, 0)
                     last = min(np.searchsorted(neg, -(lo - slack), side="right") - 1, K - 1)
@@ -97,8 +124,8 @@ def patch_cover(patch, n: int, block: int):
     hit = None
     if spec is not None:
         U, half, blocks = block_layout(patch, n, block)
-        centres, radii = cell_spheres(spec[0], spec[1], U, half)
-        hit = Cover.from_cells(centres, radii, blocks)
+        centres, radii, normals, flat = cell_spheres(spec[0], spec[1], U, half)
+        hit = Cover.from_cells(centres, radii, blocks, normals, flat)
     cache[(n, block)] = hit
     return hit
 
@@ -106,9 +133,10 @@ def patch_cover(patch, n: int, block: int):
 def touch_steps(moving, fixed, e, grid, slack=1e-9):
     """Booleans (K,): the steps of ``grid`` in which the posed covers can touch."""
     return touched_steps(moving.centres, moving.radii, moving.block_centres, moving.block_radii,
-                         moving.blocks, fixed.centres, fixed.radii, fixed.block_centres,
-                         fixed.block_radii, fixed.blocks, np.asarray(e, dtype=float),
-                         np.asarray(grid, dtype=float), float(slack))
+                         moving.blocks, moving.normals, moving.flat, fixed.centres, fixed.radii,
+                         fixed.block_centres, fixed.block_radii, fixed.blocks, fixed.normals,
+                         fixed.flat, np.asarray(e, dtype=float), np.asarray(grid, dtype=float),
+                         float(slack))
 
 
 def warm():
