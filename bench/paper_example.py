@@ -8,12 +8,14 @@ runs, all measured in this run; and the same example with Drake's plain witness 
 coarser step cap (``--coarse-step``), which is the output spacing, for its cost; and with the
 couples evaluated in Python instead of the compiled kernels (`ContactOptions.compiled`), with
 the difference of the capture times. Also the set-up (the initial state: the first-contact
-placement, its seeks, and their number) and the kernels' cold and warm start (a fresh process that compiles them
-into an empty cache directory, then one that loads them from it).
+placement, its seeks, and their number; and that of another approach of the same geometry)
+and the kernels' cold and warm start (a fresh process that compiles them into an empty cache
+directory, then one that loads them from it).
 
     python bench/paper_example.py [SCENARIO.yaml]
 """
 import argparse
+import copy
 import dataclasses
 import os
 import subprocess
@@ -86,6 +88,13 @@ def main():
     t0 = time.perf_counter()
     state = initial_state(scenario)
     t_state = time.perf_counter() - t0
+    # The set-up of another approach of the same geometry (the roll 1 deg more): the pairs'
+    # covers and coarse grids are kept per geometry, as for the next condition of a sweep.
+    other_roll = copy.deepcopy(scenario)
+    other_roll.initial.target_yaw_deg += 1.0
+    t0 = time.perf_counter()
+    initial_state(other_roll)
+    t_state_warm = time.perf_counter() - t0
     seeks = first_contact_seeks(scenario.geometry, contact_approach(scenario)[0],
                                 which=scenario.contact.pairs)
     t0 = time.perf_counter()
@@ -112,13 +121,11 @@ def main():
         plain = simulate(scenario, state=state, dd=dd2, witness_approach=False)
     coarse = None
     if args.coarse_step > 0:
-        import copy
         sc2 = copy.deepcopy(scenario)
         sc2.simulator_config.max_step_size = args.coarse_step
         coarse = simulate(sc2, state=state, dd=build_docking_diagram(sc2))
     other = None
     if args.compare_scheme and args.compare_scheme != scenario.simulator_config.integration_scheme:
-        import copy
         sc3 = copy.deepcopy(scenario)
         sc3.simulator_config.integration_scheme = args.compare_scheme
         other = simulate(sc3, state=state, dd=build_docking_diagram(sc3))
@@ -126,7 +133,8 @@ def main():
     if starts is not None:
         print(f"compiled kernels: cold start {starts[0]:.2f} s (compiling into an empty cache), "
               f"warm start {starts[1]:.2f} s (loading it), each a fresh process")
-    print(f"set-up: {t_state:.4f} s")
+    print(f"set-up: {t_state:.4f} s (another approach of the same geometry: "
+          f"{t_state_warm:.4f} s)")
     print(f"set-up seeks: {seeks} (the first-contact search on its final approach)")
     print(f"diagram build (excluded): {t_build:.2f} s")
     print(f"simulated {r.end_time:.4f} s (captured: {r.captured}); impacts {len(r.impacts)}; "
