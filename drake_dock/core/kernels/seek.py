@@ -28,17 +28,28 @@ def _point(kind, prm, R, o, u0, u1):
 
 
 @njit(cache=True)
+def _frame(R, o):
+    """R and o as twelve scalars, read once for a grid's loop."""
+    return (R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2], R[2, 0], R[2, 1], R[2, 2],
+            o[0], o[1], o[2])
+
+
+@njit(cache=True)
+def _place(F, r, X, a):
+    """X[a] = R r + o (Eq. 20) for the `_frame` F, as `_point` computes it."""
+    X[a, 0] = F[0] * r[0] + F[1] * r[1] + F[2] * r[2] + F[9]
+    X[a, 1] = F[3] * r[0] + F[4] * r[1] + F[5] * r[2] + F[10]
+    X[a, 2] = F[6] * r[0] + F[7] * r[1] + F[8] * r[2] + F[11]
+
+
+@njit(cache=True)
 def _positions(kind, prm, R, o, U):
-    """The points R r(u) + o (Eq. 20) at the rows u of U, as `_point` computes them."""
+    """The points R r(u) + o (Eq. 20) at the rows u of U."""
     X = np.empty((U.shape[0], 3))
-    r00, r01, r02, r10, r11, r12 = R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2]
-    r20, r21, r22, o0, o1, o2 = R[2, 0], R[2, 1], R[2, 2], o[0], o[1], o[2]
+    F = _frame(R, o)
     two = U.shape[1] == 2
     for a in range(U.shape[0]):
-        r = position(kind, prm, U[a, 0], U[a, 1] if two else 0.0)
-        X[a, 0] = r00 * r[0] + r01 * r[1] + r02 * r[2] + o0
-        X[a, 1] = r10 * r[0] + r11 * r[1] + r12 * r[2] + o1
-        X[a, 2] = r20 * r[0] + r21 * r[1] + r22 * r[2] + o2
+        _place(F, position(kind, prm, U[a, 0], U[a, 1] if two else 0.0), X, a)
     return X
 
 
@@ -107,16 +118,11 @@ def _axes_positions(kind, prm, R, o, A):
             U[a] = _axes_point(A, a)
         return _positions(kind, prm, R, o, U)
     X = np.empty((n * n, 3))
-    r00, r01, r02, r10, r11, r12 = R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2]
-    r20, r21, r22, o0, o1, o2 = R[2, 0], R[2, 1], R[2, 2], o[0], o[1], o[2]
+    F = _frame(R, o)
     for j in range(n):
         row = petal_row(prm, A[1, j])
         for i in range(n):
-            r = petal_point(prm, A[0, i], A[1, j], row)
-            a = i * n + j
-            X[a, 0] = r00 * r[0] + r01 * r[1] + r02 * r[2] + o0
-            X[a, 1] = r10 * r[0] + r11 * r[1] + r12 * r[2] + o1
-            X[a, 2] = r20 * r[0] + r21 * r[1] + r22 * r[2] + o2
+            _place(F, petal_point(prm, A[0, i], A[1, j], row), X, i * n + j)
     return X
 
 
