@@ -171,7 +171,7 @@ def stewart_deflection(dp: DockingPlant, plant_context):
 
 
 def stewart_history(dp: DockingPlant, X) -> tuple[np.ndarray, np.ndarray]:
-    """The Stewart element's stroke \|x\| (m, the translational deflection of
+    """The Stewart element's stroke |x| (m, the translational deflection of
     `stewart_deflection`) and the magnitude of its force on the target APDS (N) at each plant
     state [q, v] of X [N, nq + nv]."""
     pc = dp.plant.CreateDefaultContext()

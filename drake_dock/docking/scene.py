@@ -180,7 +180,21 @@ def first_contact(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13,
     ends of the steps its patches can touch in (`touch_steps`). Remembered per geometry and
     approach (a pure function of them)."""
     lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, step, xtol, which)
+    if lam_c is None:
+        raise NoPairCloses(f"no pair closes on the approach {approach}")
     return lam_c, list(names)
+
+
+class NoPairCloses(NumericalError):
+    """No pair of the contact set closes on the approach down to a ring-face distance of -H."""
+
+
+def first_contact_or_faces(g: ApdsGeometry, approach: Approach, which="paper"):
+    """`first_contact`, or, when no pair of the set closes on the approach, where the rings'
+    faces meet (lam = 0, the ring-face plane; no closing pair): docs/model.md, "Initial
+    conditions"."""
+    lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, None, 1e-13, which)
+    return (0.0, []) if lam_c is None else (lam_c, list(names))
 
 
 def first_contact_seeks(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13,
@@ -282,7 +296,7 @@ def _first_contact(geometry: tuple, approach: Approach, step, xtol, which):
             d_c = max(roots.values())
             names = tuple(sorted(n for n, r in roots.items() if r >= d_c - 1e-9))
             return d_c, names, gaps.seeks
-    raise NumericalError(f"no pair closes on the approach {approach}")
+    return None, (), gaps.seeks
 
 
 @dataclasses.dataclass
@@ -341,11 +355,12 @@ def initial_state(scenario) -> InitialState:
 
 def contact_approach(scenario):
     """The scenario's straight approach and its first contact: (Approach, lam_c, closing
-    pairs of the scenario's contact set). The lateral offset is the ring centre's at first
+    pairs of the scenario's contact set; lam_c = 0 and none where no pair closes and the ring
+    faces meet first). The lateral offset is the ring centre's at first
     contact. With a lateral velocity
     the aim point (where the path meets the target's ring-face plane) is
     aim = offset + s v_lateral / chaser_speed, where s, the ring-face distance at contact, solves
-    s = h_c(aim(s)) (brentq to 1e-10 m)."""
+    s = h_c(aim(s)) (brentq to 1e-10 m; `_consistent_height`)."""
     ic = scenario.initial
     g = scenario.geometry
     which = scenario.contact.pairs
@@ -361,12 +376,75 @@ def contact_approach(scenario):
 
     def mismatch(s):
         a = approach(s)
-        return a.height(first_contact(g, a, which=which)[0]) - s
+        return a.height(first_contact_or_faces(g, a, which)[0]) - s
 
     s = 0.0
     if slope.any():
-        s_max = 2.0 * g.H + 0.05           # no pair is closed above this ring-face distance
-        s = brentq(mismatch, 0.0, s_max, xtol=1e-10)
+        s = _consistent_height(mismatch, 2.0 * g.H + 0.05)
+        if s is None:
+            raise NoPairCloses(
+                f"no straight approach at initial.lateral_velocity {ic.lateral_velocity} m/s "
+                f"has its first contact (contact.pairs: {which}) at initial.lateral_offset "
+                f"{ic.lateral_offset} m: the first contact jumps past that offset")
     a = approach(s)
-    lam_c, closing = first_contact(g, a, which=which)
+    lam_c, closing = first_contact_or_faces(g, a, which)
+    if not closing:
+        _check_free_approach(g, a, which)
     return a, lam_c, closing
+
+
+# |s - h_c(aim(s))| below this is a root of the placement's fixed point, not a jump (m): a
+# jump in the first contact moves it by 0.1 mm or more.
+PLACEMENT_TOL = 1e-6
+
+
+def _consistent_height(mismatch, s_max, cells=46):
+    """The ring-face distance s in [0, s_max] with mismatch(s) = h_c(aim(s)) - s = 0: brentq on
+    the whole range first; h_c jumps where the first contact changes pairs or features, so a
+    bracket may close on a jump instead of a root. Then every sign change on a grid of ``cells``
+    intervals is tried, and the largest root is taken (the highest consistent first contact);
+    None when there is none."""
+    try:
+        s = brentq(mismatch, 0.0, s_max, xtol=1e-10)
+        if abs(mismatch(s)) <= PLACEMENT_TOL:
+            return s
+    except ValueError:                                  # no sign change over the range
+        pass
+    grid = np.linspace(0.0, s_max, cells + 1)
+    f = [mismatch(x) for x in grid]
+    for k in range(cells - 1, -1, -1):
+        if f[k] == 0.0:
+            return float(grid[k])
+        if f[k] * f[k + 1] < 0:
+            s = brentq(mismatch, grid[k], grid[k + 1], xtol=1e-10)
+            if abs(mismatch(s)) <= PLACEMENT_TOL:
+                return s
+    return None
+
+
+# Deeper than this, a feature crossing the other APDS on a free approach is a contact (m).
+FREE_APPROACH_TOL = 1e-4
+
+
+def _check_free_approach(g: ApdsGeometry, approach: Approach, which: str):
+    """Where no pair of the set closes, the chaser may still meet the target's APDS with a
+    feature the set does not model: the independent interpenetration check
+    (`drake_dock.docking.penetration`) follows the straight approach from the search's start
+    down to the ring-face plane, and a crossing deeper than `FREE_APPROACH_TOL` is a
+    `NoPairCloses` naming it. A clear approach (a roll of 0: the petals pass between each
+    other) goes on to the faces. A crossing within the tolerance of a petal's edge grazes it: in
+    the paper's geometry (Rs = R - H cot(alpha1)) a ring's inside circle passes exactly through
+    the petal tips of a coaxial approach."""
+    from drake_dock.docking.penetration import deepest_penetration
+    lam0 = travel_grid(g, approach)[0]
+    (R0, p0), (R1, p1) = approach.pose(lam0), approach.pose(0.0)
+    eye, zero = np.eye(3), np.zeros(3)
+    found = deepest_penetration(g, np.array([0.0, 1.0]), np.array([[eye, R0], [eye, R1]]),
+                                np.array([[zero, p0], [zero, p1]]), ("target", "chaser"),
+                                edge=-FREE_APPROACH_TOL)
+    if found.depth > FREE_APPROACH_TOL:
+        height = approach.height(lam0) * (1.0 - found.time)
+        raise NoPairCloses(
+            f"no pair of contact.pairs: {which} closes on the approach {approach}, but there "
+            f"the {found.feature} passes through the {found.solid} (by {found.depth * 1e3:.3g}"
+            f" mm at the ring-face distance {height:.4g} m): a contact the set does not model")
