@@ -386,7 +386,8 @@ def select_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9
             f"({modes} and {tuple(NAME[m] for m in M_[other])}): Painleve indeterminacy",
             time=time, couples=names)
     dirs = [D_[best, i].copy() if m == ref.SLIDE else None for i, m in enumerate(modes)]
-    return ref.ContactSolution(modes, dirs, V_[best], LN[best], LT[best], GF[best], list(rows))
+    return ref.ContactSolution(modes, dirs, V_[best].copy(), LN[best].copy(), LT[best].copy(),
+                               GF[best].copy(), list(rows))
 
 
 def warm():
