@@ -48,6 +48,7 @@ from drake_dock.errors import NumericalError, PainleveError, SingularContactErro
 STICK, SLIDE, DETACH = "stick", "slide", "detach"
 MAX_ENUMERATED = 8
 TIE_RTOL = 1e-6     # consistency accepted at a transition when none holds at rtol
+SLIDE_START_ITER = 200   # fixed-point iterations for the direction of a start of sliding
 
 
 @dataclasses.dataclass
@@ -160,7 +161,8 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None) -> C
                            Cf if Cf is not None else np.zeros_like(a0), list(rows))
 
 
-def _slide_start(Minv, a0, rows, modes, dirs, i_start, omega, time, max_iter=200):
+def _slide_start(Minv, a0, rows, modes, dirs, i_start, omega, time,
+                 max_iter=SLIDE_START_ITER):
     """Sliding directions of couples that start to slide from rest: friction opposes the
     tangential relative acceleration it produces (fixed point s = a_t/|a_t|)."""
     dirs = list(dirs)

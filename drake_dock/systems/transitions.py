@@ -184,7 +184,7 @@ class Transitions:
         M, Minv, a0, _, _ = ev.free_acceleration(ctx, v, inputs)
         select = compiled_constraints.select_modes if opt.compiled else select_modes
         sol = select(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
-                           avoid=[() if hit else leaving.get(i, ()) for i in cand])
+                     avoid=[() if hit else leaving.get(i, ()) for i in cand])
         cons = []
         for j, i in enumerate(cand):
             st = states[i]
