@@ -62,7 +62,8 @@ class ContactOptions:
                                      # track_distance (`seek_couple`): their distance only sets
                                      # the clearance, which keeps track_distance / 2 in hand
     max_impacts: int = 10000
-    compiled: bool = True            # the couples by the compiled kernels (False: in Python)
+    compiled: bool = True            # the couples, seeks, constraint solve and mode selection
+                                     # by the compiled kernels (False: in Python)
 
 
 @dataclasses.dataclass

@@ -11,6 +11,7 @@ from drake_dock.core import hybrid
 from drake_dock.core.constraints import select_modes
 from drake_dock.core.couple import evaluate_couple
 from drake_dock.core.hybrid import Mode
+from drake_dock.core.kernels import constraints as compiled_constraints
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.core.patches import posed
@@ -181,8 +182,9 @@ class Transitions:
         ev.set_scratch(q, v)
         rows = [ev.row(i, evs[i], poses, ctx) for i in cand]
         M, Minv, a0, _, _ = ev.free_acceleration(ctx, v, inputs)
-        sol = select_modes(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
-                           avoid=[() if hit else leaving.get(i, ()) for i in cand])
+        select = compiled_constraints.select_modes if opt.compiled else select_modes
+        sol = select(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
+                     avoid=[() if hit else leaving.get(i, ()) for i in cand])
         cons = []
         for j, i in enumerate(cand):
             st = states[i]
