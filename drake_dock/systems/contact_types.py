@@ -63,6 +63,8 @@ class ContactOptions:
                                      # the clearance, which keeps track_distance / 2 in hand
     max_impacts: int = 10000
     compiled: bool = True            # the couples by the compiled kernels (False: in Python)
+    broad_phase: bool = False        # a far pair whose covers are at least track_distance
+                                     # apart is not sought (`Transitions.screen`)
 
 
 @dataclasses.dataclass
