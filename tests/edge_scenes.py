@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from drake_dock.core.patches import Annulus, Arc, Circle, Segment
+from drake_dock.core.patches import Annulus, Arc, Circle, Cone, Segment
 from drake_dock.docking.scene import rot_x, rot_z
 
 EZ = np.array([0.0, 0.0, 1.0])
@@ -148,6 +148,34 @@ def rim_over_face():
                       math.atan2(x2[1], x2[0]) % (2 * math.pi)])
         p1, p2 = s.world(t, x1, x2)
         return u, x1[2], p1, p2, EZ
+
+    s.exact = exact
+    return s
+
+
+def arc_over_cone():
+    """A tip-like arc (radius 0.4) held level, its centre ~0.1 m off the axis of a guide-surface
+    cone (rho = 0.6 - z cot 45 deg, Eq. 12) and ~0.32 m up, outside it: the couple is the arc's
+    point nearest the axis, rho = r - D (D the centre's distance from the axis), at the gap
+    (rho + z cot(alpha) - R0) sin(alpha), with the foot on the cone's meridian through it and
+    the normal (sin(alpha) e_rho + cos(alpha) e_z)."""
+    alpha, R0 = math.pi / 4, 0.6
+    cone = Cone(R0, alpha, (2.0, 4.3), (0.0, 0.4))
+    s = EdgeScene("CS", Arc(0.4, 0.0, (math.pi - 1.5, math.pi + 1.5)), cone,
+                  (Wave(0.1, 0.02, 0.8), Wave(0.0, 0.03, 1.1), Wave(0.32, 0.01, 1.3)),
+                  Wave(0.0, 0.3, 0.9))
+
+    def exact(t, branch=+1):
+        c = np.array([f(t) for f in s.c])
+        D = math.hypot(c[0], c[1])
+        x1 = np.array([c[0] * (1.0 - s.r / D), c[1] * (1.0 - s.r / D), c[2]])
+        e = x1[:2] / (s.r - D)
+        n = np.array([math.sin(alpha) * e[0], math.sin(alpha) * e[1], math.cos(alpha)])
+        gap = (s.r - D + c[2] / math.tan(alpha) - R0) * math.sin(alpha)
+        x2 = x1 - gap * n
+        u = np.array([ring_angle(s, t, x1), math.atan2(x2[1], x2[0]) % (2 * math.pi), x2[2]])
+        p1, p2 = s.world(t, x1, x2)
+        return u, gap, p1, p2, rot_z(s.chi(t)) @ n
 
     s.exact = exact
     return s

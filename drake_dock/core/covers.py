@@ -19,6 +19,10 @@ c1, c2, radii rho1 + rho2 = r) can touch only for lam in the interval
     b = w . e,  D = b^2 - |e|^2 (|w|^2 - r^2) >= 0;
 
 outside the union of these intervals the patches are apart.
+
+At a fixed pose the least of |c1 - c2| - (rho1 + rho2) over the sphere pairs is a lower bound of
+the distance of the two patches (`cover_gap`): every point of a patch lies in a sphere of its
+cover.
 """
 from __future__ import annotations
 
@@ -88,6 +92,13 @@ def patch_cover(patch, n: int, block: int) -> Cover:
         hit = cache[(n, block)] = Cover.from_cells(patch.position(U), cell_radii(patch, U, half),
                                                    blocks)
     return hit
+
+
+def cover_gap(a: Cover, b: Cover) -> float:
+    """The least |c_a - c_b| - (rho_a + rho_b) over the cell sphere pairs of the posed covers a
+    and b: a lower bound of the distance of their patches (negative where spheres overlap)."""
+    d = np.linalg.norm(a.centres[:, None, :] - b.centres[None, :, :], axis=-1)
+    return float((d - a.radii[:, None] - b.radii[None, :]).min())
 
 
 def _intervals(w, r, e):

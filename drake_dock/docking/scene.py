@@ -14,7 +14,7 @@ from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import Patch, posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.apds import PAIR_SETS, ApdsGeometry, apds_patches
+from drake_dock.docking.apds import PAIR_SETS, ApdsGeometry, apds_patches, side_phi
 from drake_dock.errors import InputError, NumericalError
 
 TARGET_APDS = "target_apds"
@@ -56,6 +56,8 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     if which == "complete":
         pairs += edge_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
         pairs += edge_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
+        pairs += tip_surface_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
+        pairs += tip_surface_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
     return pairs
 
 
@@ -72,6 +74,25 @@ def edge_pairs(P, one, other) -> list[PairSpec]:
     out = [PairSpec(f"cc_{x}ring_{y}{i}", "CC", b1, P.ring, b2, P.sides[i]) for i in range(1, 7)]
     out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
     out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
+    return out
+
+
+def tip_surface_pairs(P, one, other, R) -> list[PairSpec]:
+    """APDS ``one``'s tip arcs (Body 1) against the guide surfaces of APDS ``other`` they can
+    face, cs_<X>tip<j>_<Y><k> (C-S); R turns ``other``'s frame into ``one``'s at the matched
+    facing. Tip arc j faces surface k when their mid-directions are less than 90 deg apart
+    about the axis at the matched facing: the two petals next to the gap it enters, reached at
+    a relative roll near +-60 deg; the third petal is 180 deg away (docs/model.md)."""
+    (x, b1), (y, b2) = one, other
+    out = []
+    for j in (1, 2, 3):
+        a = side_phi(2 * j - 1) + math.pi / 6
+        for k in (1, 2, 3):
+            b = side_phi(2 * k - 1) + math.pi / 6
+            w = R @ np.array([math.cos(b), math.sin(b), 0.0])
+            if w[0] * math.cos(a) + w[1] * math.sin(a) > 0.0:
+                out.append(PairSpec(f"cs_{x}tip{j}_{y}{k}", "CS", b1, P.tips[j], b2,
+                                    P.surfaces[k]))
     return out
 
 

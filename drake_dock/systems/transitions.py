@@ -46,7 +46,8 @@ class Transitions:
             sl = ev.couple_slice(i)
             if initial or (st.mode == Mode.FAR
                            and ev.far.bound(i, poses, st) >= early * st.clearance):
-                self.seek(i, poses, st, u, t, False, initial)
+                if not self.screen(i, poses, st):
+                    self.seek(i, poses, st, u, t, False, initial)
                 continue
             if st.mode == Mode.FAR:
                 continue
@@ -77,6 +78,27 @@ class Transitions:
                                      pairs_plus=copy.deepcopy(modes.pairs),
                                      impact_loss_plus=modes.impact_loss)
         return x_new, modes
+
+    def screen(self, i, poses, st) -> bool:
+        """The broad phase (``options.broad_phase``) for far pair i (its `PairState` st): when
+        the least gap G of its covers (a lower bound of its distance) is at least
+        ``track_distance``, a seek could only leave it far, so it is not sought; it keeps G as
+        its distance, with the far pair's clearance of `hybrid.after_seek`. Returns whether
+        the pair was screened so."""
+        opt = self.options
+        if not opt.broad_phase:
+            return False
+        with self.timing.measure("seeking"):
+            gap = self.ev.far.cover_gap(i, poses)
+            if not gap >= opt.track_distance:
+                return False
+            st.ref_X21 = self.ev.far.reference(i, poses)
+            st.distance = gap
+            st.mode, st.clearance = hybrid.after_seek(gap, False, False, False,
+                                                      opt.track_distance, opt.reseek_floor)
+            st.slide_dir = None
+            self.timing.count_screen(self.pairs[i].name)
+        return True
 
     def seek(self, i, poses, st, u, time, was_contact, initial=False):
         """Sect. 5.1 for pair i (its `PairState` st, its couple written into u), and the mode
