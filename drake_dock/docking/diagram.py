@@ -19,10 +19,11 @@ from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 from pydrake.systems.framework import (DiagramBuilder, EventStatus, LeafSystem, PublishEvent,
                                        WitnessFunctionDirection)
 
-from drake_dock.systems.contact_system import ContactOptions, ContactPair, RigidContactSystem
+from drake_dock.systems.contact_system import (ContactOptions, ContactPair, Handover,
+                                                RigidContactSystem)
 from drake_dock.systems.simulator import tolerances
 from drake_dock.docking.plant import DockingPlant, StewartDamperPower, make_docking_plant
-from drake_dock.docking.scene import scenario_pairs
+from drake_dock.docking.scene import pair_handovers, scenario_pairs
 
 
 @dataclasses.dataclass
@@ -77,8 +78,9 @@ def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagra
     scene_graph = builder.AddSystem(SceneGraph())
     dp = make_docking_plant(scenario, scene_graph)
     frames = dp.apds_frames
+    specs = scenario_pairs(scenario)
     pairs = [ContactPair(p.name, p.kind, frames[p.body1], p.patch1, frames[p.body2], p.patch2)
-             for p in scenario_pairs(scenario)]
+             for p in specs]
     if options is None:
         # LZB's accuracy follows the simulator's (`drake_dock.systems.simulator.tolerances`).
         options = ContactOptions(impact_rtol=tolerances(scenario.simulator_config).impact_rtol)
@@ -87,7 +89,7 @@ def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagra
         wrench_bodies=("chaser",),
         extra_powers=[("stewart_damper_work", StewartDamperPower(dp))],
         energy_scale=0.5 * scenario.bodies.chaser.mass * scenario.initial.chaser_speed ** 2
-        or 1.0))
+        or 1.0, handovers=[Handover(*h) for h in pair_handovers(scenario.geometry, specs)]))
     contact.set_name("rigid_contact")
     to_pose = builder.AddSystem(MultibodyPositionToGeometryPose(dp.plant,
                                                                 input_multibody_state=True))

@@ -17,6 +17,7 @@ from drake_dock.core.kernels.couples import DRIFT_REL as KERNEL_DRIFT_REL
 from drake_dock.errors import DriftError
 from drake_dock.systems.contact_types import Evaluation
 from drake_dock.systems.far_pairs import FarPairs
+from drake_dock.systems.handovers import HandoverLinks
 
 KV = JacobianWrtVariable.kV
 
@@ -38,7 +39,8 @@ class PlantEvaluator:
     x = [q, v, u*, energy integrals]; pair i's couple is u*[uoff[i]:uoff[i + 1]]. ``inputs``
     arguments are (generalized force or None, [(body, world wrench [torque, force])])."""
 
-    def __init__(self, plant, pairs, law, options, extra_powers=(), energy_scale=1.0):
+    def __init__(self, plant, pairs, law, options, extra_powers=(), energy_scale=1.0,
+                 handovers=()):
         self.plant, self.pairs, self.law, self.options = plant, list(pairs), law, options
         self.extra_powers = list(extra_powers)
         self.energy_scale = energy_scale
@@ -67,6 +69,7 @@ class PlantEvaluator:
                                      for p, f in zip(self.pairs, self.fidx)])
             self.kernel = kernel if kernel.supported else None
         self.far = FarPairs(pairs, self.fidx)
+        self.links = HandoverLinks(self.pairs, handovers)
         self.evaluations = 0
         self._zero_v = np.zeros(self.nv)         # never written
         self._world = plant.world_frame()
