@@ -105,8 +105,7 @@ class Transitions:
 
     def seek(self, i, poses, states, u, time, was_contact, initial=False):
         """Sect. 5.1 for pair i (its `PairState` states[i], its couple written into u), and the
-        mode
-        that follows (`hybrid.after_seek`). At the initial seek a pair with a declared
+        mode that follows (`hybrid.after_seek`). At the initial seek a pair with a declared
         ``sigma`` whose couple lies on the wrong side by more than ``impact_gap_tol`` is
         refused: the bodies start interpenetrating."""
         name = self.pairs[i].name
