@@ -216,3 +216,114 @@ def tip_handover():
     roots = [(-B + k * math.sqrt(B * B - 4 * A * C)) / (2 * A) for k in (-1, 1)]
     (t_h,) = [x for x in roots if 0.0 <= x <= 1.0]
     return scenes[0], scenes[1], t_h
+
+
+class Fn:
+    """f(t) with its rate f'(t), given as two functions."""
+
+    def __init__(self, f, df):
+        self.f, self.df = f, df
+
+    def __call__(self, t):
+        return self.f(t)
+
+    def rate(self, t):
+        return self.df(t)
+
+
+def _ring_angle(phi, psi):
+    """The parameter of the point at angle phi in the plane of a ring posed by
+    Rz(beta) Rx(pi/2) Rz(psi) (phi from its radial axis towards +z)."""
+    return (phi - psi) % (2 * math.pi)
+
+
+def ring_over_plate_edge():
+    """A ring (radius 0.4) standing in a vertical plane y = c_y across the edge x = 0 of the
+    plate 0 <= x <= 1, -1 <= y <= 1 (z = 0), in contact throughout: on the face while
+    c_x = 0.03 cos(2 pi t) >= 0 (its lowest point, c_z = r), pivoting over the edge point
+    (0, c_y, 0) while c_x < 0 (|c - edge point| = r). Returns (surface scene, edge scene,
+    `SurfaceEdge`, (t_on, t_off) = (0.25, 0.75), the times c_x = 0)."""
+    from drake_dock.core.handover import SurfaceEdge
+    from drake_dock.core.patches import PlaneRect
+    r = 0.4
+    cx = Fn(lambda t: 0.03 * math.cos(2 * math.pi * t),
+            lambda t: -0.06 * math.pi * math.sin(2 * math.pi * t))
+    cz = Fn(lambda t: r if cx(t) >= 0 else math.sqrt(r * r - cx(t) ** 2),
+            lambda t: 0.0 if cx(t) >= 0 else -cx(t) * cx.rate(t) / math.sqrt(r * r - cx(t) ** 2))
+    c = (cx, Wave(0.0, 0.1, 1.3, v=0.02), cz)
+    psi, tau = Wave(0.3, 0.5, 0.9), Wave(0.5 * math.pi)
+    plate = PlaneRect((0.0, -1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), size=(1.0, 2.0))
+    edge = Segment((0.0, -1.0, 0.0), (0.0, 1.0, 0.0))
+    surf = EdgeScene("CS", Circle(r), plate, c, psi, tau=tau)
+    over = EdgeScene("CC", Circle(r), edge, c, psi, tau=tau)
+    R2 = lambda t: rot_z(surf.chi(t))
+
+    def exact_face(t):
+        x = np.array([cx(t), c[1](t), 0.0])
+        u = np.array([_ring_angle(-0.5 * math.pi, psi(t)), x[0], x[1] + 1.0])
+        return (u, 0.0, *surf.world(t, x, x), R2(t) @ EZ)
+
+    def exact_edge(t):
+        x = np.array([0.0, c[1](t), 0.0])
+        u = np.array([_ring_angle(math.atan2(-cz(t), -cx(t)), psi(t)), 0.5 * (x[1] + 1.0)])
+        return (u, 0.0, *over.world(t, x, x), R2(t) @ np.array([cx(t), 0.0, cz(t)]) / r)
+
+    surf.exact, over.exact = exact_face, exact_edge
+    return surf, over, SurfaceEdge(0, False, lambda e: 2.0 * e, lambda f: 0.5 * f), (0.25, 0.75)
+
+
+def ring_over_petal_tip():
+    """A ring (radius 0.4) in the meridian plane theta_0(t) of an APDS (`ApdsGeometry()`), in
+    contact throughout: rolling on guide surface 1 (tangent to its generatrix at zeta_f =
+    H + p) while p(t) = 0.02 sin(2 pi (t - 1/4)) < 0, pivoting over the tip arc's point at
+    theta_0 (by the angle p / (r sin alpha1), so that the centre's velocity is continuous)
+    while p >= 0. The cone's nearest point to a point of the meridian half-plane lies on the
+    same meridian. Returns (surface scene, tip scene, `SurfaceEdge`, (0.25, 0.75))."""
+    from drake_dock.docking.apds import ApdsGeometry, guide_surface, petal_edges, tip_arc
+    g = ApdsGeometry()
+    a1, r = g.alpha1, 0.4
+    cot, Rt = 1.0 / math.tan(a1), g.R - g.H / math.tan(a1)
+    A = g.R * math.sin(g.alpha2)
+    th0 = Wave(math.pi / 6, 0.05, 1.1)
+    p = Fn(lambda t: 0.02 * math.sin(2 * math.pi * (t - 0.25)),
+           lambda t: 0.04 * math.pi * math.cos(2 * math.pi * (t - 0.25)))
+
+    def meridian(t):
+        """(rho_c, z_c), their rates, and the contact point's (rho, z) and unit normal."""
+        if p(t) < 0:
+            zf = g.H + p(t)
+            m = np.array([math.sin(a1), math.cos(a1)])
+            foot = np.array([g.R - zf * cot, zf])
+            return foot + r * m, p.rate(t) * np.array([-cot, 1.0]), foot, m
+        phi = 0.5 * math.pi - a1 + p(t) / (r * math.sin(a1))
+        e = np.array([math.cos(phi), math.sin(phi)])
+        rate = p.rate(t) / math.sin(a1) * np.array([-e[1], e[0]])
+        return np.array([Rt, g.H]) + r * e, rate, np.array([Rt, g.H]), e
+
+    def centre(t, k):
+        (rho, z), (drho, dz), _, _ = meridian(t)
+        b, db = th0(t), th0.rate(t)
+        return ((rho * math.cos(b), rho * math.sin(b), z)[k],
+                (drho * math.cos(b) - rho * math.sin(b) * db,
+                 drho * math.sin(b) + rho * math.cos(b) * db, dz)[k])
+
+    c = tuple(Fn(lambda t, k=k: centre(t, k)[0], lambda t, k=k: centre(t, k)[1])
+              for k in range(3))
+    psi, tau = Wave(0.2, 0.3, 0.7), Wave(0.5 * math.pi)
+    surf = EdgeScene("CS", Circle(r), guide_surface(g, 1), c, psi, tau=tau, beta=th0)
+    tip = EdgeScene("CC", Circle(r), tip_arc(g, 1), c, psi, tau=tau, beta=th0)
+
+    def exact(scene, t):
+        _, _, (rho, z), m = meridian(t)
+        b = th0(t)
+        x = np.array([rho * math.cos(b), rho * math.sin(b), z])
+        n = rot_z(scene.chi(t)) @ np.array([m[0] * math.cos(b), m[0] * math.sin(b), m[1]])
+        ring = _ring_angle(math.atan2(-m[1], -m[0]), psi(t))
+        if scene is tip:
+            return (np.array([ring, b]), 0.0, *tip.world(t, x, x), n)
+        t1 = math.asin(A / rho) - g.alpha2
+        s = (b - t1) / (math.pi / 3 - 2 * t1)
+        return (np.array([ring, s, z]), 0.0, *surf.world(t, x, x), n)
+
+    surf.exact, tip.exact = (lambda t: exact(surf, t)), (lambda t: exact(tip, t))
+    return surf, tip, petal_edges(g, 1)["tip"], (0.25, 0.75)

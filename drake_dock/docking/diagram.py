@@ -22,11 +22,12 @@ from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 from pydrake.systems.framework import (DiagramBuilder, EventStatus, LeafSystem, PublishEvent,
                                        WitnessFunctionDirection)
 
-from drake_dock.systems.contact_system import ContactOptions, ContactPair, RigidContactSystem
+from drake_dock.systems.contact_system import (ContactOptions, ContactPair, Handover,
+                                                RigidContactSystem)
 from drake_dock.systems.simulator import tolerances
 from drake_dock.docking.outcome import CaptureRule, misalignment
 from drake_dock.docking.plant import DockingPlant, StewartDamperPower, make_docking_plant
-from drake_dock.docking.scene import scenario_pairs
+from drake_dock.docking.scene import pair_handovers, scenario_pairs
 
 
 @dataclasses.dataclass
@@ -103,8 +104,9 @@ def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagra
     scene_graph = builder.AddSystem(SceneGraph())
     dp = make_docking_plant(scenario, scene_graph)
     frames = dp.apds_frames
+    specs = scenario_pairs(scenario)
     pairs = [ContactPair(p.name, p.kind, frames[p.body1], p.patch1, frames[p.body2], p.patch2)
-             for p in scenario_pairs(scenario)]
+             for p in specs]
     if options is None:
         # LZB's accuracy follows the simulator's (`drake_dock.systems.simulator.tolerances`).
         # The broad phase screens the far pairs of the complete set; the paper's 12 pairs are
@@ -116,7 +118,7 @@ def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagra
         wrench_bodies=("chaser",),
         extra_powers=[("stewart_damper_work", StewartDamperPower(dp))],
         energy_scale=0.5 * scenario.bodies.chaser.mass * scenario.initial.chaser_speed ** 2
-        or 1.0))
+        or 1.0, handovers=[Handover(*h) for h in pair_handovers(scenario.geometry, specs)]))
     contact.set_name("rigid_contact")
     to_pose = builder.AddSystem(MultibodyPositionToGeometryPose(dp.plant,
                                                                 input_multibody_state=True))

@@ -14,7 +14,8 @@ from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import Patch, posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.apds import PAIR_SETS, ApdsGeometry, apds_patches, side_phi
+from drake_dock.docking.apds import (PAIR_SETS, ApdsGeometry, apds_patches, petal_edges,
+                                      side_phi)
 from drake_dock.errors import InputError, NumericalError
 
 TARGET_APDS = "target_apds"
@@ -93,6 +94,22 @@ def tip_surface_pairs(P, one, other, R) -> list[PairSpec]:
             if w[0] * math.cos(a) + w[1] * math.sin(a) > 0.0:
                 out.append(PairSpec(f"cs_{x}tip{j}_{y}{k}", "CS", b1, P.tips[j], b2,
                                     P.surfaces[k]))
+    return out
+
+
+def pair_handovers(g: ApdsGeometry, pairs) -> list:
+    """(edge pair, surface pair, `SurfaceEdge`) of each hand-over among ``pairs``
+    (`drake_dock.core.handover`): a ring's inside circle passes between guide surface k
+    (cs_<X>ring_<Y>k) and its sides 2k - 1, 2k (cc_<X>ring_<Y><i>) and its tip arc
+    (cc_<X>ring_<Y>tip<k>), `petal_edges`."""
+    names = {p.name for p in pairs}
+    out = []
+    for x, y in (("C", "T"), ("T", "C")):
+        for k in (1, 2, 3):
+            for key, edge in petal_edges(g, k).items():
+                e = f"cc_{x}ring_{y}{'tip' + str(k) if key == 'tip' else key}"
+                if {e, f"cs_{x}ring_{y}{k}"} <= names:
+                    out.append((e, f"cs_{x}ring_{y}{k}", edge))
     return out
 
 

@@ -21,7 +21,8 @@ from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.core.contact_law import ContactLaw
 from drake_dock.systems.contact_system import (COUPLE_SLICES, ContactOptions, ContactPair,
-                                               RigidContactSystem)
+                                               Handover, RigidContactSystem)
+from drake_dock.core.handover import SurfaceEdge
 from drake_dock.core.patches import Annulus, Circle, PlaneRect, Segment
 from drake_dock.systems.simulator import make_simulator, make_witness_approach
 
@@ -64,12 +65,15 @@ def rot_x(a):
 
 
 def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restitution=0.0,
-                    plane_end=50.0, face="plane", options=ContactOptions()) -> SmallScene:
+                    plane_end=50.0, face="plane", edge=False,
+                    options=ContactOptions()) -> SmallScene:
     """A uniform disk (rim = a Circle, C-S) on a plane inclined by theta, its axle along y;
     down-slope is +x; the plane patch ends at x = ``plane_end``. I_axle = m r^2 / 2.
     ``face="annulus"`` takes a ring face instead of the plane: the `Annulus` 1 <= rho <= 100
     (u = (rho, theta), a polar parametrisation) centred at y = -``ANNULUS_CENTRE_Y``, so that the
-    disk's path along x runs across it near rho = 5."""
+    disk's path along x runs across it near rho = 5. With ``edge`` (on the plane) the plane's
+    end is an edge too: the pair "rim_edge" (C-C, the segment x = plane_end) with a hand-over
+    from and to "rim_plane" (`drake_dock.core.handover`)."""
     plant = _plant(G * np.array([math.sin(theta), 0.0, -math.cos(theta)]))
     I_ax = 0.5 * mass * radius ** 2
     I_d = 0.25 * mass * radius ** 2
@@ -87,9 +91,18 @@ def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restituti
         plane = PlaneRect([-50.0, -5.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
                           size=(50.0 + plane_end, 10.0))
     plant.Finalize()
-    pair = ContactPair("rim_plane", "CS", rim, Circle(radius), frame2, plane, sigma=1.0)
-    system = RigidContactSystem(plant, [pair], ContactLaw(mu=mu, mu_s=mu_s,
-                                                          restitution=restitution), options)
+    circle = Circle(radius)
+    pairs = [ContactPair("rim_plane", "CS", rim, circle, frame2, plane, sigma=1.0)]
+    handovers = []
+    if edge:
+        # The plane's parameters are (x + 50, y + 5); the segment's e gives y = 10 e - 5.
+        pairs.append(ContactPair("rim_edge", "CC", rim, circle, plant.world_frame(),
+                                 Segment([plane_end, -5.0, 0.0], [plane_end, 5.0, 0.0])))
+        handovers.append(Handover("rim_edge", "rim_plane", SurfaceEdge(
+            0, True, lambda e: 10.0 * e, lambda f: 0.1 * f)))
+    system = RigidContactSystem(plant, pairs, ContactLaw(mu=mu, mu_s=mu_s,
+                                                         restitution=restitution), options,
+                                handovers=handovers)
     return SmallScene(plant, system, body, dict(theta=theta, mass=mass, radius=radius,
                                                 I_axle=I_ax, mu=mu,
                                                 mu_s=system.law.static_mu))

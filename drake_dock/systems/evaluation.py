@@ -18,6 +18,7 @@ from drake_dock.core.kernels.couples import DRIFT_REL as KERNEL_DRIFT_REL
 from drake_dock.errors import DriftError
 from drake_dock.systems.contact_types import Evaluation
 from drake_dock.systems.far_pairs import FarPairs
+from drake_dock.systems.handovers import HandoverLinks
 
 KV = JacobianWrtVariable.kV
 
@@ -39,7 +40,8 @@ class PlantEvaluator:
     x = [q, v, u*, energy integrals]; pair i's couple is u*[uoff[i]:uoff[i + 1]]. ``inputs``
     arguments are (generalized force or None, [(body, world wrench [torque, force])])."""
 
-    def __init__(self, plant, pairs, law, options, extra_powers=(), energy_scale=1.0):
+    def __init__(self, plant, pairs, law, options, extra_powers=(), energy_scale=1.0,
+                 handovers=()):
         self.plant, self.pairs, self.law, self.options = plant, list(pairs), law, options
         self.extra_powers = list(extra_powers)
         self.energy_scale = energy_scale
@@ -73,6 +75,7 @@ class PlantEvaluator:
             from drake_dock.core.kernels import constraints as solver
             self.solver = solver
         self.far = FarPairs(pairs, self.fidx)
+        self.links = HandoverLinks(self.pairs, handovers)
         self.evaluations = 0
         self._zero_v = np.zeros(self.nv)         # never written
         self._world = plant.world_frame()
