@@ -12,6 +12,7 @@ import numpy as np
 from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.core.constraints import STICK, solve_given_modes
+from drake_dock.core.kernels import constraints as compiled
 from drake_dock.core.hybrid import Mode
 from drake_dock.studies.small_scenes import stool
 from drake_dock.systems.simulator import make_simulator
@@ -85,6 +86,12 @@ def main():
     def solve():
         solve_given_modes(Minv, a0, R, [STICK] * 3, [None] * 3, omega=20.0)
 
+    W, bias, gap, vn, _, mu, _ = compiled.pack_rows(R)
+    codes, dirs = np.full(3, compiled.STICK), np.zeros((3, 2))
+
+    def solve_compiled():
+        compiled.solve_packed(Minv, a0, W, bias, gap, vn, mu, codes, dirs, 20.0)
+
     n = a.repeats
     t_full = per_call(full, n)
     t_plant = per_call(plant_only, n)
@@ -92,7 +99,8 @@ def main():
              "3 couples (Eq. 47, frame, bias)": per_call(couples, n),
              "3 rows W (Drake Jacobians)": per_call(rows, n),
              "M, free acceleration": per_call(free, n),
-             "constraint solve (9 rows)": per_call(solve, n)}
+             "constraint solve (9 rows), Python": per_call(solve, n),
+             "constraint solve (9 rows), compiled": per_call(solve_compiled, n)}
     print(f"contact system, 3 sticking couples: {t_full:8.1f} us per derivative evaluation")
     print(f"plant alone (free flight):          {t_plant:8.1f} us")
     print(f"ratio contact system / plant:       {t_full / t_plant:8.1f}x")

@@ -6,7 +6,8 @@ spent isolating witness events (steps of more than 50 evaluations), and the rati
 runs, all measured in this run; and the same example with Drake's plain witness isolation
 (`simulate(..., witness_approach=False)`), for the ratio of the step shortening; and with a
 coarser step cap (``--coarse-step``), which is the output spacing, for its cost; and with the
-couples evaluated in Python instead of the compiled kernels (`ContactOptions.compiled`), with
+contact mathematics (couples, seeks, constraint solve, mode selection) in Python instead of
+the compiled kernels (`ContactOptions.compiled`), with
 the difference of the capture times. Also the set-up (the initial state: the first-contact
 placement, its seeks, and their number; and that of another approach of the same geometry)
 and the kernels' cold and warm start (a fresh process that compiles them into an empty cache
@@ -60,7 +61,7 @@ def kernel_start(cache_dir):
 
 
 def python_path_diagram(scenario, dd):
-    """The diagram of ``dd``'s options with the couples evaluated in Python."""
+    """The diagram of ``dd``'s options with the contact mathematics in Python."""
     options = dataclasses.replace(dd.contact.options, compiled=False)
     return build_docking_diagram(scenario, options=options)
 
@@ -160,7 +161,8 @@ def main():
               f"{other.wall_time:.3f} s, {other.evaluations} evaluations, "
               f"{len(other.record.t)} samples; capture {other.capture_time:.9f} s vs "
               f"{r.capture_time:.9f} s; ratio {other.wall_time / wall:.2f}x")
-    print(f"with the couples in Python instead of the compiled kernels: {py.wall_time:.3f} s, "
+    print(f"with the contact mathematics in Python instead of the compiled kernels: "
+          f"{py.wall_time:.3f} s, "
           f"{py.evaluations} evaluations; capture {py.capture_time!r} s vs "
           f"{r.capture_time!r} s (difference {abs(py.capture_time - r.capture_time):.1e} s); "
           f"ratio {py.wall_time / wall:.2f}x")

@@ -1,8 +1,9 @@
 """Model no more than a scene needs: per scene, the pairs it declares, the pairs searched and
-the seeks, and the share of the wall time spent seeking, in contact dynamics and in impacts
-(`RigidContactSystem.timing`), all measured in this run.
+the seeks (and the far pairs the broad phase screened), and the share of the wall time spent
+seeking, in contact dynamics and in impacts (`RigidContactSystem.timing`), all measured in this
+run; the docking scenes with both contact sets (`contact.pairs`).
 
-    python bench/time_shares.py
+    python bench/time_shares.py [--quick]
 """
 import math
 import time
@@ -22,11 +23,33 @@ def small(name, sc, X, V, t_end):
     print(f"{name}: {time_shares_line(sc.system.timing.shares(wall))}; wall {wall:.3f} s")
 
 
-def main():
+def docking(name, path, pairs):
+    """A docking scene with the contact set ``pairs``; the wall time per simulated second, as
+    the two sets first close at different ring distances (docs/model.md)."""
+    import yaml
+    from drake_dock.docking.scenario import load_scenario
     from drake_dock.docking.simulate import simulate
-    from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
-    r = simulate(load_scenario(PAPER_EXAMPLE))
-    print(f"paper example (12 pairs): {time_shares_line(r.timing)}; wall {r.wall_time:.3f} s")
+    with open(path) as f:
+        data = yaml.safe_load(f)
+    data.setdefault("contact", {})["pairs"] = pairs
+    r = simulate(load_scenario(data=yaml.safe_dump(data)))
+    print(f"{name}, {pairs} ({r.timing['pairs_declared']} pairs): {time_shares_line(r.timing)};"
+          f" wall {r.wall_time:.3f} s for {r.end_time:.4f} s simulated "
+          f"({r.wall_time / r.end_time:.2f} s/s, {r.evaluations} evaluations, {r.outcome})")
+
+
+def main(argv=None):
+    import argparse
+    from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--quick", action="store_true", help="the paper example only")
+    args = ap.parse_args(argv)
+    scenes = [("paper example", PAPER_EXAMPLE)]
+    if not args.quick:
+        scenes.append(("IDSS box corner", MODELS_DIR / "idss_box_corner.yaml"))
+    for name, path in scenes:
+        for pairs in ("paper", "complete"):
+            docking(name, path, pairs)
     sc = stool()
     small("stool at rest (3 pairs)", sc, (np.eye(3), np.array([0, 0, 0.2 + 0.05])),
           (np.zeros(3), np.zeros(3)), 0.5)

@@ -138,10 +138,12 @@ def format_summary(s) -> str:
 
 def time_shares_line(ts) -> str:
     """One line: the share of wall time spent seeking, in contact dynamics, in impacts and
-    elsewhere, and the pairs searched (declared pairs and seeks)."""
+    elsewhere, and the pairs searched (declared pairs, seeks, and far pairs the broad phase kept
+    from a seek)."""
     sh = ts["shares"]
     seeks = ts["seeks_per_pair"]
     return (f"time shares: seeking {sh['seeking']:.0%}, contact dynamics "
             f"{sh['contact_dynamics']:.0%}, impacts {sh['impacts']:.0%}, other {sh['other']:.0%};"
             f" pairs searched {sum(1 for n in seeks.values() if n)}/{ts['pairs_declared']} "
-            f"declared, {sum(seeks.values())} seeks")
+            f"declared, {sum(seeks.values())} seeks, "
+            f"{sum(ts.get('screens_per_pair', {}).values())} screened by the broad phase")

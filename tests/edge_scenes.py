@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from drake_dock.core.patches import Annulus, Arc, Circle, Segment
+from drake_dock.core.patches import Annulus, Arc, Circle, Cone, Segment
 from drake_dock.docking.scene import rot_x, rot_z
 
 EZ = np.array([0.0, 0.0, 1.0])
@@ -153,6 +153,34 @@ def rim_over_face():
     return s
 
 
+def arc_over_cone():
+    """A tip-like arc (radius 0.4) held level, its centre ~0.1 m off the axis of a guide-surface
+    cone (rho = 0.6 - z cot 45 deg, Eq. 12) and ~0.32 m up, outside it: the couple is the arc's
+    point nearest the axis, rho = r - D (D the centre's distance from the axis), at the gap
+    (rho + z cot(alpha) - R0) sin(alpha), with the foot on the cone's meridian through it and
+    the normal (sin(alpha) e_rho + cos(alpha) e_z)."""
+    alpha, R0 = math.pi / 4, 0.6
+    cone = Cone(R0, alpha, (2.0, 4.3), (0.0, 0.4))
+    s = EdgeScene("CS", Arc(0.4, 0.0, (math.pi - 1.5, math.pi + 1.5)), cone,
+                  (Wave(0.1, 0.02, 0.8), Wave(0.0, 0.03, 1.1), Wave(0.32, 0.01, 1.3)),
+                  Wave(0.0, 0.3, 0.9))
+
+    def exact(t, branch=+1):
+        c = np.array([f(t) for f in s.c])
+        D = math.hypot(c[0], c[1])
+        x1 = np.array([c[0] * (1.0 - s.r / D), c[1] * (1.0 - s.r / D), c[2]])
+        e = x1[:2] / (s.r - D)
+        n = np.array([math.sin(alpha) * e[0], math.sin(alpha) * e[1], math.cos(alpha)])
+        gap = (s.r - D + c[2] / math.tan(alpha) - R0) * math.sin(alpha)
+        x2 = x1 - gap * n
+        u = np.array([ring_angle(s, t, x1), math.atan2(x2[1], x2[0]) % (2 * math.pi), x2[2]])
+        p1, p2 = s.world(t, x1, x2)
+        return u, gap, p1, p2, rot_z(s.chi(t)) @ n
+
+    s.exact = exact
+    return s
+
+
 # The petal-like tip: a straight side from A on the outer circle (radius 0.6) to the corner Q
 # on the tip circle (radius 0.4), then the tip arc from Q (a corner, as at an APDS petal tip).
 TIP_RADIUS, THETA_Q = 0.4, 0.3
@@ -188,3 +216,114 @@ def tip_handover():
     roots = [(-B + k * math.sqrt(B * B - 4 * A * C)) / (2 * A) for k in (-1, 1)]
     (t_h,) = [x for x in roots if 0.0 <= x <= 1.0]
     return scenes[0], scenes[1], t_h
+
+
+class Fn:
+    """f(t) with its rate f'(t), given as two functions."""
+
+    def __init__(self, f, df):
+        self.f, self.df = f, df
+
+    def __call__(self, t):
+        return self.f(t)
+
+    def rate(self, t):
+        return self.df(t)
+
+
+def _ring_angle(phi, psi):
+    """The parameter of the point at angle phi in the plane of a ring posed by
+    Rz(beta) Rx(pi/2) Rz(psi) (phi from its radial axis towards +z)."""
+    return (phi - psi) % (2 * math.pi)
+
+
+def ring_over_plate_edge():
+    """A ring (radius 0.4) standing in a vertical plane y = c_y across the edge x = 0 of the
+    plate 0 <= x <= 1, -1 <= y <= 1 (z = 0), in contact throughout: on the face while
+    c_x = 0.03 cos(2 pi t) >= 0 (its lowest point, c_z = r), pivoting over the edge point
+    (0, c_y, 0) while c_x < 0 (|c - edge point| = r). Returns (surface scene, edge scene,
+    `SurfaceEdge`, (t_on, t_off) = (0.25, 0.75), the times c_x = 0)."""
+    from drake_dock.core.handover import SurfaceEdge
+    from drake_dock.core.patches import PlaneRect
+    r = 0.4
+    cx = Fn(lambda t: 0.03 * math.cos(2 * math.pi * t),
+            lambda t: -0.06 * math.pi * math.sin(2 * math.pi * t))
+    cz = Fn(lambda t: r if cx(t) >= 0 else math.sqrt(r * r - cx(t) ** 2),
+            lambda t: 0.0 if cx(t) >= 0 else -cx(t) * cx.rate(t) / math.sqrt(r * r - cx(t) ** 2))
+    c = (cx, Wave(0.0, 0.1, 1.3, v=0.02), cz)
+    psi, tau = Wave(0.3, 0.5, 0.9), Wave(0.5 * math.pi)
+    plate = PlaneRect((0.0, -1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), size=(1.0, 2.0))
+    edge = Segment((0.0, -1.0, 0.0), (0.0, 1.0, 0.0))
+    surf = EdgeScene("CS", Circle(r), plate, c, psi, tau=tau)
+    over = EdgeScene("CC", Circle(r), edge, c, psi, tau=tau)
+    R2 = lambda t: rot_z(surf.chi(t))
+
+    def exact_face(t):
+        x = np.array([cx(t), c[1](t), 0.0])
+        u = np.array([_ring_angle(-0.5 * math.pi, psi(t)), x[0], x[1] + 1.0])
+        return (u, 0.0, *surf.world(t, x, x), R2(t) @ EZ)
+
+    def exact_edge(t):
+        x = np.array([0.0, c[1](t), 0.0])
+        u = np.array([_ring_angle(math.atan2(-cz(t), -cx(t)), psi(t)), 0.5 * (x[1] + 1.0)])
+        return (u, 0.0, *over.world(t, x, x), R2(t) @ np.array([cx(t), 0.0, cz(t)]) / r)
+
+    surf.exact, over.exact = exact_face, exact_edge
+    return surf, over, SurfaceEdge(0, False, lambda e: 2.0 * e, lambda f: 0.5 * f), (0.25, 0.75)
+
+
+def ring_over_petal_tip():
+    """A ring (radius 0.4) in the meridian plane theta_0(t) of an APDS (`ApdsGeometry()`), in
+    contact throughout: rolling on guide surface 1 (tangent to its generatrix at zeta_f =
+    H + p) while p(t) = 0.02 sin(2 pi (t - 1/4)) < 0, pivoting over the tip arc's point at
+    theta_0 (by the angle p / (r sin alpha1), so that the centre's velocity is continuous)
+    while p >= 0. The cone's nearest point to a point of the meridian half-plane lies on the
+    same meridian. Returns (surface scene, tip scene, `SurfaceEdge`, (0.25, 0.75))."""
+    from drake_dock.docking.apds import ApdsGeometry, guide_surface, petal_edges, tip_arc
+    g = ApdsGeometry()
+    a1, r = g.alpha1, 0.4
+    cot, Rt = 1.0 / math.tan(a1), g.R - g.H / math.tan(a1)
+    A = g.R * math.sin(g.alpha2)
+    th0 = Wave(math.pi / 6, 0.05, 1.1)
+    p = Fn(lambda t: 0.02 * math.sin(2 * math.pi * (t - 0.25)),
+           lambda t: 0.04 * math.pi * math.cos(2 * math.pi * (t - 0.25)))
+
+    def meridian(t):
+        """(rho_c, z_c), their rates, and the contact point's (rho, z) and unit normal."""
+        if p(t) < 0:
+            zf = g.H + p(t)
+            m = np.array([math.sin(a1), math.cos(a1)])
+            foot = np.array([g.R - zf * cot, zf])
+            return foot + r * m, p.rate(t) * np.array([-cot, 1.0]), foot, m
+        phi = 0.5 * math.pi - a1 + p(t) / (r * math.sin(a1))
+        e = np.array([math.cos(phi), math.sin(phi)])
+        rate = p.rate(t) / math.sin(a1) * np.array([-e[1], e[0]])
+        return np.array([Rt, g.H]) + r * e, rate, np.array([Rt, g.H]), e
+
+    def centre(t, k):
+        (rho, z), (drho, dz), _, _ = meridian(t)
+        b, db = th0(t), th0.rate(t)
+        return ((rho * math.cos(b), rho * math.sin(b), z)[k],
+                (drho * math.cos(b) - rho * math.sin(b) * db,
+                 drho * math.sin(b) + rho * math.cos(b) * db, dz)[k])
+
+    c = tuple(Fn(lambda t, k=k: centre(t, k)[0], lambda t, k=k: centre(t, k)[1])
+              for k in range(3))
+    psi, tau = Wave(0.2, 0.3, 0.7), Wave(0.5 * math.pi)
+    surf = EdgeScene("CS", Circle(r), guide_surface(g, 1), c, psi, tau=tau, beta=th0)
+    tip = EdgeScene("CC", Circle(r), tip_arc(g, 1), c, psi, tau=tau, beta=th0)
+
+    def exact(scene, t):
+        _, _, (rho, z), m = meridian(t)
+        b = th0(t)
+        x = np.array([rho * math.cos(b), rho * math.sin(b), z])
+        n = rot_z(scene.chi(t)) @ np.array([m[0] * math.cos(b), m[0] * math.sin(b), m[1]])
+        ring = _ring_angle(math.atan2(-m[1], -m[0]), psi(t))
+        if scene is tip:
+            return (np.array([ring, b]), 0.0, *tip.world(t, x, x), n)
+        t1 = math.asin(A / rho) - g.alpha2
+        s = (b - t1) / (math.pi / 3 - 2 * t1)
+        return (np.array([ring, s, z]), 0.0, *surf.world(t, x, x), n)
+
+    surf.exact, tip.exact = (lambda t: exact(surf, t)), (lambda t: exact(tip, t))
+    return surf, tip, petal_edges(g, 1)["tip"], (0.25, 0.75)

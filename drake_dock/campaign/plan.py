@@ -2,7 +2,8 @@
 
 Fields: ``scenario`` (the base scenario file, relative to the plan's directory), ``samples``,
 ``seed``, ``sampler`` (`SAMPLERS`), ``batch`` (samples per Dask task), ``axes`` (the two inputs
-of the capture-probability figure) and ``vary``: a map from a numeric scenario field's dotted
+of the capture-probability figure), ``set`` (optional: a map from a scenario field's dotted
+path to the value every sample takes instead of the base scenario's) and ``vary``: a map from a numeric scenario field's dotted
 path to one distribution, ``uniform: [lo, hi]``, ``normal: [mean, sd]`` or ``choice: [...]``;
 for a vector field one ``[lo, hi]`` (or ``[mean, sd]``) per component, and each choice a list
 of its components. Every bad value raises `InputError` naming the field (``vary.<path>`` for a
@@ -115,7 +116,7 @@ def _normalized_vary(raw_vary):
     return out
 
 
-_TOP = {f.name for f in dataclasses.fields(CampaignPlan)}
+_TOP = {f.name for f in dataclasses.fields(CampaignPlan)} | {"set"}
 
 
 def _raw(data: str, filename: str) -> dict:
@@ -138,8 +139,33 @@ def _raw(data: str, filename: str) -> dict:
     if "axes" in raw and not (isinstance(raw["axes"], list)
                               and all(isinstance(a, str) for a in raw["axes"])):
         raise InputError("axes", raw["axes"], "a list of two varied fields' dotted paths")
+    if not isinstance(raw.get("set", {}), dict) or not all(
+            isinstance(k, str) for k in raw.get("set", {})):
+        raise InputError("set", raw["set"], "a map from a scenario field's dotted path to a value")
     raw["vary"] = _normalized_vary(raw.get("vary"))
     return raw
+
+
+def _base_scenario(scenario_file: Path, overrides: dict) -> Scenario:
+    """The base scenario file with the plan's ``set`` values written into its fields, loaded
+    and validated as one scenario (a bad path or value is named as ``set.<path>``)."""
+    if not overrides:
+        return load_scenario(scenario_file)
+    try:
+        tree = yaml.safe_load(scenario_file.read_text(encoding="utf-8")) or {}
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        return load_scenario(scenario_file)          # names the file's own error
+    for path, value in overrides.items():
+        node, parts = tree, path.split(".")
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise InputError(f"set.{path}", value, "the dotted path of a scenario field")
+        node[parts[-1]] = value
+    try:
+        return load_scenario(data=yaml.safe_dump(tree))
+    except InputError as e:
+        raise InputError("set", overrides, "scenario fields and valid values", str(e)) from None
 
 
 # Field paths against the scenario's schema -----------------------------------------------------
@@ -255,12 +281,13 @@ def load_plan(filename) -> tuple[CampaignPlan, Scenario, list[Field]]:
         raise InputError("plan file", str(filename), "a readable YAML text file",
                          getattr(e, "strerror", None) or str(e)) from None
     raw = _raw(data, str(filename))
+    overrides = raw.pop("set", None) or {}
     try:
         plan = yaml_load_typed(schema=CampaignPlan, data=yaml.safe_dump(raw))
     except (RuntimeError, ValueError, TypeError) as e:
         raise InputError("plan", str(filename), "values of the documented types",
                          str(e)) from None
     scenario_file = filename.parent / plan.scenario
-    base = load_scenario(scenario_file)
+    base = _base_scenario(scenario_file, overrides)
     plan.scenario = str(scenario_file)
     return plan, base, validate_plan(plan, base)

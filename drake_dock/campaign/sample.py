@@ -15,11 +15,9 @@ import copy
 import math
 import time
 
-import numpy as np
-
 from drake_dock.campaign.plan import set_field
 from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.plant import stewart_deflection
+from drake_dock.docking.plant import stewart_history
 from drake_dock.docking.results import summary, timeseries
 from drake_dock.docking.scenario import validate
 from drake_dock.docking.simulate import simulate
@@ -80,16 +78,8 @@ def input_columns(values: dict) -> dict:
 def stewart_peaks(result) -> tuple[float, float]:
     """The largest translational deflection (m) of the Stewart element and the largest force
     (N) it exerts on the target APDS, over the recorded samples."""
-    dp = result.dd.dp
-    pc = dp.plant.CreateDefaultContext()
-    stroke = force = 0.0
-    for x in result.record.x:
-        dp.plant.SetPositionsAndVelocities(pc, x)
-        deflection, _ = stewart_deflection(dp, pc)
-        f = dp.bushing.CalcBushingSpatialForceOnFrameC(pc).translational()
-        stroke = max(stroke, float(np.linalg.norm(deflection)))
-        force = max(force, float(np.linalg.norm(f)))
-    return stroke, force
+    stroke, force = stewart_history(result.dd.dp, result.record.x)
+    return float(stroke.max(initial=0.0)), float(force.max(initial=0.0))
 
 
 def measure(result) -> dict:

@@ -48,6 +48,7 @@ from drake_dock.errors import NumericalError, PainleveError, SingularContactErro
 STICK, SLIDE, DETACH = "stick", "slide", "detach"
 MAX_ENUMERATED = 8
 TIE_RTOL = 1e-6     # consistency accepted at a transition when none holds at rtol
+SLIDE_START_ITER = 200   # fixed-point iterations for the direction of a start of sliding
 
 
 @dataclasses.dataclass
@@ -89,7 +90,18 @@ class ContactSolution:
 
     def power_lost_to_friction(self, rows):
         """sum -lam_t . v_t over the couples (>= 0 for sliding, 0 for sticking)."""
-        return float(sum(-(lt @ r.vt) for lt, r in zip(self.lam_t, rows)))
+        return friction_power(self.lam_t, [r.vt for r in rows])
+
+
+def friction_power(lam_t, vt) -> float:
+    """sum -lam_t . v_t over the couples, their tangential forces and velocities (k, 2)."""
+    return float(sum(-(lt @ v) for lt, v in zip(lam_t, vt)))
+
+
+def stabilised(x, vn, gap, omega):
+    """x + 2 omega g' + omega^2 g: the Baumgarte-stabilised normal row (Eq. 52), with x = g''
+    or its velocity-product term bn."""
+    return x + 2 * omega * vn + omega ** 2 * gap
 
 
 def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None) -> ContactSolution:
@@ -100,12 +112,11 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None) -> C
         if m == STICK:
             cols += [r.Wn, r.Wt[:, 0], r.Wt[:, 1]]
             cons += [r.Wn, r.Wt[:, 0], r.Wt[:, 1]]
-            rhs += [r.bn + 2 * omega * r.vn + omega ** 2 * r.gap,
-                    r.bt[0], r.bt[1]]
+            rhs += [stabilised(r.bn, r.vn, r.gap, omega), r.bt[0], r.bt[1]]
         elif m == SLIDE:
             cols.append(r.Wn - r.mu * (r.Wt @ s))
             cons.append(r.Wn)
-            rhs.append(r.bn + 2 * omega * r.vn + omega ** 2 * r.gap)
+            rhs.append(stabilised(r.bn, r.vn, r.gap, omega))
     vdot = a0
     lam = np.zeros(0)
     Cf = None
@@ -150,7 +161,8 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None) -> C
                            Cf if Cf is not None else np.zeros_like(a0), list(rows))
 
 
-def _slide_start(Minv, a0, rows, modes, dirs, i_start, omega, time, max_iter=200):
+def _slide_start(Minv, a0, rows, modes, dirs, i_start, omega, time,
+                 max_iter=SLIDE_START_ITER):
     """Sliding directions of couples that start to slide from rest: friction opposes the
     tangential relative acceleration it produces (fixed point s = a_t/|a_t|)."""
     dirs = list(dirs)
@@ -176,7 +188,7 @@ def _slide_start(Minv, a0, rows, modes, dirs, i_start, omega, time, max_iter=200
 def stabilised_gddot(sol, rows, omega) -> np.ndarray:
     """(k,) g'' + 2 omega g' + omega^2 g: the normal row the contact modes hold at zero
     (Eq. 52, stabilised)."""
-    return sol.gddot + np.array([2 * omega * r.vn + omega ** 2 * r.gap for r in rows])
+    return np.array([stabilised(g, r.vn, r.gap, omega) for g, r in zip(sol.gddot, rows)])
 
 
 def _consistent(sol, rows, omega, tol_f, tol_a):

@@ -28,6 +28,10 @@ A sphere (centre c1, radius rho1) can then touch the cell only where
 |n_c . (w - lam e)| <= rho1 + kappa_c, w = c1(0) - c2: an interval of lam (all or none when
 n_c . e = 0), intersected with the spheres'. Where a curve passes close to a surface but on one
 side of it (a ring just inside a petal's cone), the slab is far thinner than the sphere.
+
+At a fixed pose the least of |c1 - c2| - (rho1 + rho2) over the sphere pairs is a lower bound of
+the distance of the two patches (`cover_gap`): every point of a patch lies in a sphere of its
+cover.
 """
 from __future__ import annotations
 
@@ -115,6 +119,13 @@ def patch_cover(patch, n: int, block: int) -> Cover:
         hit = cache[(n, block)] = Cover.from_cells(patch.position(U), cell_radii(patch, U, half),
                                                    blocks, *slabs)
     return hit
+
+
+def cover_gap(a: Cover, b: Cover) -> float:
+    """The least |c_a - c_b| - (rho_a + rho_b) over the cell sphere pairs of the posed covers a
+    and b: a lower bound of the distance of their patches (negative where spheres overlap)."""
+    d = np.linalg.norm(a.centres[:, None, :] - b.centres[None, :, :], axis=-1)
+    return float((d - a.radii[:, None] - b.radii[None, :]).min())
 
 
 def _intervals(w, r, e):

@@ -58,7 +58,8 @@ def intersecting(distance: float, finish_failed: bool, gap_tol: float) -> bool:
 
 
 def after_seek(distance: float, usable: bool, crossing: bool, was_contact: bool,
-               track_distance: float, reseek_floor: float) -> tuple[Mode, float | None]:
+               track_distance: float, reseek_floor: float,
+               carried: bool = False) -> tuple[Mode, float | None]:
     """The mode after a seek and, for a FAR pair, its clearance (the relative travel after which
     it is sought again; None for a tracked pair).
 
@@ -66,10 +67,13 @@ def after_seek(distance: float, usable: bool, crossing: bool, was_contact: bool,
     `drake_dock.core.seeking.contact_couple`), not crossing and nearer than
     ``track_distance`` is TRACKED, unless the pair has just left a contact (a contact that runs
     off a patch end ends there). A FAR pair keeps half ``track_distance`` in hand (a crossing
-    pair: half ``track_distance``), and never less than half its distance or ``reseek_floor``."""
-    if usable and not crossing and distance < track_distance and not was_contact:
+    pair, or a ``carried`` one, whose couple lies on an edge where a linked pair carries it
+    (`drake_dock.core.handover`): half ``track_distance``), and never less than half its
+    distance or ``reseek_floor``."""
+    if usable and not crossing and not carried and distance < track_distance \
+            and not was_contact:
         return Mode.TRACKED, None
-    if crossing:
+    if crossing or carried:
         return Mode.FAR, 0.5 * track_distance
     if distance >= track_distance:
         return Mode.FAR, max(distance - 0.5 * track_distance, 0.5 * distance, reseek_floor)

@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from drake_dock.core.handover import SurfaceEdge
 from drake_dock.core.patches import Annulus, Arc, Circle, Cone, PolarCurve, Reparametrized
 from drake_dock.errors import InputError
 
@@ -233,6 +234,26 @@ def guide_surface(g: ApdsGeometry, k: int) -> Reparametrized:
     phi0 = side_phi(2 * k - 1)
     cone = Cone(g.R, g.alpha1, (phi0, phi0 + math.pi / 3), (0.0, g.H))
     return Reparametrized(cone, _PetalMap(g, k))
+
+
+def petal_edges(g: ApdsGeometry, k: int) -> dict:
+    """The edges of guide surface k (u = (s, zeta)) that are patches of their own
+    (`drake_dock.core.handover.SurfaceEdge`): guide side 2k - 1 at s = 0 and side 2k at s = 1
+    (zeta = (R - rho(theta)) tan(alpha1), Eq. 14; theta = phi_i + sigma_i theta_1(zeta),
+    Eq. 13), and tip arc k at zeta = H (theta = phi_{2k-1} + theta_1(H) + s (pi/3 -
+    2 theta_1(H))). Keys: the side's number i, or "tip"."""
+    m = _PetalMap(g, k)
+    out = {}
+    for i, upper in ((2 * k - 1, False), (2 * k, True)):
+        side, phi, sigma = guide_side(g, i), side_phi(i), side_sigma(i)
+        out[i] = SurfaceEdge(0, upper, lambda th, side=side: side.parts(th)[1][0],
+                             lambda z, phi=phi, sigma=sigma: phi + sigma * (
+                                 math.asin(m.A / (g.R - z * m.cot1)) - g.alpha2))
+    t1 = math.asin(m.A / (g.R - g.H * m.cot1)) - g.alpha2
+    w = math.pi / 3 - 2 * t1
+    out["tip"] = SurfaceEdge(1, True, lambda th: (th - m.phi0 - t1) / w,
+                             lambda s: m.phi0 + t1 + s * w)
+    return out
 
 
 def ring_circle(g: ApdsGeometry) -> Circle:

@@ -1,25 +1,77 @@
-"""How a docking run ends besides capture: the named outcomes and their rules (pure functions
-of the ring distance over time and of whether a couple is in contact).
+"""How a docking run ends: the named outcomes and their rules (pure functions of the rings'
+relative pose over time and of whether a couple is in contact).
 
-- ``captured``: the axial ring-centre distance reaches ``simulation.capture_distance``
-  (`drake_dock.docking.diagram.CaptureMonitor`, a witness).
+- ``captured``: the latches can engage: the axial ring-centre distance within
+  ``simulation.capture_distance``, the lateral offset within ``simulation.capture_lateral`` and
+  the tilt between the docking axes within ``simulation.capture_tilt_deg`` (`CaptureRule`;
+  `drake_dock.docking.diagram.CaptureMonitor` locates it with a witness).
 - ``rebound``: no couple in contact, the ring distance above its start and growing.
-- ``jammed``: the ring distance has not fallen by ``JAM_DISTANCE`` for
-  ``simulation.jam_time`` seconds.
+- ``jammed``: the distance to capture (`CaptureRule.to_go`) has not fallen by ``JAM_DISTANCE``
+  for ``simulation.jam_time`` seconds.
 - ``timeout``: ``simulation.duration`` reached first.
 """
 from __future__ import annotations
 
 import dataclasses
+import math
+
+import numpy as np
 
 OUTCOMES = ("captured", "rebound", "jammed", "timeout")
 JAM_DISTANCE = 1e-3     # m: the progress that resets the jam clock
 
 
+def misalignment(R_t, p_t, R_c, p_c) -> tuple[float, float, float]:
+    """The chaser ring's pose in the target ring's frame (rotation R_t, centre p_t; R_c, p_c the
+    chaser's; the two docking axes face each other): the axial and the lateral offset of its
+    centre (m) and the tilt between the axes (rad, atan2 of |z_t x -z_c| and z_t . -z_c)."""
+    R_t, dp = np.asarray(R_t), np.asarray(p_c) - np.asarray(p_t)
+    z_t, z_c = R_t[:, 2], -np.asarray(R_c)[:, 2]
+    tilt = math.atan2(float(np.linalg.norm(np.cross(z_t, z_c))), float(z_t @ z_c))
+    return float(z_t @ dp), math.hypot(float(R_t[:, 0] @ dp), float(R_t[:, 1] @ dp)), tilt
+
+
+@dataclasses.dataclass(frozen=True)
+class CaptureRule:
+    """The latches' tolerances (docs/model.md, "Capture"): ``axial`` (m, the ring-centre
+    distance along the target's axis), ``lateral`` (m) and ``tilt_deg`` (deg); None leaves a
+    tolerance out of the test. ``ring_radius`` (m) turns a tilt into the rim's displacement."""
+
+    axial: float
+    lateral: float | None
+    tilt_deg: float | None
+    ring_radius: float
+
+    @classmethod
+    def of(cls, simulation, geometry) -> "CaptureRule":
+        return cls(simulation.capture_distance, simulation.capture_lateral,
+                   simulation.capture_tilt_deg, geometry.R)
+
+    def to_go(self, axial: float, lateral: float, tilt: float) -> float:
+        """The distance to capture (m): the axial distance, or where the lateral offset or the
+        tilt (rad; as the rim's displacement R tilt) exceeds its tolerance by more, the axial
+        tolerance plus that excess. Captured iff to_go <= ``axial``; continuous, so that a
+        witness can locate it. With no lateral or tilt tolerance it is the axial distance."""
+        d = axial
+        if self.lateral is not None:
+            d = max(d, self.axial + (lateral - self.lateral))
+        if self.tilt_deg is not None:
+            d = max(d, self.axial + self.ring_radius * (tilt - math.radians(self.tilt_deg)))
+        return d
+
+    def describe(self) -> str:
+        parts = [f"axial ring-centre distance <= {self.axial:g} m"]
+        if self.lateral is not None:
+            parts.append(f"lateral offset <= {self.lateral:g} m")
+        if self.tilt_deg is not None:
+            parts.append(f"tilt <= {self.tilt_deg:g} deg")
+        return ", ".join(parts)
+
+
 @dataclasses.dataclass
 class OutcomeWatch:
-    """Fed the ring distance at each step; ``update`` returns (outcome, reason) once a rule
-    other than capture holds, else None."""
+    """Fed the ring distance and the distance to capture (`CaptureRule.to_go`) at each step;
+    ``update`` returns (outcome, reason) once a rule other than capture holds, else None."""
 
     d_start: float
     jam_time: float
@@ -27,16 +79,18 @@ class OutcomeWatch:
     d_best: float = float("inf")
     d_last: float = float("inf")
 
-    def update(self, t: float, d: float, in_contact: bool):
-        if d <= self.d_best - JAM_DISTANCE or self.d_best == float("inf"):
-            self.d_best, self.t_best = d, t
+    def update(self, t: float, d: float, in_contact: bool, to_go: float | None = None):
+        to_go = d if to_go is None else to_go
+        if to_go <= self.d_best - JAM_DISTANCE or self.d_best == float("inf"):
+            self.d_best, self.t_best = to_go, t
         growing, self.d_last = d > self.d_last, d
         if not in_contact and growing and d > self.d_start:
             return "rebound", (f"separating with no couple in contact: ring distance {d:.6g} m "
                                f"above its start {self.d_start:.6g} m")
         if t - self.t_best >= self.jam_time:
-            return "jammed", (f"the ring distance has not fallen by {JAM_DISTANCE:g} m in "
-                              f"{self.jam_time:g} s (at {d:.6g} m)")
+            return "jammed", (f"the distance to capture has not fallen by {JAM_DISTANCE:g} m "
+                              f"in {self.jam_time:g} s (at {to_go:.6g} m; ring distance "
+                              f"{d:.6g} m)")
         return None
 
 

@@ -153,6 +153,7 @@ class _PetalWatch:
 
     name: str
     solid: str
+    edge: float = 1e-9         # m: the plate's edges widened by this (narrowed if negative)
     s: np.ndarray = None
     frac: np.ndarray = None
     zeta: np.ndarray = None
@@ -167,7 +168,8 @@ class _PetalWatch:
             if flip.any():
                 w = self.s[flip] / (self.s[flip] - s[flip])      # where s = 0, linearly
                 through = _over(g, self.frac[flip] + w * (frac[flip] - self.frac[flip]),
-                                self.zeta[flip] + w * (zeta[flip] - self.zeta[flip]))
+                                self.zeta[flip] + w * (zeta[flip] - self.zeta[flip]),
+                                self.edge)
                 idx = np.flatnonzero(flip)[through]
                 self.crossed[idx] = ~self.crossed[idx]
         self.s, self.frac, self.zeta = s, frac, zeta
@@ -175,16 +177,18 @@ class _PetalWatch:
 
 
 def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=1e-3,
-                        features=None) -> Penetration:
+                        features=None, edge=1e-9) -> Penetration:
     """The deepest interpenetration of the two APDS over the samples t (N,) with their frames'
     poses R_WA (N, 2, 3, 3), p_WA (N, 2, 3) (the timeseries fields), names the two APDS names;
-    ``features`` replaces `feature_points` (a subset, for tests)."""
+    ``features`` replaces `feature_points` (a subset, for tests). A point crosses a petal where
+    its foot lies within ``edge`` (m) outside the plate's edges or further in; a negative edge
+    takes a crossing that close to an edge (a grazing of the edge) as passing round it."""
     feats = feature_points(g) if features is None else features
     reach = max(float(np.linalg.norm(X, axis=1).max()) for X in feats.values())
     best = Penetration()
     for a, b in ((0, 1), (1, 0)):
         R, p = relative_poses(R_WA, p_WA, a, b)
-        watches = {(f, k): _PetalWatch(f"{names[a]} {f}", f"{names[b]} petal {k}")
+        watches = {(f, k): _PetalWatch(f"{names[a]} {f}", f"{names[b]} petal {k}", edge)
                    for f in feats if f.startswith(PETAL_FEATURES) for k in (1, 2, 3)}
         for tt, Rab, pab in sub_steps(t, R, p, reach, max_travel):
             for fname, X in feats.items():

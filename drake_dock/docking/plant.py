@@ -170,6 +170,19 @@ def stewart_deflection(dp: DockingPlant, plant_context):
     return x, RollPitchYaw(X_AC.rotation()).vector()
 
 
+def stewart_history(dp: DockingPlant, X) -> tuple[np.ndarray, np.ndarray]:
+    """The Stewart element's stroke |x| (m, the translational deflection of
+    `stewart_deflection`) and the magnitude of its force on the target APDS (N) at each plant
+    state [q, v] of X [N, nq + nv]."""
+    pc = dp.plant.CreateDefaultContext()
+    stroke, force = np.empty(len(X)), np.empty(len(X))
+    for k, x in enumerate(X):
+        dp.plant.SetPositionsAndVelocities(pc, x)
+        stroke[k] = np.linalg.norm(stewart_deflection(dp, pc)[0])
+        force[k] = np.linalg.norm(dp.bushing.CalcBushingSpatialForceOnFrameC(pc).translational())
+    return stroke, force
+
+
 def stewart_potential(dp: DockingPlant, plant_context) -> float:
     """Potential of the Stewart springs, 1/2 sum k x^2 + 1/2 sum k_t theta^2 (Eq. 9), with
     Drake's bushing coordinates. Drake 1.51 does not implement the bushing's potential; the

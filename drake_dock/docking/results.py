@@ -15,10 +15,13 @@ impact_tangential_impulse[M,12,2], impact_restitution[M].
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from drake_dock.core.hybrid import Mode
 from drake_dock.systems.contact_system import COUPLE_SLICES
+from drake_dock.docking.outcome import misalignment
 from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
                                       stewart_potential)
 from drake_dock.docking.scene import CHASER_APDS, scenario_pairs
@@ -147,15 +150,12 @@ def energy_ledger(ts: dict) -> dict:
 
 def final_misalignment(ts: dict) -> dict:
     """The chaser ring's pose in the target ring's frame at the end: axial and lateral offset
-    of its centre (m) and the tilt between the two docking axes (deg)."""
+    of its centre (m) and the tilt between the two docking axes (deg; `misalignment`)."""
     names = ts["apds_names"].tolist()
     j_t, j_c = names.index("target_apds"), names.index("chaser_apds")
-    R_t, p_t = ts["R_WA"][-1, j_t], ts["p_WA"][-1, j_t]
-    R_c, p_c = ts["R_WA"][-1, j_c], ts["p_WA"][-1, j_c]
-    r = R_t.T @ (p_c - p_t)
-    cos_tilt = float(np.clip(-(R_t[:, 2] @ R_c[:, 2]), -1.0, 1.0))
-    return {"axial_m": float(r[2]), "lateral_m": float(np.hypot(r[0], r[1])),
-            "tilt_deg": float(np.degrees(np.arccos(cos_tilt)))}
+    axial, lateral, tilt = misalignment(ts["R_WA"][-1, j_t], ts["p_WA"][-1, j_t],
+                                        ts["R_WA"][-1, j_c], ts["p_WA"][-1, j_c])
+    return {"axial_m": axial, "lateral_m": lateral, "tilt_deg": math.degrees(tilt)}
 
 
 def summary(result, ts: dict) -> dict:
@@ -175,6 +175,9 @@ def summary(result, ts: dict) -> dict:
         "captured": bool(result.captured),
         "capture_time_s": result.capture_time,
         "capture_distance_m": s.simulation.capture_distance,
+        "capture_tolerances": {"axial_m": s.simulation.capture_distance,
+                               "lateral_m": s.simulation.capture_lateral,
+                               "tilt_deg": s.simulation.capture_tilt_deg},
         "end_time_s": result.end_time,
         "number_of_impacts": len(result.impacts),
         "impact_times_s": ts["impact_t"].tolist(),

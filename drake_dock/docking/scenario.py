@@ -98,6 +98,9 @@ class SimulationParams:
     duration: float = 10.0           # the timeout (s): a run ends earlier at a named outcome
     jam_time: float = 2.0            # s without 1 mm of progress of the rings: "jammed"
     capture_distance: float = 0.005  # axial ring-centre distance ending the capture phase (m)
+    # The latches' other tolerances (docs/model.md, "Capture"); null leaves one out of the test.
+    capture_lateral: typing.Optional[float] = 0.01    # lateral ring-centre offset (m)
+    capture_tilt_deg: typing.Optional[float] = 0.5    # tilt between the docking axes (deg)
 
 
 def default_simulator_config() -> SimulatorConfig:
@@ -277,6 +280,14 @@ def validate(s: Scenario) -> Scenario:
     _positive("simulation.duration", s.simulation.duration)
     _positive("simulation.jam_time", s.simulation.jam_time)
     _positive("simulation.capture_distance", s.simulation.capture_distance)
+    if s.simulation.capture_lateral is not None and not (
+            0 < _finite("simulation.capture_lateral", s.simulation.capture_lateral) < s.geometry.R):
+        raise InputError("simulation.capture_lateral", s.simulation.capture_lateral,
+                         f"0 < tolerance < the ring radius R = {s.geometry.R} m, or null (not tested)")
+    if s.simulation.capture_tilt_deg is not None and not (
+            0 < _finite("simulation.capture_tilt_deg", s.simulation.capture_tilt_deg) < 90):
+        raise InputError("simulation.capture_tilt_deg", s.simulation.capture_tilt_deg,
+                         "0 < tolerance < 90 deg, or null (not tested)")
     _validate_simulator_config(s.simulator_config, s.simulation.duration)
     return s
 

@@ -14,7 +14,8 @@ from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import Patch, posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.apds import PAIR_SETS, ApdsGeometry, apds_patches
+from drake_dock.docking.apds import (PAIR_SETS, ApdsGeometry, apds_patches, petal_edges,
+                                      side_phi)
 from drake_dock.errors import InputError, NumericalError
 
 TARGET_APDS = "target_apds"
@@ -56,6 +57,8 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     if which == "complete":
         pairs += edge_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
         pairs += edge_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
+        pairs += tip_surface_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
+        pairs += tip_surface_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
     return pairs
 
 
@@ -72,6 +75,41 @@ def edge_pairs(P, one, other) -> list[PairSpec]:
     out = [PairSpec(f"cc_{x}ring_{y}{i}", "CC", b1, P.ring, b2, P.sides[i]) for i in range(1, 7)]
     out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
     out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
+    return out
+
+
+def tip_surface_pairs(P, one, other, R) -> list[PairSpec]:
+    """APDS ``one``'s tip arcs (Body 1) against the guide surfaces of APDS ``other`` they can
+    face, cs_<X>tip<j>_<Y><k> (C-S); R turns ``other``'s frame into ``one``'s at the matched
+    facing. Tip arc j faces surface k when their mid-directions are less than 90 deg apart
+    about the axis at the matched facing: the two petals next to the gap it enters, reached at
+    a relative roll near +-60 deg; the third petal is 180 deg away (docs/model.md)."""
+    (x, b1), (y, b2) = one, other
+    out = []
+    for j in (1, 2, 3):
+        a = side_phi(2 * j - 1) + math.pi / 6
+        for k in (1, 2, 3):
+            b = side_phi(2 * k - 1) + math.pi / 6
+            w = R @ np.array([math.cos(b), math.sin(b), 0.0])
+            if w[0] * math.cos(a) + w[1] * math.sin(a) > 0.0:
+                out.append(PairSpec(f"cs_{x}tip{j}_{y}{k}", "CS", b1, P.tips[j], b2,
+                                    P.surfaces[k]))
+    return out
+
+
+def pair_handovers(g: ApdsGeometry, pairs) -> list:
+    """(edge pair, surface pair, `SurfaceEdge`) of each hand-over among ``pairs``
+    (`drake_dock.core.handover`): a ring's inside circle passes between guide surface k
+    (cs_<X>ring_<Y>k) and its sides 2k - 1, 2k (cc_<X>ring_<Y><i>) and its tip arc
+    (cc_<X>ring_<Y>tip<k>), `petal_edges`."""
+    names = {p.name for p in pairs}
+    out = []
+    for x, y in (("C", "T"), ("T", "C")):
+        for k in (1, 2, 3):
+            for key, edge in petal_edges(g, k).items():
+                e = f"cc_{x}ring_{y}{'tip' + str(k) if key == 'tip' else key}"
+                if {e, f"cs_{x}ring_{y}{k}"} <= names:
+                    out.append((e, f"cs_{x}ring_{y}{k}", edge))
     return out
 
 
@@ -180,7 +218,21 @@ def first_contact(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13,
     ends of the steps its patches can touch in (`touch_steps`). Remembered per geometry and
     approach (a pure function of them)."""
     lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, step, xtol, which)
+    if lam_c is None:
+        raise NoPairCloses(f"no pair closes on the approach {approach}")
     return lam_c, list(names)
+
+
+class NoPairCloses(NumericalError):
+    """No pair of the contact set closes on the approach down to a ring-face distance of -H."""
+
+
+def first_contact_or_faces(g: ApdsGeometry, approach: Approach, which="paper"):
+    """`first_contact`, or, when no pair of the set closes on the approach, where the rings'
+    faces meet (lam = 0, the ring-face plane; no closing pair): docs/model.md, "Initial
+    conditions"."""
+    lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, None, 1e-13, which)
+    return (0.0, []) if lam_c is None else (lam_c, list(names))
 
 
 def first_contact_seeks(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13,
@@ -290,7 +342,7 @@ def _first_contact(geometry: tuple, approach: Approach, step, xtol, which):
             d_c = max(roots.values())
             names = tuple(sorted(n for n, r in roots.items() if r >= d_c - 1e-9))
             return d_c, names, gaps.seeks
-    raise NumericalError(f"no pair closes on the approach {approach}")
+    return None, (), gaps.seeks
 
 
 @dataclasses.dataclass
@@ -349,11 +401,12 @@ def initial_state(scenario) -> InitialState:
 
 def contact_approach(scenario):
     """The scenario's straight approach and its first contact: (Approach, lam_c, closing
-    pairs of the scenario's contact set). The lateral offset is the ring centre's at first
+    pairs of the scenario's contact set; lam_c = 0 and none where no pair closes and the ring
+    faces meet first). The lateral offset is the ring centre's at first
     contact. With a lateral velocity
     the aim point (where the path meets the target's ring-face plane) is
     aim = offset + s v_lateral / chaser_speed, where s, the ring-face distance at contact, solves
-    s = h_c(aim(s)) (brentq to 1e-10 m)."""
+    s = h_c(aim(s)) (brentq to 1e-10 m; `_consistent_height`)."""
     ic = scenario.initial
     g = scenario.geometry
     which = scenario.contact.pairs
@@ -369,12 +422,75 @@ def contact_approach(scenario):
 
     def mismatch(s):
         a = approach(s)
-        return a.height(first_contact(g, a, which=which)[0]) - s
+        return a.height(first_contact_or_faces(g, a, which)[0]) - s
 
     s = 0.0
     if slope.any():
-        s_max = 2.0 * g.H + 0.05           # no pair is closed above this ring-face distance
-        s = brentq(mismatch, 0.0, s_max, xtol=1e-10)
+        s = _consistent_height(mismatch, 2.0 * g.H + 0.05)
+        if s is None:
+            raise NoPairCloses(
+                f"no straight approach at initial.lateral_velocity {ic.lateral_velocity} m/s "
+                f"has its first contact (contact.pairs: {which}) at initial.lateral_offset "
+                f"{ic.lateral_offset} m: the first contact jumps past that offset")
     a = approach(s)
-    lam_c, closing = first_contact(g, a, which=which)
+    lam_c, closing = first_contact_or_faces(g, a, which)
+    if not closing:
+        _check_free_approach(g, a, which)
     return a, lam_c, closing
+
+
+# |s - h_c(aim(s))| below this is a root of the placement's fixed point, not a jump (m): a
+# jump in the first contact moves it by 0.1 mm or more.
+PLACEMENT_TOL = 1e-6
+
+
+def _consistent_height(mismatch, s_max, cells=46):
+    """The ring-face distance s in [0, s_max] with mismatch(s) = h_c(aim(s)) - s = 0: brentq on
+    the whole range first; h_c jumps where the first contact changes pairs or features, so a
+    bracket may close on a jump instead of a root. Then every sign change on a grid of ``cells``
+    intervals is tried, and the largest root is taken (the highest consistent first contact);
+    None when there is none."""
+    try:
+        s = brentq(mismatch, 0.0, s_max, xtol=1e-10)
+        if abs(mismatch(s)) <= PLACEMENT_TOL:
+            return s
+    except ValueError:                                  # no sign change over the range
+        pass
+    grid = np.linspace(0.0, s_max, cells + 1)
+    f = [mismatch(x) for x in grid]
+    for k in range(cells - 1, -1, -1):
+        if f[k] == 0.0:
+            return float(grid[k])
+        if f[k] * f[k + 1] < 0:
+            s = brentq(mismatch, grid[k], grid[k + 1], xtol=1e-10)
+            if abs(mismatch(s)) <= PLACEMENT_TOL:
+                return s
+    return None
+
+
+# Deeper than this, a feature crossing the other APDS on a free approach is a contact (m).
+FREE_APPROACH_TOL = 1e-4
+
+
+def _check_free_approach(g: ApdsGeometry, approach: Approach, which: str):
+    """Where no pair of the set closes, the chaser may still meet the target's APDS with a
+    feature the set does not model: the independent interpenetration check
+    (`drake_dock.docking.penetration`) follows the straight approach from the search's start
+    down to the ring-face plane, and a crossing deeper than `FREE_APPROACH_TOL` is a
+    `NoPairCloses` naming it. A clear approach (a roll of 0: the petals pass between each
+    other) goes on to the faces. A crossing within the tolerance of a petal's edge grazes it: in
+    the paper's geometry (Rs = R - H cot(alpha1)) a ring's inside circle passes exactly through
+    the petal tips of a coaxial approach."""
+    from drake_dock.docking.penetration import deepest_penetration
+    lam0 = travel_grid(g, approach)[0]
+    (R0, p0), (R1, p1) = approach.pose(lam0), approach.pose(0.0)
+    eye, zero = np.eye(3), np.zeros(3)
+    found = deepest_penetration(g, np.array([0.0, 1.0]), np.array([[eye, R0], [eye, R1]]),
+                                np.array([[zero, p0], [zero, p1]]), ("target", "chaser"),
+                                edge=-FREE_APPROACH_TOL)
+    if found.depth > FREE_APPROACH_TOL:
+        height = approach.height(lam0) * (1.0 - found.time)
+        raise NoPairCloses(
+            f"no pair of contact.pairs: {which} closes on the approach {approach}, but there "
+            f"the {found.feature} passes through the {found.solid} (by {found.depth * 1e3:.3g}"
+            f" mm at the ring-face distance {height:.4g} m): a contact the set does not model")

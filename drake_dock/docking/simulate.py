@@ -176,11 +176,13 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
         if approach is not None:
             approach(root)
         t = root.get_time()
-        d = dd.capture.distance(dd.capture.GetMyContextFromRoot(root))
+        cap = dd.capture.GetMyContextFromRoot(root)
+        d, to_go = dd.capture.distance(cap), dd.capture.to_go(cap)
         if progress is not None:
-            progress(t, t_end, progress_fraction(t, t_end, d, watch.d_start, sp.capture_distance))
+            progress(t, t_end, progress_fraction(t, t_end, to_go, watch.d_start,
+                                                 sp.capture_distance))
         modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
-        end = watch.update(t, d, any(st.mode.in_contact for st in modes.pairs))
+        end = watch.update(t, d, any(st.mode.in_contact for st in modes.pairs), to_go)
         if end is not None:
             ended.append(end)
             return EventStatus.ReachedTermination(dd.capture, end[0])
@@ -204,8 +206,7 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
     if ended:
         outcome, reason = ended[0]
     elif terminated:
-        outcome, reason = "captured", (f"axial ring-centre distance <= "
-                                       f"{sp.capture_distance:g} m")
+        outcome, reason = "captured", dd.capture.rule.describe()
     else:
         outcome, reason = "timeout", f"simulation.duration {t_end:g} s reached"
     captured = outcome == "captured"

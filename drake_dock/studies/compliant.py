@@ -47,7 +47,7 @@ from scipy.spatial import ConvexHull
 from drake_dock.docking.apds import guide_surface
 from drake_dock.docking.diagram import axial_ring_distance
 from drake_dock.docking.plant import (DockingPlant, populate_plant, set_initial_state,
-                                      stewart_deflection)
+                                      stewart_history)
 from drake_dock.errors import InputError
 from drake_dock.systems.simulator import make_simulator
 
@@ -287,10 +287,9 @@ def _step_ends(dp, X):
     plant = dp.plant
     pc = plant.CreateDefaultContext()
     n = len(X)
-    v, w, stroke = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n)
+    v, w = np.zeros((n, 3)), np.zeros((n, 3))
     for k, x in enumerate(X):
         plant.SetPositionsAndVelocities(pc, x)
         v[k] = plant.EvalBodySpatialVelocityInWorld(pc, dp.bodies["chaser"]).translational()
         w[k] = plant.EvalBodySpatialVelocityInWorld(pc, dp.bodies["target_apds"]).rotational()
-        stroke[k] = np.linalg.norm(stewart_deflection(dp, pc)[0])
-    return v, w, stroke
+    return v, w, stewart_history(dp, X)[0]

@@ -36,7 +36,7 @@ import dataclasses
 
 import numpy as np
 
-from drake_dock.docking.plant import stewart_deflection
+from drake_dock.docking.plant import stewart_history
 from drake_dock.docking.results import rigid_chaser_force
 
 METRICS = ("capture_time", "apds_spin_rate", "chaser_axial_velocity", "peak_contact_force",
@@ -98,16 +98,6 @@ def sampled_peak(t, y) -> float:
     return float(y0 + s0 * (tv - t0) + c * (tv - t0) * (tv - t1))
 
 
-def stroke_samples(dp, X) -> np.ndarray:
-    """\\|x\\| of the Stewart element's deflection at each plant state of X [N, nq + nv]."""
-    pc = dp.plant.CreateDefaultContext()
-    out = np.empty(len(X))
-    for k, x in enumerate(X):
-        dp.plant.SetPositionsAndVelocities(pc, x)
-        out[k] = np.linalg.norm(stewart_deflection(dp, pc)[0])
-    return out
-
-
 def _distinct(t):
     """Keeps the last of samples that share a time (pre- and post-impact samples)."""
     return np.r_[np.diff(t) > 0, True]
@@ -143,7 +133,7 @@ def rigid_metrics(result, start: SceneStart) -> dict:
     w_a = dp.plant.EvalBodySpatialVelocityInWorld(pc, dp.bodies["target_apds"]).rotational()
     t, F = rigid_chaser_force(result)
     keep = _distinct(t)
-    stroke = stroke_samples(dp, np.asarray(rec.x)[keep])
+    stroke = stewart_history(dp, np.asarray(rec.x)[keep])[0]
     m = at_capture(result.capture_time, w_a @ start.e3, v_c, start)
     m["peak_contact_force"] = sliding_peak_force(t, np.linalg.norm(F, axis=1), m["capture_time"])
     m["peak_stewart_stroke"] = sampled_peak(t[keep], stroke)

@@ -21,12 +21,14 @@ from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.core.contact_law import ContactLaw
 from drake_dock.systems.contact_system import (COUPLE_SLICES, ContactOptions, ContactPair,
-                                               RigidContactSystem)
-from drake_dock.core.patches import Circle, PlaneRect, Segment
+                                               Handover, RigidContactSystem)
+from drake_dock.core.handover import SurfaceEdge
+from drake_dock.core.patches import Annulus, Circle, PlaneRect, Segment
 from drake_dock.systems.simulator import make_simulator, make_witness_approach
 
 G = 9.81
 PAINLEVE_THETA = math.radians(30.0)
+ANNULUS_CENTRE_Y = 5.0    # m: where `disk_on_incline`'s ring face is centred
 # The small scenes integrate at SMALL_SCENE_ACCURACY (RK5) and locate their events to 1e-2 of
 # a context accuracy of at least WITNESS_ACCURACY_FLOOR, in seconds; `ContactOptions`' default
 # impact_rtol (1e-10) is `drake_dock.systems.simulator.tolerances`' value for it.
@@ -63,9 +65,15 @@ def rot_x(a):
 
 
 def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restitution=0.0,
-                    plane_end=50.0, options=ContactOptions()) -> SmallScene:
+                    plane_end=50.0, face="plane", edge=False,
+                    options=ContactOptions()) -> SmallScene:
     """A uniform disk (rim = a Circle, C-S) on a plane inclined by theta, its axle along y;
-    down-slope is +x; the plane patch ends at x = ``plane_end``. I_axle = m r^2 / 2."""
+    down-slope is +x; the plane patch ends at x = ``plane_end``. I_axle = m r^2 / 2.
+    ``face="annulus"`` takes a ring face instead of the plane: the `Annulus` 1 <= rho <= 100
+    (u = (rho, theta), a polar parametrisation) centred at y = -``ANNULUS_CENTRE_Y``, so that the
+    disk's path along x runs across it near rho = 5. With ``edge`` (on the plane) the plane's
+    end is an edge too: the pair "rim_edge" (C-C, the segment x = plane_end) with a hand-over
+    from and to "rim_plane" (`drake_dock.core.handover`)."""
     plant = _plant(G * np.array([math.sin(theta), 0.0, -math.cos(theta)]))
     I_ax = 0.5 * mass * radius ** 2
     I_d = 0.25 * mass * radius ** 2
@@ -74,13 +82,27 @@ def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restituti
     rim = plant.AddFrame(FixedOffsetFrame("rim", body.body_frame(),
                                           RigidTransform(RotationMatrix(rot_x(math.pi / 2)),
                                                          np.zeros(3))))
+    if face == "annulus":
+        frame2 = plant.AddFrame(FixedOffsetFrame("face", plant.world_frame(), RigidTransform(
+            np.array([0.0, -ANNULUS_CENTRE_Y, 0.0]))))
+        plane = Annulus(1.0, 100.0)
+    else:
+        frame2 = plant.world_frame()
+        plane = PlaneRect([-50.0, -5.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
+                          size=(50.0 + plane_end, 10.0))
     plant.Finalize()
-    plane = PlaneRect([-50.0, -5.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0],
-                      size=(50.0 + plane_end, 10.0))
-    pair = ContactPair("rim_plane", "CS", rim, Circle(radius), plant.world_frame(), plane,
-                       sigma=1.0)
-    system = RigidContactSystem(plant, [pair], ContactLaw(mu=mu, mu_s=mu_s,
-                                                          restitution=restitution), options)
+    circle = Circle(radius)
+    pairs = [ContactPair("rim_plane", "CS", rim, circle, frame2, plane, sigma=1.0)]
+    handovers = []
+    if edge:
+        # The plane's parameters are (x + 50, y + 5); the segment's e gives y = 10 e - 5.
+        pairs.append(ContactPair("rim_edge", "CC", rim, circle, plant.world_frame(),
+                                 Segment([plane_end, -5.0, 0.0], [plane_end, 5.0, 0.0])))
+        handovers.append(Handover("rim_edge", "rim_plane", SurfaceEdge(
+            0, True, lambda e: 10.0 * e, lambda f: 0.1 * f)))
+    system = RigidContactSystem(plant, pairs, ContactLaw(mu=mu, mu_s=mu_s,
+                                                         restitution=restitution), options,
+                                handovers=handovers)
     return SmallScene(plant, system, body, dict(theta=theta, mass=mass, radius=radius,
                                                 I_axle=I_ax, mu=mu,
                                                 mu_s=system.law.static_mu))

@@ -34,10 +34,14 @@ decided by a function of `drake_dock.core.hybrid`:
   the contact set; the others, and the couples in contact left out of the impact, are TRACKED.
 - lambda_n reaches zero, the sliding velocity reaches zero or reverses, the sticking force
   reaches the static cone: the modes of the contact set are selected again (`select_modes`).
-- a couple reaches the end of its domain, or its Jacobian turns singular (Eq. 39 fails): the
-  pair is sought again; if the new couple is interior and isolated the pair continues with it
-  (a hand-over within the pair, only when not in contact), otherwise it becomes far (a contact
-  that runs off a patch end ends there). A contact couple whose Jacobian turns singular raises
+- a couple reaches a declared edge of its surface, or an edge couple's hand-over guard
+  reaches zero (its curve passes over the surface): the couple is handed to the linked pair
+  with its mode (`Handover`, `drake_dock.core.handover`; docs/model.md, "Hand-over between an
+  edge and a surface");
+- a couple reaches any other end of its domain, or its Jacobian turns singular (Eq. 39
+  fails): the pair is sought again; if the new couple is interior and isolated the pair
+  continues with it (a hand-over within the pair, only when not in contact), otherwise it
+  becomes far (a contact that runs off a patch end ends there). A contact couple whose Jacobian turns singular raises
   `SingularCoupleError`.
 - a pair sought while its patches cross each other (only possible past a patch end, where the
   model has no contact) stays far and is sought again after half ``track_distance`` of travel.
@@ -63,7 +67,7 @@ from drake_dock.errors import DriftError, ZenoError
 from drake_dock.systems import witnesses
 from drake_dock.systems.contact_types import (COUPLE_FIELDS, COUPLE_OUTPUT_SIZE, COUPLE_SLICES,
                                               ContactModes, ContactOptions, ContactPair,
-                                              Evaluation, PairState)
+                                              Evaluation, Handover, PairState)
 from drake_dock.systems.evaluation import PlantEvaluator
 from drake_dock.systems.memo import Memo
 from drake_dock.systems.outputs import CoupleRows
@@ -72,8 +76,8 @@ from drake_dock.systems.transitions import Transitions
 from drake_dock.systems.witnesses import FAR_WITNESS
 
 __all__ = ["COUPLE_FIELDS", "COUPLE_OUTPUT_SIZE", "COUPLE_SLICES", "FAR_WITNESS", "ContactLaw",
-           "ContactModes", "ContactOptions", "ContactPair", "DriftError", "Mode", "PairState",
-           "RigidContactSystem", "Timing", "ZenoError", "check_pairs"]
+           "ContactModes", "ContactOptions", "ContactPair", "DriftError", "Handover", "Mode",
+           "PairState", "RigidContactSystem", "Timing", "ZenoError", "check_pairs"]
 
 
 def check_pairs(plant, pairs, energy_scale):
@@ -104,14 +108,15 @@ class RigidContactSystem(LeafSystem):
     are state in units of ``energy_scale`` (J): Drake's error control compares every state's
     absolute error with the accuracy, so that integrals in joules of a run with kJ of kinetic
     energy, not its motion, would set the step (the docking diagram passes the chaser's
-    kinetic energy; the ``energy`` output is in joules)."""
+    kinetic energy; the ``energy`` output is in joules). ``handovers`` are the declared
+    `Handover`s between edge pairs and surface pairs (`drake_dock.core.handover`)."""
 
     #: evaluations kept for reuse (`Memo`)
     eval_memo_size = 16
 
     def __init__(self, plant, pairs, law: ContactLaw = ContactLaw(),
                  options: ContactOptions = ContactOptions(), wrench_bodies=(),
-                 extra_powers=(), energy_scale: float = 1.0):
+                 extra_powers=(), energy_scale: float = 1.0, handovers=()):
         super().__init__()
         check_pairs(plant, pairs, energy_scale)
         law.validate("law")
@@ -119,7 +124,7 @@ class RigidContactSystem(LeafSystem):
         self.energy_scale = float(energy_scale)
         self.extra_powers = list(extra_powers)
         self.evaluator = ev = PlantEvaluator(plant, pairs, law, options, self.extra_powers,
-                                             self.energy_scale)
+                                             self.energy_scale, handovers)
         self.nq, self.nv, self.nu, self.ie = ev.nq, ev.nv, ev.nu, ev.ie
         self.timing = Timing([p.name for p in pairs])
         self.transitions = Transitions(ev, self.timing)
@@ -245,14 +250,16 @@ class RigidContactSystem(LeafSystem):
     # ------------------------------------------------------------------ witnesses
     def DoGetWitnessFunctions(self, context):
         return [self._w_far if i is None else self._w[i][kind]
-                for i, kind in witnesses.armed(self.get_modes(context).pairs)]
+                for i, kind in witnesses.armed(self.get_modes(context).pairs,
+                                               self.evaluator.links.of_edge)]
 
     def witness_values(self, context) -> dict:
         """The values of the witnesses `DoGetWitnessFunctions` returns now, by description
         (used by `drake_dock.systems.stepping.WitnessApproach` to predict their zeros)."""
         return {FAR_WITNESS if i is None else f"{self.pairs[i].name} {kind}":
                 self._witness(context, i, kind)
-                for i, kind in witnesses.armed(self.get_modes(context).pairs)}
+                for i, kind in witnesses.armed(self.get_modes(context).pairs,
+                                               self.evaluator.links.of_edge)}
 
     def witness_rates(self, context) -> dict:
         """Time derivatives of the gap witnesses of the tracked couples, by description:

@@ -8,10 +8,12 @@ import math
 import numpy as np
 
 from drake_dock.core.contact_law import ContactLaw
+from drake_dock.core.handover import SurfaceEdge
 from drake_dock.core.hybrid import Mode
 
 __all__ = ["COUPLE_FIELDS", "COUPLE_OUTPUT_SIZE", "COUPLE_SLICES", "ContactLaw", "ContactModes",
-           "ContactOptions", "ContactPair", "Evaluation", "PairState"]
+           "ContactOptions", "ContactPair", "Evaluation", "Handover", "PairState",
+           "SurfaceEdge"]
 
 # Layout of each couple's output port; "status" is the pair's `Mode` (0 far, 1 tracked,
 # 2 sliding, 3 sticking).
@@ -42,6 +44,17 @@ class ContactPair:
     sigma: float | None = None
 
 
+@dataclasses.dataclass(frozen=True)
+class Handover:
+    """A declared hand-over (`drake_dock.core.handover`): pair ``edge_pair`` (C-C) and pair
+    ``surface_pair`` (C-S) share their curve on Body 1, and the edge pair's curve on Body 2 is
+    the boundary ``edge`` of the surface pair's surface."""
+
+    edge_pair: str
+    surface_pair: str
+    edge: SurfaceEdge
+
+
 @dataclasses.dataclass
 class ContactOptions:
     baumgarte: float = 20.0          # omega (rad/s) of the constraint stabilisation
@@ -62,7 +75,10 @@ class ContactOptions:
                                      # track_distance (`seek_couple`): their distance only sets
                                      # the clearance, which keeps track_distance / 2 in hand
     max_impacts: int = 10000
-    compiled: bool = True            # the couples by the compiled kernels (False: in Python)
+    compiled: bool = True            # the couples, seeks, constraint solve and mode selection
+                                     # by the compiled kernels (False: in Python)
+    broad_phase: bool = False        # a far pair whose covers are at least track_distance
+                                     # apart is not sought (`Transitions.screen`)
 
 
 @dataclasses.dataclass

@@ -10,13 +10,15 @@ import numpy as np
 from pydrake.multibody.math import SpatialForce
 from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
 
-from drake_dock.core.constraints import SLIDE, STICK, ContactRow, solve_given_modes
+from drake_dock.core.constraints import (SLIDE, STICK, ContactRow, friction_power,
+                                         solve_given_modes)
 from drake_dock.core.couple import evaluate_couple, float_pose, float_vec
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels.couples import DRIFT_REL as KERNEL_DRIFT_REL
 from drake_dock.errors import DriftError
 from drake_dock.systems.contact_types import Evaluation
 from drake_dock.systems.far_pairs import FarPairs
+from drake_dock.systems.handovers import HandoverLinks
 
 KV = JacobianWrtVariable.kV
 
@@ -38,7 +40,8 @@ class PlantEvaluator:
     x = [q, v, u*, energy integrals]; pair i's couple is u*[uoff[i]:uoff[i + 1]]. ``inputs``
     arguments are (generalized force or None, [(body, world wrench [torque, force])])."""
 
-    def __init__(self, plant, pairs, law, options, extra_powers=(), energy_scale=1.0):
+    def __init__(self, plant, pairs, law, options, extra_powers=(), energy_scale=1.0,
+                 handovers=()):
         self.plant, self.pairs, self.law, self.options = plant, list(pairs), law, options
         self.extra_powers = list(extra_powers)
         self.energy_scale = energy_scale
@@ -66,7 +69,13 @@ class PlantEvaluator:
             kernel = TrackedCouples([(p.kind, p.patch1, p.patch2, f)
                                      for p, f in zip(self.pairs, self.fidx)])
             self.kernel = kernel if kernel.supported else None
+        # The constraint solve (Eq. 48-52) compiled, or in Python with options.compiled off.
+        self.solver = None
+        if options.compiled:
+            from drake_dock.core.kernels import constraints as solver
+            self.solver = solver
         self.far = FarPairs(pairs, self.fidx)
+        self.links = HandoverLinks(self.pairs, handovers)
         self.evaluations = 0
         self._zero_v = np.zeros(self.nv)         # never written
         self._world = plant.world_frame()
@@ -142,7 +151,14 @@ class PlantEvaluator:
         return evals, udot
 
     def row(self, i, ev, poses, ctx):
-        """W^3, W^1, W^2 (Eq. 11) from Drake's point Jacobians and the bias terms (Eq. 52)."""
+        """Pair i's `ContactRow` (`row_arrays`)."""
+        W, bn, bt = self.row_arrays(i, ev, poses, ctx)
+        return ContactRow(self.pairs[i].name, W[:, 0], W[:, 1:], bn, bt, ev.gap, ev.vn, ev.vt,
+                          self.law.mu, self.mu_s)
+
+    def row_arrays(self, i, ev, poses, ctx):
+        """W (nv, 3), the columns W^3, W^1, W^2 of Eq. (11) from Drake's point Jacobians, and the
+        bias terms bn, bt (Eq. 52)."""
         p = self.pairs[i]
         a, b = self.fidx[i]
         world = self._world
@@ -157,8 +173,32 @@ class PlantEvaluator:
         D = np.array([ev.n, ev.ta, ev.tb]).T          # columns n, ta, tb
         W = J.T @ D
         b = D.T @ ab.ravel()
-        return ContactRow(p.name, W[:, 0], W[:, 1:], ev.bias_n + b[0], ev.bias_t + b[1:],
-                          ev.gap, ev.vn, ev.vt, self.law.mu, self.mu_s)
+        return W, ev.bias_n + b[0], ev.bias_t + b[1:]
+
+    def solve(self, t, Minv, a0, row_pairs, evals, smodes, dirs, poses, ctx):
+        """The constraint solve for the modes of the contact set (Eq. 48-52): v', lambda_n (per
+        row), lambda_t and the generalized contact force; compiled (one call) or in Python."""
+        omega = self.options.baumgarte
+        if self.solver is None:
+            rows = [self.row(i, evals[i], poses, ctx) for i in row_pairs]
+            sol = solve_given_modes(Minv, a0, rows, smodes, dirs, omega=omega, time=t)
+            return sol.vdot, sol.lam_n, sol.lam_t, sol.generalized_force
+        kc = len(row_pairs)
+        if kc == 0:
+            return a0, np.zeros(0), np.zeros((0, 2)), np.zeros_like(a0)
+        S = self.solver
+        W, bias = np.empty((kc, self.nv, 3)), np.empty((kc, 3))
+        gap, vn, sdirs = np.empty(kc), np.empty(kc), np.zeros((kc, 2))
+        codes = np.empty(kc, np.int64)
+        for j, i in enumerate(row_pairs):
+            ev = evals[i]
+            W[j], bias[j, 0], bias[j, 1:] = self.row_arrays(i, ev, poses, ctx)
+            gap[j], vn[j] = ev.gap, ev.vn
+            codes[j] = S.CODE[smodes[j]]
+            if dirs[j] is not None:
+                sdirs[j] = dirs[j]
+        return S.solve_packed(Minv, a0, W, bias, gap, vn, np.full(kc, self.law.mu), codes,
+                              sdirs, omega, time=t, names=[self.pairs[i].name for i in row_pairs])
 
     def free_acceleration(self, ctx, v, inputs):
         """M, M^-1, a0 = M^-1 tau (every force but contact), and the power of the plant's
@@ -213,11 +253,10 @@ class PlantEvaluator:
         poses, twists = self.frame_kinematics(ctx)
         k = len(self.pairs)
         evals, udot = self.couples(t, u, poses, twists, modes)
-        rows, row_pairs, smodes, dirs = [], [], [], []
+        row_pairs, smodes, dirs = [], [], []
         for i, st in enumerate(modes.pairs):
             ev = evals[i]
             if st.mode.in_contact:
-                rows.append(self.row(i, ev, poses, ctx))
                 row_pairs.append(i)
                 if st.mode == Mode.STICKING:
                     smodes.append(STICK)
@@ -228,14 +267,15 @@ class PlantEvaluator:
                     dirs.append(ev.vt / s if s > self.options.v_slip or st.slide_dir is None
                                 else st.slide_dir)
         M, Minv, a0, p_plant, p_in = self.free_acceleration(ctx, v, inputs)
-        sol = solve_given_modes(Minv, a0, rows, smodes, dirs, omega=self.options.baumgarte,
-                                time=t)
+        vdot, lam_rn, lam_rt, gf = self.solve(t, Minv, a0, row_pairs, evals, smodes, dirs, poses,
+                                              ctx)
         lam_n, lam_t = np.zeros(k), np.zeros((k, 2))
         for j, i in enumerate(row_pairs):
-            lam_n[i], lam_t[i] = sol.lam_n[j], sol.lam_t[j]
+            lam_n[i], lam_t[i] = lam_rn[j], lam_rt[j]
         qdot = self.plant.MapVelocityToQDot(ctx, v)
-        E = Evaluation(q, v, qdot, sol.vdot, udot, evals, lam_n, lam_t, sol.generalized_force,
-                       sol.power_lost_to_friction(rows), p_plant, p_in, np.full(k, np.nan), {},
+        E = Evaluation(q, v, qdot, vdot, udot, evals, lam_n, lam_t, gf,
+                       friction_power(lam_rt, [evals[i].vt for i in row_pairs]), p_plant, p_in,
+                       np.full(k, np.nan), {},
                        poses, np.array([f(q, v) for _, f in self.extra_powers], dtype=float),
                        modes)
         E.xdot = np.concatenate([qdot, E.vdot, udot, np.array(

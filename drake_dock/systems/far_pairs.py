@@ -1,10 +1,18 @@
 """The far pairs' travel bound (Sect. 5.1): a conservative bound of the travel of patch 1
-relative to frame 2 since the pair's last seek, compared with its clearance."""
+relative to frame 2 since the pair's last seek, compared with its clearance; and the broad
+phase: the least gap of the pair's bounding-sphere covers (`drake_dock.core.covers`), a lower
+bound of its distance that needs no seek."""
 from __future__ import annotations
 
 import math
 
 import numpy as np
+
+from drake_dock.core import covers
+from drake_dock.core.kernels import cover as compiled_cover
+
+# Covers of the broad phase: cells per parameter and per block, by patch dimension.
+BROAD_CELLS = {1: (256, 16), 2: (32, 8)}
 
 
 def bounding_sphere(patch, n=41):
@@ -43,6 +51,20 @@ class FarPairs:
         spheres = [bounding_sphere(p.patch1) for p in pairs]
         self.centres = np.array([c for c, _ in spheres]).reshape(-1, 3)
         self.radii = np.array([r for _, r in spheres])
+        self.pairs = pairs
+
+    def covers(self, i):
+        """The covers (`BROAD_CELLS`) of pair i's two patches, compiled where the patches have
+        kernel descriptions (kept on the patches)."""
+        return [compiled_cover.patch_cover(p, *BROAD_CELLS[p.dim])
+                or covers.patch_cover(p, *BROAD_CELLS[p.dim])
+                for p in (self.pairs[i].patch1, self.pairs[i].patch2)]
+
+    def cover_gap(self, i, poses):
+        """The least gap of pair i's covers at ``poses``, patch 1 placed in frame 2: a lower
+        bound of the pair's distance (`drake_dock.core.covers.cover_gap`)."""
+        c1, c2 = self.covers(i)
+        return compiled_cover.cover_gap(c1.posed(*self.reference(i, poses)), c2)
 
     def reference(self, i, poses):
         """The relative pose of pair i kept at a seek."""

@@ -11,7 +11,8 @@ PARTS = ("seeking", "contact_dynamics", "impacts")
 @dataclasses.dataclass
 class Timing:
     """Cumulative wall time (s) of the contact system's parts (reset with `reset`): seeking
-    (Sect. 5.1, the hierarchical grid and Newton, per pair with the number of seeks), contact
+    (Sect. 5.1, the hierarchical grid and Newton, per pair with the number of seeks, and the
+    broad phase's cover gaps), contact
     dynamics (every derivative evaluation: couple tracking, Eq. 47, the constraint forces) and
     impacts (LZB and the mode selection at events). Only the declared pairs are ever searched."""
 
@@ -20,10 +21,11 @@ class Timing:
     contact_dynamics: float = 0.0
     impacts: float = 0.0
     seeks: dict = dataclasses.field(default_factory=dict)
+    screens: dict = dataclasses.field(default_factory=dict)   # far pairs the broad phase kept
 
     def reset(self):
         self.seeking = self.contact_dynamics = self.impacts = 0.0
-        self.seeks = {}
+        self.seeks, self.screens = {}, {}
 
     @contextlib.contextmanager
     def measure(self, part: str):
@@ -37,10 +39,15 @@ class Timing:
     def count_seek(self, pair: str):
         self.seeks[pair] = self.seeks.get(pair, 0) + 1
 
+    def count_screen(self, pair: str):
+        self.screens[pair] = self.screens.get(pair, 0) + 1
+
     def shares(self, wall_time: float) -> dict:
         """The three parts and the rest (Drake's integrator, witnesses, logging) as fractions of
-        ``wall_time``, with the pairs declared and the seeks per pair."""
+        ``wall_time``, with the pairs declared, the seeks per pair and the broad phase's
+        screenings per pair (far pairs not sought: their covers were apart)."""
         out = {k: getattr(self, k) / wall_time for k in PARTS}
         out["other"] = max(0.0, 1.0 - sum(out.values()))
         return {"wall_time": wall_time, "shares": out, "pairs_declared": len(self.pairs),
-                "seeks_per_pair": {n: self.seeks.get(n, 0) for n in self.pairs}}
+                "seeks_per_pair": {n: self.seeks.get(n, 0) for n in self.pairs},
+                "screens_per_pair": {n: self.screens.get(n, 0) for n in self.pairs}}

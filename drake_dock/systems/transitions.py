@@ -7,10 +7,11 @@ import os
 
 import numpy as np
 
-from drake_dock.core import hybrid
+from drake_dock.core import handover, hybrid
 from drake_dock.core.constraints import select_modes
 from drake_dock.core.couple import evaluate_couple
 from drake_dock.core.hybrid import Mode
+from drake_dock.core.kernels import constraints as compiled_constraints
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.core.patches import posed
@@ -39,13 +40,18 @@ class Transitions:
         ctx = ev.set_scratch(q, v)
         poses, twists = ev.frame_kinematics(ctx)
         initial = all(st.ref_X21 is None and st.mode == Mode.FAR for st in modes.pairs)
+        handed = {}         # pair handed to -> pair it continues (`drake_dock.core.handover`)
         # 1. Seeking: at initialisation, for far pairs whose clearance is used up, and for
-        #    couples at a domain end or with a singular Jacobian.
+        #    couples at a domain end or with a singular Jacobian; hand-overs between an edge
+        #    pair and a surface pair.
         for i, st in enumerate(modes.pairs):
             sl = ev.couple_slice(i)
+            if i in handed:
+                continue
             if initial or (st.mode == Mode.FAR
                            and ev.far.bound(i, poses, st) >= early * st.clearance):
-                self.seek(i, poses, st, u, t, False, initial)
+                if not self.screen(i, poses, st):
+                    self.seek(i, poses, modes.pairs, u, t, False, initial)
                 continue
             if st.mode == Mode.FAR:
                 continue
@@ -54,6 +60,11 @@ class Transitions:
             c = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
                                 twists[b], u[sl], st.sigma)
             u[sl] = c.u
+            to = ev.links.target(i, c.u, c.n, poses[b][0], modes.pairs)
+            if to is not None:
+                self.hand_over(i, *to, c.n, poses, modes.pairs, u)
+                handed[to[0]] = i
+                continue
             margin = np.concatenate([p.patch1.margin(c.u[:p.patch1.dim]),
                                      p.patch2.margin(c.u[p.patch1.dim:])]) / ev.spans[i]
             if c.conditioning <= opt.conditioning_min and st.mode.in_contact:
@@ -61,11 +72,11 @@ class Transitions:
                     f"the Jacobian of a couple in contact turned singular (Eq. 39 fails; "
                     f"conditioning {c.conditioning:.2e})", time=t, couples=[p.name])
             if margin.min() <= 0.0 or c.conditioning <= opt.conditioning_min:
-                self.seek(i, poses, st, u, t, st.mode.in_contact)
+                self.seek(i, poses, modes.pairs, u, t, st.mode.in_contact)
         # 2. Impacts and 3. modes.
         n_impacts = len(modes.impacts)
         with self.timing.measure("impacts"):
-            v = self.impacts_and_modes(t, modes, ctx, q, v, u, inputs, current)
+            v = self.impacts_and_modes(t, modes, ctx, q, v, u, inputs, current, handed)
         x_new = x.copy()
         x_new[ev.nq:ev.nq + ev.nv] = v
         x_new[ev.nq + ev.nv:ev.ie] = u
@@ -77,20 +88,58 @@ class Transitions:
                                      impact_loss_plus=modes.impact_loss)
         return x_new, modes
 
-    def seek(self, i, poses, st, u, time, was_contact, initial=False):
-        """Sect. 5.1 for pair i (its `PairState` st, its couple written into u), and the mode
-        that follows (`hybrid.after_seek`). At the initial seek a pair with a declared
+    def screen(self, i, poses, st) -> bool:
+        """The broad phase (``options.broad_phase``) for far pair i (its `PairState` st): when
+        the least gap G of its covers (a lower bound of its distance) is at least
+        ``track_distance``, a seek could only leave it far, so it is not sought; it keeps G as
+        its distance, with the far pair's clearance of `hybrid.after_seek`. Returns whether
+        the pair was screened so."""
+        opt = self.options
+        if not opt.broad_phase:
+            return False
+        with self.timing.measure("seeking"):
+            gap = self.ev.far.cover_gap(i, poses)
+            if not gap >= opt.track_distance:
+                return False
+            st.ref_X21 = self.ev.far.reference(i, poses)
+            st.distance = gap
+            st.mode, st.clearance = hybrid.after_seek(gap, False, False, False,
+                                                      opt.track_distance, opt.reseek_floor)
+            st.slide_dir = None
+            self.timing.count_screen(self.pairs[i].name)
+        return True
+
+    def hand_over(self, i, j, uj, n, poses, states, u):
+        """Pair i's couple (normal n) continues as pair j's couple uj: j takes i's mode and the
+        sigma that keeps n (`drake_dock.core.handover`); i is far, its nearest point carried
+        by j (clearance half ``track_distance``, as `hybrid.after_seek` for a carried couple)."""
+        ev, p = self.ev, self.pairs[j]
+        a, b = ev.fidx[j]
+        u[ev.couple_slice(j)] = uj
+        raw = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
+                              poses[b], (np.zeros(3),) * 2, uj, 1.0, project=False)
+        si, sj = states[i], states[j]
+        sj.mode, sj.sigma, sj.slide_dir = si.mode, handover.carried_sigma(n, raw.n), None
+        si.mode, si.clearance = hybrid.after_seek(abs(raw.gap), False, False, True,
+                                                  self.options.track_distance,
+                                                  self.options.reseek_floor, carried=True)
+        si.slide_dir, si.ref_X21 = None, ev.far.reference(i, poses)
+        si.distance = sj.distance = abs(raw.gap)
+
+    def seek(self, i, poses, states, u, time, was_contact, initial=False):
+        """Sect. 5.1 for pair i (its `PairState` states[i], its couple written into u), and the
+        mode that follows (`hybrid.after_seek`). At the initial seek a pair with a declared
         ``sigma`` whose couple lies on the wrong side by more than ``impact_gap_tol`` is
         refused: the bodies start interpenetrating."""
         name = self.pairs[i].name
         with self.timing.measure("seeking"):
             try:
-                self._seek(i, poses, st, u, time, was_contact, initial)
+                self._seek(i, poses, states, u, time, was_contact, initial)
             finally:
                 self.timing.count_seek(name)
 
-    def _seek(self, i, poses, st, u, time, was_contact, initial):
-        ev, opt, p = self.ev, self.options, self.pairs[i]
+    def _seek(self, i, poses, states, u, time, was_contact, initial):
+        ev, opt, p, st = self.ev, self.options, self.pairs[i], states[i]
         a, b = ev.fidx[i]
         try:
             P1, P2 = posed(p.patch1, *poses[a]), posed(p.patch2, *poses[b])
@@ -108,8 +157,9 @@ class Transitions:
         usable, uc = f.usable, f.u
         crossing = hybrid.intersecting(c.distance, f.finish_failed, opt.impact_gap_tol)
         if usable:
-            gap = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
-                                  poses[b], (np.zeros(3),) * 2, uc, 1.0, project=False).gap
+            raw = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
+                                  poses[b], (np.zeros(3),) * 2, uc, 1.0, project=False)
+            gap = raw.gap
             sigma = hybrid.couple_sigma(p.sigma, gap)
             crossing = hybrid.patches_cross(gap, c.distance, sigma, opt.impact_gap_tol)
         if initial and p.sigma is not None and (
@@ -123,17 +173,26 @@ class Transitions:
                              f"signed gap >= -impact_gap_tol = {-opt.impact_gap_tol:g} m",
                              "the bodies start interpenetrating")
         u[ev.couple_slice(i)] = uc
-        mode, clearance = hybrid.after_seek(c.distance, usable, crossing, was_contact,
-                                            opt.track_distance, opt.reseek_floor)
+        # A couple where a hand-over is due (on a declared edge of the surface, or an edge
+        # couple over the face) is the linked pair's, not this pair's.
+        due = [j for j, _ in ev.links.due(i, uc, sigma * raw.n if usable else None,
+                                          poses[b][0])]
+        carried = any(states[j].mode != Mode.FAR for j in due)
+        mode, clearance = hybrid.after_seek(c.distance, usable and not due, crossing,
+                                            was_contact, opt.track_distance, opt.reseek_floor,
+                                            carried)
         if mode == Mode.TRACKED:
             st.sigma = sigma
         else:
             st.clearance = clearance
         st.mode, st.slide_dir = mode, None
 
-    def impacts_and_modes(self, t, modes, ctx, q, v, u, inputs, current):
+    def impacts_and_modes(self, t, modes, ctx, q, v, u, inputs, current, handed=None):
         """2. The LZB impact of the couples hit (Sect. 6) and 3. the modes of the contact set
-        (Eq. 48-52), then the velocity projection onto the new constraints; returns v."""
+        (Eq. 48-52), then the velocity projection onto the new constraints; returns v.
+        ``handed`` maps a pair handed a couple to the pair it continues, whose forces it
+        takes."""
+        handed = handed or {}
         ev, opt = self.ev, self.options
         states = modes.pairs
         evs = {}
@@ -154,7 +213,8 @@ class Transitions:
         leaving = {}
         if any(st.mode.in_contact for st in states):
             E = current()
-            leaving = {i: hybrid.modes_left(st.mode, E.lam_n[i], E.lam_t[i], ev.mu_s)
+            src = {i: handed.get(i, i) for i, st in enumerate(states) if st.mode.in_contact}
+            leaving = {i: hybrid.modes_left(st.mode, E.lam_n[src[i]], E.lam_t[src[i]], ev.mu_s)
                        for i, st in enumerate(states) if st.mode.in_contact}
         poses = evaluate_all(v)
         gap, vn = gaps_and_rates()
@@ -181,8 +241,9 @@ class Transitions:
         ev.set_scratch(q, v)
         rows = [ev.row(i, evs[i], poses, ctx) for i in cand]
         M, Minv, a0, _, _ = ev.free_acceleration(ctx, v, inputs)
-        sol = select_modes(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
-                           avoid=[() if hit else leaving.get(i, ()) for i in cand])
+        select = compiled_constraints.select_modes if opt.compiled else select_modes
+        sol = select(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
+                     avoid=[() if hit else leaving.get(i, ()) for i in cand])
         cons = []
         for j, i in enumerate(cand):
             st = states[i]

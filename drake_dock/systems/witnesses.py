@@ -51,6 +51,16 @@ def _cond(ev, E, st, i):
     return 1.0 if c is None else c.conditioning - ev.options.conditioning_min
 
 
+def _handover(ev, E, st, i):
+    """The guard of an edge pair with a declared hand-over (`drake_dock.core.handover`): n . b,
+    positive while its curve lies beyond the edge; at its zero the couple passes onto the
+    surface and is handed to the surface pair."""
+    c = E.evals[i]
+    if c is None:
+        return 1.0
+    return ev.links.guard(i, c.n, c.u, E.poses[ev.fidx[i][1]][0])
+
+
 def _lambda(ev, E, st, i):
     """lambda_n of a couple in contact: it detaches at its zero (Eq. 50-51)."""
     return E.lam_n[i] if st.mode.in_contact else 1.0
@@ -84,7 +94,8 @@ def _clear(ev, E, st, i):
 # kind: (name after the pair's name, value(evaluator, evaluation, pair state, pair index))
 WITNESSES = {"gap": ("gap", _gap), "end": ("domain end", _end), "cond": ("Eq. 39", _cond),
              "lambda": ("lambda_n", _lambda), "slip": ("slip", _slip),
-             "cone": ("friction cone", _cone), "apex": ("gap rate", _apex)}
+             "cone": ("friction cone", _cone), "apex": ("gap rate", _apex),
+             "handover": ("hand-over", _handover)}
 
 # The witnesses of a pair in each mode, in the order they are armed.
 BY_MODE = {Mode.FAR: (),
@@ -111,10 +122,13 @@ def declare(system, pairs, value_at, event):
     return per_pair, far
 
 
-def armed(states) -> list:
+def armed(states, edge_pairs=()) -> list:
     """(pair index or None, kind) of every witness armed for the pairs' `PairState`s: the far
-    pairs' clearance when a pair is far, then each pair's witnesses of its mode."""
+    pairs' clearance when a pair is far, then each pair's witnesses of its mode, and the
+    hand-over guard of the pairs in ``edge_pairs`` that are not far."""
     out = [(None, "clear")] if any(st.mode == Mode.FAR for st in states) else []
     for i, st in enumerate(states):
         out += [(i, kind) for kind in BY_MODE[st.mode]]
+        if st.mode != Mode.FAR and i in edge_pairs:
+            out.append((i, "handover"))
     return out

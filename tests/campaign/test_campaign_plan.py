@@ -47,8 +47,40 @@ def test_the_good_plan_and_the_shipped_idss_plan_load(tmp_path):
     assert [f.path for f in load_plan(plan)[2]] == ["initial.lateral_offset",
                                                     "initial.target_yaw_deg"]
     idss, base, fields = load_plan(MODELS_DIR / "idss_envelope.yaml")
-    assert base == load_scenario(PAPER_EXAMPLE)
+    # The paper example with the plan's `set`: capture on the axial distance alone.
+    paper = load_scenario(PAPER_EXAMPLE)
+    assert paper.simulation.capture_lateral is not None
+    paper.simulation.capture_lateral = paper.simulation.capture_tilt_deg = None
+    assert base == paper
     assert sum(f.dims for f in fields) == 11         # the eleven random initial parameters
+
+
+@pytest.mark.parametrize("set_, field, named", [
+    ("{initial.no_such_field: 1.0}", "set", "no_such_field"),
+    ("{simulation.capture_lateral: -1.0}", "set", "simulation.capture_lateral"),
+    ("[1, 2]", "set", "dotted path"),
+    ("{initial.chaser_speed.x: 1.0}", "set.initial.chaser_speed.x", "scenario field")])
+def test_a_bad_set_is_named_before_anything_runs(tmp_path, set_, field, named):
+    """A plan's `set` writes values into the base scenario: a path that is not a scenario
+    field, or a value the scenario refuses, is an InputError naming `set` and the field."""
+    from drake_dock.campaign.plan import load_plan
+    from drake_dock.docking.scenario import PAPER_EXAMPLE
+    from drake_dock.errors import InputError
+    plan = tmp_path / "plan.yaml"
+    plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE) + f"set: {set_}\n")
+    with pytest.raises(InputError) as e:
+        load_plan(plan)
+    assert e.value.field == field and named in str(e.value)
+
+
+def test_set_values_reach_every_sample(tmp_path):
+    from drake_dock.campaign.plan import load_plan
+    from drake_dock.docking.scenario import PAPER_EXAMPLE
+    plan = tmp_path / "plan.yaml"
+    plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE)
+                    + "set: {contact.mu: 0.05, simulation.capture_tilt_deg: null}\n")
+    _, base, _ = load_plan(plan)
+    assert base.contact.mu == 0.05 and base.simulation.capture_tilt_deg is None
 
 
 def test_edges_sampler_follows_the_arcsine_law_and_sobol_points_keep_their_index():

@@ -1,19 +1,27 @@
-"""Mode selection of the contact set (drake_dock.core.constraints) on rigid bodies resting on the
-plane z = 0: a rod whose sliding tip unloads and lifts off with the gap drift of a docking run,
-Painleve's rod, and random sliding contacts against a brute-force enumeration of the modes.
-Runs without Drake."""
+"""Mode selection of the contact set on rigid bodies resting on the plane z = 0: a rod whose
+sliding tip unloads and lifts off with the gap drift of a docking run, Painleve's rod, and random
+sliding contacts against a brute-force enumeration of the modes. Each test runs the pure-Python
+reference (drake_dock.core.constraints) and the compiled kernels
+(drake_dock.core.kernels.constraints). Runs without Drake."""
 import itertools
 import math
 
 import numpy as np
 import pytest
 
-from drake_dock.core.constraints import (DETACH, SLIDE, TIE_RTOL, ContactRow, select_modes,
-                                         stabilised_gddot)
+from drake_dock.core import constraints
+from drake_dock.core.constraints import DETACH, SLIDE, TIE_RTOL, ContactRow, stabilised_gddot
+from drake_dock.core.kernels import constraints as compiled
 from drake_dock.errors import PainleveError
 
 G = 9.81
 OMEGA = 20.0          # the contact system's Baumgarte omega (rad/s)
+
+
+@pytest.fixture(params=["python", "compiled"])
+def select_modes(request):
+    """Mode selection by the reference or by the compiled kernels."""
+    return {"python": constraints.select_modes, "compiled": compiled.select_modes}[request.param]
 
 
 def body_mass(m, inertia):
@@ -98,7 +106,7 @@ LIFT_OFF = dict(gap=8.273e-9, vn=-1.875e-10, vt=[-0.0803, 0.0])
 GDDOT_FREE = -3.2909e-6
 
 
-def test_a_sliding_couple_lifting_off_with_an_open_drift_detaches():
+def test_a_sliding_couple_lifting_off_with_an_open_drift_detaches(select_modes):
     """The free motion's stabilised normal acceleration is +1.1e-8 m/s^2: sliding would need
     lambda_n = -1.1e-8 / A < 0 (a pull), detaching leaves the stabilised row >= 0, so
     detaching is the one consistent mode (Eq. 50-52). The unstabilised g'' < 0 of the free
@@ -123,7 +131,7 @@ def test_a_sliding_couple_lifting_off_with_an_open_drift_detaches():
     assert select_modes(np.linalg.inv(M), a0, [row], omega=OMEGA).modes == (DETACH,)
 
 
-def test_a_loaded_sliding_couple_with_the_same_drift_keeps_sliding():
+def test_a_loaded_sliding_couple_with_the_same_drift_keeps_sliding(select_modes):
     """Gravity on the same rod: lambda_n = -(b + 2 omega g' + omega^2 g) / A, the sliding
     tip's closed form (Eq. 50, 52)."""
     theta, l, mass, mu = math.radians(30.0), 1.0, 1000.0, 0.1
@@ -137,7 +145,7 @@ def test_a_loaded_sliding_couple_with_the_same_drift_keeps_sliding():
 
 
 @pytest.mark.parametrize("drift", [dict(gap=0.0, vn=0.0), LIFT_OFF])
-def test_painleve_rod_above_the_critical_friction_is_inconsistent(drift):
+def test_painleve_rod_above_the_critical_friction_is_inconsistent(drift, select_modes):
     """mu = 3 at 30 deg: A = (1 + 3 c (c + mu s sn)) / m < 0 for the tip sliding towards -x, and
     gravity presses it on the plane: sliding needs lambda_n = G / A < 0 and detaching has
     g'' = -G. No consistent mode: PainleveError."""
@@ -170,7 +178,7 @@ def random_scene(rng):
     return body_mass(mass, inertia), a0, rows
 
 
-def test_random_sliding_contacts_match_the_enumeration():
+def test_random_sliding_contacts_match_the_enumeration(select_modes):
     """Random scenes in the lift-off window: mode selection always succeeds at mu = 0.1, and
     its choice is a consistent mode of the brute-force enumeration with the same
     accelerations."""

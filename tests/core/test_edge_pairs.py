@@ -1,6 +1,6 @@
 """The edge and face pairs (`contact.pairs: complete`) in closed form (tests/edge_scenes.py): a
-ring's circle over a straight edge and over a tip arc (C-C), a tilted rim over a ring face (C-S)
-and the hand-over at a petal-like tip, tracked by Eq. (47) through prescribed motions to 1e-8;
+ring's circle over a straight edge and over a tip arc (C-C), a tilted rim over a ring face (C-S),
+a tip arc over a guide-surface cone (C-S) and the hand-over at a petal-like tip, tracked by Eq. (47) through prescribed motions to 1e-8;
 the compiled kernels against the Python reference to 1e-12."""
 import math
 
@@ -16,10 +16,11 @@ from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.docking.apds import ApdsGeometry, apds_patches
 from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec
-from edge_scenes import CORNER, rim_over_face, ring_over_arc, ring_over_segment, tip_handover
+from edge_scenes import (CORNER, arc_over_cone, rim_over_face, ring_over_arc, ring_over_segment,
+                         tip_handover)
 
 SCENES = {"ring_over_segment": ring_over_segment, "ring_over_arc": ring_over_arc,
-          "rim_over_face": rim_over_face}
+          "rim_over_face": rim_over_face, "arc_over_cone": arc_over_cone}
 TIMES = np.linspace(0.0, 1.0, 11)
 
 
@@ -161,11 +162,12 @@ def test_kernels_equal_the_python_path(name):
 
 def test_complete_set_names_and_patches(geom):
     """`paper` is the 12 pairs; `complete` adds, per APDS, its ring's inside circle against the
-    other's 6 sides and 3 tip arcs and its rim against the other's face (20 pairs)."""
+    other's 6 sides and 3 tip arcs, its rim against the other's face and its tip arcs against
+    the other's guide surfaces they can face (32 pairs)."""
     paper, complete = apds_pairs(geom), apds_pairs(geom, "complete")
     assert [p.name for p in complete[:12]] == [p.name for p in paper] and len(paper) == 12
     new = {p.name: p for p in complete[12:]}
-    assert len(new) == 20
+    assert len(new) == 32
     P = apds_patches(geom)
     side = new["cc_Cring_T3"]
     assert side.kind == "CC" and type(side.patch2) is type(P.sides[3])
@@ -200,3 +202,26 @@ def test_complete_pairs_compiled_seek_equals_python(g, d):
         ref, got = seek_couple(P1, P2), compiled_seek.seek_couple(P1, P2)
         assert got.distance == pytest.approx(ref.distance, rel=0, abs=1e-12), pr.name
         assert got.interior == ref.interior, pr.name
+
+
+def test_tip_arcs_face_the_surfaces_their_pairs_name(geom):
+    """A tip arc has a pair with a guide surface of the other APDS exactly when, at some
+    relative roll in the scenario's range (-60 to 60 deg), a point of the arc lies over the
+    surface's angular span at its base, the widest (Eq. 13): sampled rolls and arc points."""
+    from drake_dock.docking.scene import relative_pose
+    P = apds_patches(geom)
+    names = {p.name for p in apds_pairs(geom, "complete") if p.name.startswith("cs_") and
+             "tip" in p.name}
+    reach = set()
+    for yaw in np.radians(np.linspace(-60.0, 60.0, 241)):
+        R = relative_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
+        for x, y, turn in (("C", "T", R), ("T", "C", R.T)):
+            for j in (1, 2, 3):
+                tip = P.tips[j]
+                pts = tip.position(np.linspace(tip.lower, tip.upper, 50)) @ turn.T
+                az = np.arctan2(pts[:, 1], pts[:, 0])
+                for k in (1, 2, 3):
+                    lo = (k - 1) * 2 * math.pi / 3
+                    if (((az - lo) % (2 * math.pi)) <= math.pi / 3).any():
+                        reach.add(f"cs_{x}tip{j}_{y}{k}")
+    assert names == reach and len(names) == 12

@@ -60,6 +60,15 @@ def test_after_seek_by_hand(distance, usable, crossing, was_contact, expected):
         assert clearance == pytest.approx(expected[1], rel=1e-12)
 
 
+@pytest.mark.parametrize("distance, usable, was_contact", [
+    (0.0, False, True), (1e-5, False, False), (0.01, True, False), (0.05, True, False)])
+def test_after_seek_carried_couple_keeps_half_track_distance(distance, usable, was_contact):
+    """A couple carried by a linked pair (`drake_dock.core.handover`) is far with half
+    track_distance of clearance at any distance, even a usable one: it is that pair's couple."""
+    assert hybrid.after_seek(distance, usable, False, was_contact, 0.02, 1e-4,
+                             carried=True) == (FAR, 0.01)
+
+
 def test_far_clearance_never_lets_a_pair_touch_unseen():
     """A pair at distance d > reseek_floor cannot touch within its clearance of relative travel
     (the distance shrinks at most by the travel), and it keeps at least half of the smaller of

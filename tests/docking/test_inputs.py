@@ -107,12 +107,12 @@ def test_contact_static_friction_defaults_to_sliding_friction():
 
 
 def test_contact_pairs_names_the_contact_set(paper_scenario):
-    """contact.pairs: ``paper`` (the default, the paper's 12 pairs) or ``complete`` (32 pairs);
+    """contact.pairs: ``paper`` (the default, the paper's 12 pairs) or ``complete`` (44 pairs);
     anything else is named by its field."""
     from drake_dock.docking.scene import scenario_pairs
     assert paper_scenario.contact.pairs == "paper" and len(scenario_pairs(paper_scenario)) == 12
     s = load_scenario(data="contact: {pairs: complete}")
-    assert len(scenario_pairs(s)) == 32
+    assert len(scenario_pairs(s)) == 44
     _fails("contact: {pairs: all}", "contact.pairs")
     _fails("contact: {pairs: 12}", "contact.pairs")
 
@@ -136,6 +136,14 @@ PHYSICAL = {
                          "simulator_config.use_error_control", "accuracy"),
     "a run not starting at 0": ("simulator_config: {start_time: 1.0}",
                                 "simulator_config.start_time", "t = 0"),
+    "no lateral capture tolerance": ("simulation: {capture_lateral: 0.0}",
+                                     "simulation.capture_lateral", "or null"),
+    "a lateral capture tolerance beyond the ring": ("simulation: {capture_lateral: 0.7}",
+                                                    "simulation.capture_lateral", "R = 0.6 m"),
+    "a tilt capture tolerance of a right angle": ("simulation: {capture_tilt_deg: 90.0}",
+                                                  "simulation.capture_tilt_deg", "< 90 deg"),
+    "a negative tilt capture tolerance": ("simulation: {capture_tilt_deg: -0.5}",
+                                          "simulation.capture_tilt_deg", "0 < tolerance"),
     "a run paced to stand still": ("simulator_config: {target_realtime_rate: 1.0e-300}",
                                    "simulator_config.target_realtime_rate", "as fast as"),
 }

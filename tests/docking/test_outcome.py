@@ -9,7 +9,8 @@ import pytest
 import yaml
 
 from drake_dock.cli import main
-from drake_dock.docking.outcome import JAM_DISTANCE, OutcomeWatch, progress_fraction
+from drake_dock.docking.outcome import (JAM_DISTANCE, CaptureRule, OutcomeWatch, misalignment,
+                                        progress_fraction)
 from drake_dock.docking.scenario import PAPER_EXAMPLE
 
 
@@ -40,6 +41,69 @@ def test_separating_rings_rebound_only_without_contact():
     assert feed(OutcomeWatch(0.1, 5.0), ts, ds, [True] * len(ts)) is None
     t, outcome = feed(OutcomeWatch(0.1, 5.0), ts, ds, [False] * len(ts))
     assert outcome == "rebound" and 1.0 < t <= 1.02
+
+
+def _rot(axis, angle):
+    """Rodrigues' rotation about the unit ``axis`` by ``angle``."""
+    k = np.asarray(axis, float) / np.linalg.norm(axis)
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_misalignment_of_a_constructed_pose(seed):
+    """The chaser ring placed in a randomly turned target ring frame at a known axial and
+    lateral offset, its axis facing the target's and tilted by a known angle about an axis in
+    the joint plane: misalignment returns the three, to round-off (tilts down to 1e-9 rad, where
+    an arccos of the axes' dot product would lose them)."""
+    rng = np.random.default_rng(seed)
+    R_t = _rot(rng.normal(size=3), rng.uniform(0, np.pi))
+    p_t = rng.normal(size=3)
+    axial, lateral, phi = rng.uniform(-0.2, 0.2), rng.uniform(0, 0.1), rng.uniform(0, 2 * np.pi)
+    for tilt in (1e-9, 1e-4, 0.07, 1.2):
+        a = rng.uniform(0, 2 * np.pi)
+        R_c = R_t @ _rot([np.cos(a), np.sin(a), 0.0], tilt) @ _rot([1.0, 0, 0], np.pi)
+        p_c = p_t + R_t @ [lateral * np.cos(phi), lateral * np.sin(phi), axial]
+        got = misalignment(R_t, p_t, R_c, p_c)
+        np.testing.assert_allclose(got[:2], [axial, lateral], atol=1e-14)
+        assert got[2] == pytest.approx(tilt, rel=1e-12, abs=1e-15)
+
+
+def test_capture_rule_is_the_latches_test():
+    """to_go <= axial tolerance exactly when all three quantities are within their tolerances;
+    it is the axial distance where none binds or none is given, and continuous (|change| at most
+    the change of its arguments, the tilt as R times it)."""
+    rule = CaptureRule(0.005, 0.01, 0.5, 0.6)
+    t_tol = np.radians(0.5)
+    rng = np.random.default_rng(3)
+    for _ in range(2000):
+        a, lat, tilt = rng.uniform(-0.02, 0.03), rng.uniform(0, 0.03), rng.uniform(0, 0.03)
+        inside = a <= 0.005 and lat <= 0.01 and tilt <= t_tol
+        assert (rule.to_go(a, lat, tilt) <= 0.005) == inside
+        da, dl, dt = rng.normal(scale=1e-6, size=3)
+        change = abs(rule.to_go(a + da, lat + dl, tilt + dt) - rule.to_go(a, lat, tilt))
+        assert change <= max(abs(da), abs(dl), 0.6 * abs(dt)) * (1 + 1e-9) + 1e-18
+    assert rule.to_go(0.1, 0.0, 0.0) == 0.1
+    assert CaptureRule(0.005, None, None, 0.6).to_go(0.1, 0.3, 1.0) == 0.1
+    # The excess counts: 2 mm too far off the axis is 2 mm to go beyond the axial tolerance.
+    assert rule.to_go(0.0, 0.012, 0.0) == pytest.approx(0.007)
+
+
+def test_a_misaligned_ring_past_the_axis_jams():
+    """The axial distance keeps falling (the rings pass each other in a model without their
+    face contact) while the lateral offset stays 5 mm beyond its tolerance: no progress towards
+    capture, so the run is jammed after jam_time, not captured."""
+    rule = CaptureRule(0.005, 0.01, None, 0.6)
+    ts = np.linspace(0, 5, 501)
+    watch = OutcomeWatch(0.1, 2.0)
+    for t in ts:
+        d = 0.1 - 0.05 * t
+        end = watch.update(t, d, True, rule.to_go(d, 0.015, 0.0))
+        if end:
+            break
+    # to_go stops at 0.010 m when d falls below it (t = 1.8 s); jammed 2 s after the last mm.
+    assert end[0] == "jammed" and 1.8 - 0.02 + 2.0 - 0.011 <= t <= 3.81
+    assert "distance to capture" in end[1]
 
 
 def test_progress_is_the_further_of_way_and_time():
@@ -84,6 +148,24 @@ def test_slow_approach_runs_to_capture_with_a_progress_bar_on_the_rings(tmp_path
     assert shown == sorted(shown) and shown[-1] == 100
     d = ts["ring_distance"]
     assert d[-1] == pytest.approx(s["capture_distance_m"], abs=1e-9)
+    tol = s["capture_tolerances"]
+    assert s["final_misalignment"]["lateral_m"] <= tol["lateral_m"]
+    assert s["final_misalignment"]["tilt_deg"] <= tol["tilt_deg"]
+
+
+def test_the_paper_example_is_captured_where_the_axial_distance_alone_captures_it():
+    """The paper's rings meet coaxially: with the latches' lateral and tilt tolerances left out
+    (null), the capture witness is the axial distance alone, and the default tolerances do not
+    bind, so both runs end at the same capture time, bit for bit."""
+    from drake_dock.docking.scenario import load_scenario
+    from drake_dock.docking.simulate import simulate
+    s = load_scenario()
+    axial_only = load_scenario()
+    axial_only.simulation.capture_lateral = axial_only.simulation.capture_tilt_deg = None
+    a, b = simulate(s), simulate(axial_only)
+    assert a.outcome == b.outcome == "captured"
+    assert a.capture_time == b.capture_time
+    assert "lateral offset <= 0.01 m" in a.reason and "lateral" not in b.reason
 
 
 def _relative_kinetic_energy(data, ts, k):

@@ -86,3 +86,73 @@ def test_search_equals_the_full_scan_on_random_approaches(which, seed):
         return
     assert first_contact(g, approach, which=which) == expected[:2]
     assert first_contact_seeks(g, approach, which=which) < expected[2]
+
+
+# Where no pair closes, and the placement's fixed point -----------------------------------------
+def _scenario(**initial):
+    from drake_dock.docking.scenario import load_scenario
+    s = load_scenario()
+    for k, v in initial.items():
+        setattr(s.initial, k, v)
+    return s
+
+
+def test_a_roll_of_zero_approaches_freely_and_is_captured_without_contact():
+    """At a relative roll of 0 the petals pass between each other: no pair closes, the
+    independent interpenetration check finds the way clear (the ring's inside circle grazes the
+    petal tips, Rs = R - H cot(alpha1)), the chaser starts approach_travel before the ring faces
+    meet and coasts: captured at (approach_travel - capture_distance) / chaser_speed, no impact."""
+    from drake_dock.docking.scene import initial_state
+    from drake_dock.docking.simulate import simulate
+    s = _scenario(target_yaw_deg=0.0)
+    st = initial_state(s)
+    assert st.d_contact == 0.0 and st.closing_pairs == [] and st.d0 == s.initial.approach_travel
+    r = simulate(s)
+    t_free = (s.initial.approach_travel - s.simulation.capture_distance) / s.initial.chaser_speed
+    assert r.outcome == "captured" and not r.impacts
+    assert r.capture_time == pytest.approx(t_free, abs=1e-7)
+
+
+def test_a_large_roll_that_meets_unmodelled_features_is_a_typed_error():
+    """At 40 deg roll no paper pair closes, but the guide sides cut through the petals that are
+    not their partners: NoPairCloses names the feature and the petal, before any simulation."""
+    from drake_dock.docking.scene import NoPairCloses, initial_state
+    with pytest.raises(NoPairCloses, match=r"guide side \d passes through the \w+ petal \d"):
+        initial_state(_scenario(target_yaw_deg=40.0))
+
+
+def _idss_sample(k):
+    from pathlib import Path
+    from drake_dock.campaign.plan import load_plan
+    from drake_dock.campaign.sample import sample_scenario
+    from drake_dock.campaign.sampling import sample_specs
+    models = Path(__file__).resolve().parents[2] / "models"
+    plan, base, fields = load_plan(models / "idss_envelope.yaml")
+    (_, _, values), = sample_specs(plan, fields, [k])
+    return sample_scenario(base, values)
+
+
+def test_a_fast_sideways_approach_is_placed_at_its_consistent_first_contact():
+    """IDSS sample 34 (lateral rate 0.8 of the closing rate): the first contact changes pairs
+    with the aim, so a bracket over the whole range closes on a jump; the placement finds the
+    root instead. Checked afresh: the path passes the lateral offset at the height of its first
+    contact, and that contact is the first on the path (a full scan of every pair agrees)."""
+    from drake_dock.docking.scene import contact_approach
+    s = _idss_sample(34)
+    a, lam, closing = contact_approach(s)
+    ic = s.initial
+    h = a.height(lam)
+    aim = np.array(ic.lateral_offset) + h * np.array(ic.lateral_velocity) / ic.chaser_speed
+    np.testing.assert_allclose(a.aim, aim, atol=1e-6)
+    lam_scan, names, _ = full_scan(ApdsGeometry(), a)
+    assert lam == lam_scan and closing == names
+
+
+def test_an_approach_whose_first_contact_jumps_past_its_offset_is_a_typed_error():
+    """IDSS sample 29: along every path through the given offset the first contact is at a
+    height where the path is elsewhere; NoPairCloses names both initial fields."""
+    from drake_dock.docking.scene import NoPairCloses, contact_approach
+    with pytest.raises(NoPairCloses) as e:
+        contact_approach(_idss_sample(29))
+    assert "initial.lateral_offset" in str(e.value)
+    assert "initial.lateral_velocity" in str(e.value)

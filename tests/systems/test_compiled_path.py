@@ -1,6 +1,6 @@
-"""The contact system with its couples evaluated by the compiled kernels against the same
-system evaluated in Python (`ContactOptions(compiled=False)`): the same trajectory, impacts and
-modes, to 1e-12, on a disk dropped spinning onto an incline (impacts) and on a stool sliding
+"""The contact system with its couples, constraint solve and mode selection by the compiled
+kernels against the same system in Python (`ContactOptions(compiled=False)`): the same
+trajectory, impacts and modes, to 1e-12, on a disk dropped spinning onto an incline (impacts) and on a stool sliding
 and spinning on its three feet (three couples in contact, no impact)."""
 import math
 
@@ -15,6 +15,7 @@ from drake_dock.studies.small_scenes import disk_on_incline, stool
 def _run(make, compiled, X, V, times):
     sc = make(ContactOptions(zeno_speed=1e-2, compiled=compiled))
     assert (sc.system.evaluator.kernel is not None) == compiled
+    assert (sc.system.evaluator.solver is not None) == compiled
     sim = Simulator(sc.system)
     ctx = sim.get_mutable_context()
     sc.set_state(ctx, X, V)

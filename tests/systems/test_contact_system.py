@@ -45,11 +45,12 @@ def energy(system, ctx):
 THETA, V0 = math.radians(20.0), 1.0
 
 
-@pytest.fixture(scope="module")
-def disk_run():
+@pytest.fixture(scope="module", params=["plane", "annulus"])
+def disk_run(request):
     """Disk launched down the incline without spin (mu = mu_s = 0.3): it slides, friction spins
-    it up, the slip stops at t* and it rolls."""
-    sc = disk_on_incline(THETA, mu=0.3)
+    it up, the slip stops at t* and it rolls. On a plane patch, and on a ring face (`Annulus`,
+    the face patch of `contact.pairs: complete`) whose polar parameters turn under the path."""
+    sc = disk_on_incline(THETA, mu=0.3, face=request.param)
     r = sc.params["radius"]
     sim, root, ctx = start(sc.system, lambda c: sc.set_state(
         c, (np.eye(3), np.array([0, 0, r])), (np.zeros(3), np.array([V0, 0, 0]))))
@@ -69,6 +70,12 @@ def disk_run():
                 a_roll=a_roll, samples=samples)
 
 
+def tangential_force(c):
+    """The friction force on the disk in the world: lambda_t on the couple's tangents ta, tb
+    (the columns of its frame)."""
+    return c["frame"].reshape(3, 3)[:, :2] @ c["lambda_t"]
+
+
 def test_disk_slides_then_rolls_closed_form(disk_run):
     d = disk_run
     m, mu, t_star = d["m"], d["mu"], d["t_star"]
@@ -79,15 +86,15 @@ def test_disk_slides_then_rolls_closed_form(disk_run):
         np.testing.assert_allclose(c["lambda_n"], lam_n, rtol=1e-8)
         if t < t_star:
             assert c["status"] == Mode.SLIDING
-            np.testing.assert_allclose(c["lambda_t"], [-mu * lam_n, 0.0], rtol=1e-8,
-                                       atol=1e-8 * lam_n)
+            np.testing.assert_allclose(tangential_force(c), [-mu * lam_n, 0.0, 0.0],
+                                       rtol=1e-8, atol=1e-8 * lam_n)
             np.testing.assert_allclose(vdot[3], d["a_slide"], rtol=1e-8)
             np.testing.assert_allclose(vdot[1], d["alpha"], rtol=1e-8)
             np.testing.assert_allclose(s["x"][10], V0 + d["a_slide"] * t, rtol=1e-8)
         else:
             assert c["status"] == Mode.STICKING     # rolling
             f_roll = m * G * math.sin(THETA) - m * d["a_roll"]
-            np.testing.assert_allclose(c["lambda_t"], [-f_roll, 0.0], rtol=1e-8,
+            np.testing.assert_allclose(tangential_force(c), [-f_roll, 0.0, 0.0], rtol=1e-8,
                                        atol=1e-8 * lam_n)
             assert abs(c["lambda_t"][0]) < mu * lam_n
             np.testing.assert_allclose(vdot[3], d["a_roll"], rtol=1e-8)

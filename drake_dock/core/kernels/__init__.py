@@ -1,13 +1,14 @@
 """Compiled kernels (numba, `@njit(cache=True)`) of the per-evaluation contact mathematics over
 plain arrays: the patches' jets by kind code and parameters (`jets`), and every tracked couple
 of a contact system in one call (`couples`: Eq. 47, the projection, the contact frame, gap,
-normal velocity and the Eq. 52 bias terms), and the seek of Sect. 5.1 (`seek`). `compile_cache` chooses the directory the compiled
-code is cached in; importing this package applies it before numba is imported.
+normal velocity and the Eq. 52 bias terms), the seek of Sect. 5.1 (`seek`), and the constraint
+solve and mode selection of Eq. 48-52 (`constraints`). `compile_cache` chooses the directory
+the compiled code is cached in; importing this package applies it before numba is imported.
 
 The pure-Python modules (`drake_dock.core.patches`, `drake_dock.core.couple`,
-`drake_dock.core.seeking`) stay the reference the kernels are tested against
-(tests/core/test_kernels.py, tests/core/test_kernels_seek.py) and the path for patches that no
-kernel describes."""
+`drake_dock.core.seeking`, `drake_dock.core.constraints`) stay the reference the kernels are
+tested against (tests/core/test_kernels.py, tests/core/test_kernels_seek.py,
+tests/core/test_kernels_constraints.py) and the path for patches that no kernel describes."""
 from drake_dock.core.kernels import compile_cache
 
 compile_cache.configure()

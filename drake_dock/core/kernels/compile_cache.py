@@ -79,7 +79,8 @@ def cache_dir() -> pathlib.Path:
 
 def warm() -> None:
     """Compiles (or loads from the cache) every kernel by evaluating the kernels once."""
-    from drake_dock.core.kernels import cover, seek, tracked
+    from drake_dock.core.kernels import constraints, cover, seek, tracked
     tracked.warm()
+    constraints.warm()
     seek.warm()
     cover.warm()

@@ -114,6 +114,41 @@ def touched_steps(mc, mr, mbc, mbr, mblocks, mn, mflat, fc, fr, fbc, fbr, fblock
     return out
 
 
+@njit(cache=True)
+def _sphere_gap(c1, r1, c2, r2):
+    d0, d1, d2 = c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]
+    return math.sqrt(d0 * d0 + d1 * d1 + d2 * d2) - r1 - r2
+
+
+@njit(cache=True)
+def least_gap(ac, ar, abc, abr, ablocks, bc, br, bbc, bbr, bblocks):
+    """`covers.cover_gap` of the covers a (cells ac, ar; blocks abc, abr, ablocks) and b: the
+    block pairs in increasing order of their spheres' gap, each one's cells only while that gap
+    is below the least cell gap found (a block's sphere holds its cells' spheres)."""
+    m, k = abc.shape[0], bbc.shape[0]
+    lower = np.empty(m * k)
+    for I in range(m):
+        for J in range(k):
+            lower[I * k + J] = _sphere_gap(abc[I], abr[I], bbc[J], bbr[J])
+    best = np.inf
+    for IJ in np.argsort(lower):
+        if lower[IJ] >= best:
+            break
+        I, J = IJ // k, IJ % k
+        for a in ablocks[I]:
+            for b in bblocks[J]:
+                g = _sphere_gap(ac[a], ar[a], bc[b], br[b])
+                if g < best:
+                    best = g
+    return best
+
+
+def cover_gap(a, b) -> float:
+    """`drake_dock.core.covers.cover_gap` compiled (`least_gap`)."""
+    return float(least_gap(a.centres, a.radii, a.block_centres, a.block_radii, a.blocks,
+                           b.centres, b.radii, b.block_centres, b.block_radii, b.blocks))
+
+
 def patch_cover(patch, n: int, block: int):
     """`drake_dock.core.covers.patch_cover` from the compiled jets, or None for a patch no
     kernel describes; kept on the patch."""
@@ -145,3 +180,4 @@ def warm():
     plane = patch_cover(PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)), 4, 2)
     circle = patch_cover(Circle(0.3, 0.1), 4, 2)
     touch_steps(circle, plane, np.array([0.0, 0.0, -1.0]), np.array([0.3, 0.2, 0.1, 0.0]))
+    cover_gap(circle, plane)

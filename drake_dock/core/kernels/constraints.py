@@ -1,0 +1,407 @@
+"""The constraint solve and mode selection of `drake_dock.core.constraints` (Eq. 48-52, Coulomb
+friction, the Baumgarte-stabilised normal rows) compiled, over plain arrays:
+
+- `solve_given_modes` (the contact forces and accelerations for given modes) and
+  `select_modes` (the enumeration of the modes, the start of sliding, the consistency tests and
+  the preferences), with the signatures and results of the pure-Python reference, which the
+  tests compare them with (tests/core/test_kernels_constraints.py);
+- `solve_packed`, the solve on rows already packed as arrays (`pack_rows`), for the derivative
+  evaluation.
+
+A couple's row is packed as W (nv, 3), the columns W^3, W^1, W^2 of Eq. (11) (n, ta, tb), and
+its velocity-product terms (bn, bt) as one 3-vector. The modes are codes `STICK`, `SLIDE`,
+`DETACH`. The kernels return a status instead of raising; the wrappers raise the reference's
+typed errors. The solve uses the reference's operations in its order and array layouts (BLAS
+products, LAPACK's LU solve), so that its results equal the reference's to round-off.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, types
+from numba.extending import intrinsic
+
+from drake_dock.core import constraints as ref
+from drake_dock.errors import NumericalError, PainleveError, SingularContactError
+
+STICK, SLIDE, DETACH = 0, 1, 2
+CODE = {ref.STICK: STICK, ref.SLIDE: SLIDE, ref.DETACH: DETACH}
+NAME = (ref.STICK, ref.SLIDE, ref.DETACH)
+OK, SINGULAR, NONFINITE, NONE_CONSISTENT, INDETERMINATE = 0, 1, 2, 3, 4
+SLIDE_START_ITER = ref.SLIDE_START_ITER
+
+
+@intrinsic
+def _fma(typingctx, a, b, c):
+    """a b + c rounded once (LLVM's fma)."""
+    def codegen(context, builder, signature, args):
+        return builder.fma(*args)
+    return types.float64(types.float64, types.float64, types.float64), codegen
+
+
+@njit(cache=True)
+def stabilised(x, vn, gap, omega):
+    """x + 2 omega g' + omega^2 g: the Baumgarte-stabilised normal row (Eq. 52), x = g'' or its
+    velocity-product term bn."""
+    return x + 2 * omega * vn + omega ** 2 * gap
+
+
+@njit(cache=True)
+def _solve(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, vdot, lam_n, lam_t, gf):
+    """`constraints.solve_given_modes` into vdot (nv,), lam_n (k,), lam_t (k, 2) and the
+    generalized force gf (nv,); returns (status, cond(A)): SINGULAR when the constraint matrix
+    is singular and the equations inconsistent, NONFINITE when they hold an inf or a nan."""
+    k, nv = W.shape[0], W.shape[1]
+    m = 0
+    for i in range(k):
+        m += 3 if modes[i] == STICK else (1 if modes[i] == SLIDE else 0)
+    lam_n[:] = 0.0
+    lam_t[:] = 0.0
+    if m == 0:
+        vdot[:] = a0
+        gf[:] = 0.0
+        return OK, 0.0
+    Ct = np.empty((m, nv))         # C^T and D^T, C-ordered: C = Ct.T as the reference's
+    Dt = np.empty((m, nv))
+    rhs = np.empty(m)
+    j = 0
+    for i in range(k):
+        if modes[i] == STICK:
+            for c in range(3):
+                for a in range(nv):
+                    Ct[j + c, a] = W[i, a, c]
+                    Dt[j + c, a] = W[i, a, c]
+            rhs[j] = stabilised(bias[i, 0], vn[i], gap[i], omega)
+            rhs[j + 1] = bias[i, 1]
+            rhs[j + 2] = bias[i, 2]
+            j += 3
+        elif modes[i] == SLIDE:
+            s0, s1 = dirs[i, 0], dirs[i, 1]
+            for a in range(nv):
+                # Wt s as numpy's product of the (nv, 2) by the 2-vector rounds it
+                Ct[j, a] = W[i, a, 0] - mu[i] * _fma(W[i, a, 1], s0, W[i, a, 2] * s1)
+                Dt[j, a] = W[i, a, 0]
+            rhs[j] = stabilised(bias[i, 0], vn[i], gap[i], omega)
+            j += 1
+    C = Ct.T
+    MinvC = np.dot(Minv, C)
+    A = np.dot(Dt, MinvC)
+    b = -(rhs + np.dot(Dt, a0))
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
+        return NONFINITE, np.nan        # LAPACK is not called on them
+    # The reference's singularity test: the Hadamard ratio |det A| / prod of its row norms.
+    prod, positive = 1.0, True
+    for r in range(m):
+        s = 0.0
+        for c in range(m):
+            s += A[r, c] * A[r, c]
+        rn = math.sqrt(s)
+        positive = positive and rn > 0
+        prod *= rn
+    ratio = abs(np.linalg.det(A)) / prod if positive and prod > 0 else 0.0
+    cond = 0.0
+    if np.isfinite(ratio) and ratio > 1e-12:
+        lam = np.linalg.solve(A, b)
+    else:
+        cond = np.linalg.cond(A)
+        lam = np.linalg.lstsq(A, b, rcond=1e-10)[0]
+        if np.linalg.norm(np.dot(A, lam) - b) > 1e-8 * (1.0 + np.linalg.norm(b)):
+            return SINGULAR, cond
+    vdot[:] = a0 + np.dot(MinvC, lam)
+    gf[:] = np.dot(C, lam)
+    j = 0
+    for i in range(k):
+        if modes[i] == STICK:
+            lam_n[i], lam_t[i, 0], lam_t[i, 1] = lam[j], lam[j + 1], lam[j + 2]
+            j += 3
+        elif modes[i] == SLIDE:
+            lam_n[i] = lam[j]
+            f = -mu[i] * lam[j]
+            lam_t[i, 0], lam_t[i, 1] = f * dirs[i, 0], f * dirs[i, 1]
+            j += 1
+    return OK, cond
+
+
+@njit(cache=True)
+def _accelerations(W, bias, vdot, gdd, at):
+    """g'' (k,) and the tangential relative accelerations at (k, 2) at vdot."""
+    for i in range(W.shape[0]):
+        for c in range(3):
+            s = 0.0
+            for a in range(W.shape[1]):
+                s += W[i, a, c] * vdot[a]
+            if c == 0:
+                gdd[i] = s + bias[i, 0]
+            else:
+                at[i, c - 1] = s + bias[i, c]
+
+
+@njit(cache=True)
+def _consistent(modes, lam_n, lam_t, gdd, vn, gap, mu_s, omega, tol_f, tol_a):
+    """`constraints._consistent`: complementarity on the stabilised normal row and the static
+    cone (Eq. 50-52), within tol_f (N) and tol_a (m/s^2)."""
+    for i in range(modes.shape[0]):
+        if modes[i] == DETACH:
+            if stabilised(gdd[i], vn[i], gap[i], omega) < -tol_a:
+                return False
+        else:
+            if lam_n[i] < -tol_f:
+                return False
+            if (modes[i] == STICK
+                    and math.hypot(lam_t[i, 0], lam_t[i, 1]) > mu_s[i] * lam_n[i] + tol_f):
+                return False
+    return True
+
+
+@njit(cache=True)
+def _slide_start(Minv, a0, W, bias, gap, vn, mu, modes, dirs, starting, omega, vdot, lam_n,
+                 lam_t, gf, gdd, at):
+    """`constraints._slide_start`: the sliding directions (in dirs) of the couples starting to
+    slide, s = a_t/|a_t|, the solution in the outputs; returns (status, directions found)."""
+    for _ in range(SLIDE_START_ITER):
+        st, _c = _solve(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, vdot, lam_n,
+                        lam_t, gf)
+        if st != OK:
+            return st, False
+        _accelerations(W, bias, vdot, gdd, at)
+        change = 0.0
+        for i in starting:
+            na = math.hypot(at[i, 0], at[i, 1])
+            if na == 0.0:
+                return OK, False
+            n0, n1 = at[i, 0] / na, at[i, 1] / na
+            change = max(change, max(abs(n0 - dirs[i, 0]), abs(n1 - dirs[i, 1])))
+            dirs[i, 0], dirs[i, 1] = n0, n1
+        if change < 1e-13:
+            break
+    st, _c = _solve(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, vdot, lam_n, lam_t, gf)
+    if st != OK:
+        return st, False
+    _accelerations(W, bias, vdot, gdd, at)
+    for i in starting:
+        if not at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0:
+            return OK, False
+    return OK, True
+
+
+@njit(cache=True)
+def _select(Minv, a0, W, bias, gap, vn, vt, mu, mu_s, avoid, v_slip, omega, rtol, tie_rtol):
+    """`constraints.select_modes` without its errors: returns (status, modes (n, k), dirs
+    (n, k, 2), vdot (n, nv), lam_n (n, k), lam_t (n, k, 2), gf (n, nv), best, other), with
+    row ``best`` the choice, and for INDETERMINATE row ``other`` the second consistent
+    choice."""
+    k, nv = W.shape[0], W.shape[1]
+    nopt = np.empty(k, np.int64)
+    moving = np.zeros((k, 2))
+    has_dir = np.zeros(k, np.bool_)
+    n = 1
+    for i in range(k):
+        speed = math.hypot(vt[i, 0], vt[i, 1])
+        if speed > v_slip:
+            nopt[i] = 2
+            has_dir[i] = True
+            moving[i, 0], moving[i, 1] = vt[i, 0] / speed, vt[i, 1] / speed
+        else:
+            nopt[i] = 3
+        n *= nopt[i]
+    # Force and acceleration scales (the free motion: every couple detached).
+    gdd, at = np.empty(k), np.empty((k, 2))
+    _accelerations(W, bias, a0, gdd, at)
+    free_at = at.copy()
+    a_scale = 1.0 + np.abs(gdd).max() + np.abs(free_at).max()
+    M_ = np.empty((n, k), np.int64)
+    D_ = np.zeros((n, k, 2))
+    V_ = np.empty((n, nv))
+    LN = np.empty((n, k))
+    LT = np.empty((n, k, 2))
+    GF = np.empty((n, nv))
+    key = np.empty(n, np.int64)
+    level = np.empty(n, np.int64)       # 0 consistent at rtol, 1 within tie_rtol, 2 neither
+    modes = np.empty(k, np.int64)
+    gmodes = np.empty(k, np.int64)
+    for c in range(n):
+        # The c-th choice in itertools.product order (the last couple varies fastest).
+        r = c
+        for i in range(k - 1, -1, -1):
+            o = r % nopt[i]
+            r //= nopt[i]
+            modes[i] = (SLIDE, DETACH)[o] if has_dir[i] else o
+        M_[c] = modes
+        level[c] = 2
+        dirs = D_[c]
+        nstart = 0
+        for i in range(k):
+            if modes[i] == SLIDE:
+                if has_dir[i]:
+                    dirs[i] = moving[i]
+                else:
+                    nstart += 1
+        starting = np.empty(nstart, np.int64)
+        j = 0
+        for i in range(k):
+            if modes[i] == SLIDE and not has_dir[i]:
+                starting[j] = i
+                j += 1
+        vdot, lam_n, lam_t, gf = V_[c], LN[c], LT[c], GF[c]
+        if nstart:
+            # Start from the direction opposite to the sticking force (or the free
+            # tangential acceleration).
+            for i in range(k):
+                gmodes[i] = STICK if modes[i] == SLIDE and not has_dir[i] else modes[i]
+            st, _c = _solve(Minv, a0, W, bias, gap, vn, mu, gmodes, dirs, omega, vdot, lam_n,
+                            lam_t, gf)
+            if st != OK:
+                continue
+            for i in starting:
+                g0, g1 = -lam_t[i, 0], -lam_t[i, 1]
+                if math.hypot(g0, g1) == 0.0:
+                    g0, g1 = free_at[i, 0], free_at[i, 1]
+                ng = math.hypot(g0, g1)
+                if ng > 0:
+                    dirs[i, 0], dirs[i, 1] = g0 / ng, g1 / ng
+                else:
+                    dirs[i, 0], dirs[i, 1] = 1.0, 0.0
+            st, ok = _slide_start(Minv, a0, W, bias, gap, vn, mu, modes, dirs, starting, omega,
+                                  vdot, lam_n, lam_t, gf, gdd, at)
+            if st != OK or not ok:
+                continue
+        else:
+            st, _c = _solve(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, vdot, lam_n,
+                            lam_t, gf)
+            if st != OK:
+                continue
+            _accelerations(W, bias, vdot, gdd, at)
+        f_scale = 1.0 + np.abs(lam_n).max()
+        if _consistent(modes, lam_n, lam_t, gdd, vn, gap, mu_s, omega, rtol * f_scale,
+                       rtol * a_scale):
+            level[c] = 0
+        elif _consistent(modes, lam_n, lam_t, gdd, vn, gap, mu_s, omega,
+                         tie_rtol * f_scale, tie_rtol * a_scale):
+            level[c] = 1
+        # Preference: fewer modes being left, more sticking couples, more in contact.
+        left, sticks, detached = 0, 0, 0
+        for i in range(k):
+            left += avoid[i, modes[i]]
+            sticks += modes[i] == STICK
+            detached += modes[i] == DETACH
+        key[c] = (left * (k + 1) + (k - sticks)) * (k + 1) + detached
+    lvl = 0 if (level == 0).any() else 1
+    idx = np.flatnonzero(level == lvl)
+    if idx.shape[0] == 0:
+        return NONE_CONSISTENT, M_, D_, V_, LN, LT, GF, -1, -1
+    idx = idx[np.argsort(key[idx], kind="mergesort")]
+    best = idx[0]
+    v_scale = 1.0 + np.abs(V_[best]).max()
+    for o in idx[1:]:
+        if np.abs(V_[o] - V_[best]).max() <= 1e-6 * v_scale:
+            continue
+        for i in range(k):
+            if (M_[best, i] == DETACH) != (M_[o, i] == DETACH):
+                return INDETERMINATE, M_, D_, V_, LN, LT, GF, best, o
+    return OK, M_, D_, V_, LN, LT, GF, best, -1
+
+
+def pack_rows(rows):
+    """The `ContactRow` list as arrays: W (k, nv, 3), bias (k, 3), gap, vn (k,), vt (k, 2),
+    mu, mu_s (k,)."""
+    k = len(rows)
+    nv = len(rows[0].Wn) if k else 0
+    W, bias = np.empty((k, nv, 3)), np.empty((k, 3))
+    for i, r in enumerate(rows):
+        W[i, :, 0], W[i, :, 1:] = r.Wn, r.Wt
+        bias[i, 0], bias[i, 1:] = r.bn, r.bt
+    return (W, bias, np.array([r.gap for r in rows], dtype=float).reshape(k),
+            np.array([r.vn for r in rows], dtype=float).reshape(k),
+            np.array([r.vt for r in rows], dtype=float).reshape(k, 2),
+            np.array([r.mu for r in rows], dtype=float).reshape(k),
+            np.array([r.mu_s for r in rows], dtype=float).reshape(k))
+
+
+def _dirs_array(modes, dirs):
+    out = np.zeros((len(modes), 2))
+    for i, (m, s) in enumerate(zip(modes, dirs)):
+        if m == ref.SLIDE:
+            out[i] = s
+    return out
+
+
+def solve_packed(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, *, time=None,
+                 names=()):
+    """(vdot, lam_n (k,), lam_t (k, 2), generalized force) for the packed rows and the mode
+    codes ``modes`` (int array), ``dirs`` (k, 2) the sliding directions; `SingularContactError`
+    (naming ``names``) as the reference."""
+    k, nv = W.shape[0], len(a0)
+    vdot, lam_n, lam_t, gf = np.empty(nv), np.empty(k), np.empty((k, 2)), np.empty(nv)
+    st, cond = _solve(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, vdot, lam_n, lam_t,
+                      gf)
+    if st == NONFINITE:
+        raise NumericalError(f"contact constraint equations not finite for modes "
+                             f"{tuple(NAME[m] for m in modes)}", time=time,
+                             couples=[c for c, m in zip(names, modes) if m != DETACH])
+    if st != OK:
+        raise SingularContactError(
+            f"contact constraint equations singular and inconsistent (cond = {cond:.3e}) for "
+            f"modes {tuple(NAME[m] for m in modes)}", time=time,
+            couples=[c for c, m in zip(names, modes) if m != DETACH])
+    return vdot, lam_n, lam_t, gf
+
+
+def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None):
+    """`constraints.solve_given_modes` compiled: the same arguments and `ContactSolution`."""
+    W, bias, gap, vn, vt, mu, mu_s = pack_rows(rows)
+    codes = np.array([CODE[m] for m in modes], dtype=np.int64)
+    vdot, lam_n, lam_t, gf = solve_packed(np.ascontiguousarray(Minv, dtype=float),
+                                          np.asarray(a0, dtype=float), W, bias, gap, vn, mu,
+                                          codes, _dirs_array(modes, dirs), omega, time=time,
+                                          names=[r.name for r in rows])
+    return ref.ContactSolution(tuple(modes), list(dirs), vdot, lam_n, lam_t, gf, list(rows))
+
+
+def select_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9, avoid=None):
+    """`constraints.select_modes` compiled: the same arguments, choice and errors."""
+    k = len(rows)
+    names = [r.name for r in rows]
+    if k == 0:
+        return solve_given_modes(Minv, a0, rows, (), [], omega=omega, time=time)
+    if k > ref.MAX_ENUMERATED:
+        raise NumericalError(f"{k} couples in contact at once; mode enumeration is limited to "
+                             f"{ref.MAX_ENUMERATED}", time=time, couples=names)
+    W, bias, gap, vn, vt, mu, mu_s = pack_rows(rows)
+    av = np.zeros((k, 3), dtype=np.int64)
+    for i, a in enumerate(avoid or [()] * k):
+        for m in a:
+            av[i, CODE[m]] = 1
+    st, M_, D_, V_, LN, LT, GF, best, other = _select(
+        np.ascontiguousarray(Minv, dtype=float), np.asarray(a0, dtype=float), W, bias, gap, vn,
+        vt, mu, mu_s, av, float(v_slip), float(omega), float(rtol), ref.TIE_RTOL)
+    if st == NONE_CONSISTENT:
+        raise PainleveError("no consistent contact mode (Painleve inconsistency: the rigid "
+                            "model with this friction has no solution)", time=time,
+                            couples=names)
+    modes = tuple(NAME[m] for m in M_[best])
+    if st == INDETERMINATE:
+        raise PainleveError(
+            f"several consistent contact modes with different accelerations "
+            f"({modes} and {tuple(NAME[m] for m in M_[other])}): Painleve indeterminacy",
+            time=time, couples=names)
+    dirs = [D_[best, i].copy() if m == ref.SLIDE else None for i, m in enumerate(modes)]
+    return ref.ContactSolution(modes, dirs, V_[best].copy(), LN[best].copy(), LT[best].copy(),
+                               GF[best].copy(), list(rows))
+
+
+def warm():
+    """Compiles (or loads) the kernels by one selection and one solve of a small scene."""
+    nv = 6
+    W = np.zeros((2, nv, 3))
+    for i in range(2):
+        for c in range(3):
+            W[i, c, c] = 1.0
+            W[i, 3 + c, c] = 0.5 * (i + 1)
+    bias = np.zeros((2, 3))
+    z, vt = np.zeros(2), np.array([[0.0, 0.0], [0.1, 0.0]])
+    one = np.ones(2)
+    _select(np.eye(nv), -np.ones(nv), W, bias, z, z, vt, 0.1 * one, 0.1 * one,
+            np.zeros((2, 3), np.int64), 1e-6, 20.0, 1e-9, ref.TIE_RTOL)
+    solve_packed(np.eye(nv), -np.ones(nv), W, bias, z, z, 0.1 * one,
+                 np.array([STICK, SLIDE], np.int64), np.array([[0.0, 0.0], [1.0, 0.0]]), 20.0)

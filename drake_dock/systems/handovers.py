@@ -1,0 +1,64 @@
+"""The declared hand-overs between edge pairs and surface pairs (`Handover`), by pair index: the
+guard of an edge pair and the pair a couple is handed to, with the rules of
+`drake_dock.core.handover`."""
+from __future__ import annotations
+
+import numpy as np
+
+from drake_dock.core import handover as rule
+from drake_dock.core.hybrid import Mode
+
+
+class HandoverLinks:
+    """``of_edge[i]``: [(surface pair j, `SurfaceEdge`)] of edge pair i; ``of_surface[j]``:
+    [(edge pair i, `SurfaceEdge`)] of surface pair j."""
+
+    def __init__(self, pairs, handovers):
+        index = {p.name: k for k, p in enumerate(pairs)}
+        self.pairs = pairs
+        self.of_edge, self.of_surface = {}, {}
+        for h in handovers:
+            for name in (h.edge_pair, h.surface_pair):
+                if name not in index:
+                    raise ValueError(f"handovers: no pair named {name!r}")
+            i, j = index[h.edge_pair], index[h.surface_pair]
+            e, s = pairs[i], pairs[j]
+            if (e.kind, s.kind) != ("CC", "CS") or e.patch1 is not s.patch1 \
+                    or e.frame1 is not s.frame1 or e.frame2 is not s.frame2:
+                raise ValueError(f"handovers[{h.edge_pair}, {h.surface_pair}]: must be a C-C "
+                                 f"and a C-S pair with the same curve on the same frames")
+            self.of_edge.setdefault(i, []).append((j, h.edge))
+            self.of_surface.setdefault(j, []).append((i, h.edge))
+
+    def _guards(self, i, n, u, R2):
+        """(surface pair j, edge, guard value) for edge pair i's couple u with normal n (world),
+        Body 2 turned by R2 (`drake_dock.core.handover.edge_guard`)."""
+        for j, edge in self.of_edge.get(i, ()):
+            S = self.pairs[j].patch2
+            _, T, _ = S.jet(rule.surface_params(edge, S.lower, S.upper, float(u[-1])))
+            yield j, edge, rule.edge_guard(edge, n, [R2 @ np.asarray(t) for t in T])
+
+    def guard(self, i, n, u, R2) -> float:
+        """Edge pair i's guard: the least over its surfaces (+inf if it has none)."""
+        return min((w for _, _, w in self._guards(i, n, u, R2)), default=np.inf)
+
+    def due(self, i, u, n, R2):
+        """(pair j, j's couple) for each hand-over of pair i's couple u whose guard is met: a
+        surface pair's couple on or past a declared edge; an edge pair's guard not positive for
+        its normal n (world; None: not checked), Body 2 turned by R2."""
+        S = self.pairs[i].patch2
+        for j, edge in self.of_surface.get(i, ()):
+            if rule.reaches_edge(edge, S.lower, S.upper, u[1:]):
+                yield j, np.array(rule.to_edge(edge, 1, u))
+        if n is None:
+            return
+        for j, edge, w in self._guards(i, n, u, R2):
+            if w <= 0.0:
+                S = self.pairs[j].patch2
+                yield j, np.array(rule.to_surface(edge, 1, u, S.lower, S.upper))
+
+    def target(self, i, u, n, R2, states):
+        """Where pair i's couple is handed (`due`): (pair j, j's couple) for the first pair j
+        that is not in contact; else None."""
+        return next(((j, uj) for j, uj in self.due(i, u, n, R2)
+                     if not states[j].mode.in_contact), None)
