@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from drake_dock.docking.scene import rot_vec
+from drake_dock.docking.rotations import rot_vec
 
 PETAL_FEATURES = ("ring inside circle", "guide side", "petal")     # name prefixes
 RING_FEATURES = ("ring",)

@@ -16,6 +16,7 @@ from drake_dock.core.patches import Patch, posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.docking.apds import (PAIR_SETS, ApdsGeometry, apds_patches, petal_edges,
                                       side_phi)
+from drake_dock.docking.rotations import rot_vec, rot_x, rot_z  # noqa: F401 (re-exported)
 from drake_dock.errors import InputError, NumericalError
 
 TARGET_APDS = "target_apds"
@@ -113,16 +114,6 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
     return out
 
 
-def rot_z(a):
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def rot_x(a):
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
-
-
 # Matched facing (docs/model.md): the chaser's APDS frame is the target's turned by pi about a
 # transverse axis and by 240 deg about the docking axis, so that the pairs of Sect. 2.2 face.
 R_MATCHED = rot_z(math.radians(240.0)) @ rot_x(math.pi)
@@ -132,17 +123,6 @@ def relative_pose(yaw_rad: float, d: float):
     """Pose (R, p) of the chaser APDS in the target APDS frame: coaxial, ring faces d apart,
     the target (with its APDS) turned by yaw about the axis from the matched facing."""
     return rot_z(-yaw_rad) @ R_MATCHED, np.array([0.0, 0.0, d])
-
-
-def rot_vec(r):
-    """Rotation matrix of the rotation vector r (Rodrigues)."""
-    r = np.asarray(r, dtype=float)
-    a = float(np.linalg.norm(r))
-    if a == 0.0:
-        return np.eye(3)
-    k = r / a
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + math.sin(a) * K + (1.0 - math.cos(a)) * (K @ K)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -426,11 +406,12 @@ def contact_approach(scenario):
 
     s = 0.0
     if slope.any():
-        s = _consistent_height(mismatch, 2.0 * g.H + 0.05)
+        s = _consistent_height(mismatch, 2.0 * g.H + 0.05, float(np.linalg.norm(slope)))
         if s is None:
             raise NoPairCloses(
                 f"no straight approach at initial.lateral_velocity {ic.lateral_velocity} m/s "
-                f"has its first contact (contact.pairs: {which}) at initial.lateral_offset "
+                f"has its first contact (contact.pairs: {which}) within "
+                f"{PLACEMENT_OFFSET_TOL * 1e3:g} mm of initial.lateral_offset "
                 f"{ic.lateral_offset} m: the first contact jumps past that offset")
     a = approach(s)
     lam_c, closing = first_contact_or_faces(g, a, which)
@@ -442,18 +423,32 @@ def contact_approach(scenario):
 # |s - h_c(aim(s))| below this is a root of the placement's fixed point, not a jump (m): a
 # jump in the first contact moves it by 0.1 mm or more.
 PLACEMENT_TOL = 1e-6
+# At a jump, the ring centre at first contact may miss initial.lateral_offset by this (m).
+PLACEMENT_OFFSET_TOL = 1e-3
 
 
-def _consistent_height(mismatch, s_max, cells=46):
-    """The ring-face distance s in [0, s_max] with mismatch(s) = h_c(aim(s)) - s = 0: brentq on
-    the whole range first; h_c jumps where the first contact changes pairs or features, so a
-    bracket may close on a jump instead of a root. Then every sign change on a grid of ``cells``
-    intervals is tried, and the largest root is taken (the highest consistent first contact);
-    None when there is none."""
-    try:
-        s = brentq(mismatch, 0.0, s_max, xtol=1e-10)
-        if abs(mismatch(s)) <= PLACEMENT_TOL:
+def _consistent_height(mismatch, s_max, slope, cells=46):
+    """The ring-face distance s in [0, s_max] with mismatch(s) = h_c(aim(s)) - s = 0, for a
+    lateral slope |v_lateral| / chaser_speed. brentq on the whole range first. The first contact
+    h_c jumps where it passes from one pair or feature to another, so a bracket may close on a
+    jump instead of a root: there the ring centre at first contact misses the offset by
+    |mismatch| slope, accepted up to `PLACEMENT_OFFSET_TOL`. Otherwise every sign change on a
+    grid of ``cells`` intervals is tried: the largest root, else the largest acceptable jump
+    (the highest first contact); None when there is neither."""
+    jumps = []
+
+    def bracket(lo, hi):
+        s = brentq(mismatch, lo, hi, xtol=1e-10)
+        r = abs(mismatch(s))
+        if r <= PLACEMENT_TOL:
             return s
+        jumps.append((s, r))
+        return None
+
+    try:
+        s = bracket(0.0, s_max)
+        if s is not None or jumps[-1][1] * slope <= PLACEMENT_OFFSET_TOL:
+            return s if s is not None else jumps[-1][0]
     except ValueError:                                  # no sign change over the range
         pass
     grid = np.linspace(0.0, s_max, cells + 1)
@@ -462,10 +457,11 @@ def _consistent_height(mismatch, s_max, cells=46):
         if f[k] == 0.0:
             return float(grid[k])
         if f[k] * f[k + 1] < 0:
-            s = brentq(mismatch, grid[k], grid[k + 1], xtol=1e-10)
-            if abs(mismatch(s)) <= PLACEMENT_TOL:
+            s = bracket(grid[k], grid[k + 1])
+            if s is not None:
                 return s
-    return None
+    ok = [s for s, r in jumps if r * slope <= PLACEMENT_OFFSET_TOL]
+    return max(ok) if ok else None
 
 
 # Deeper than this, a feature crossing the other APDS on a free approach is a contact (m).

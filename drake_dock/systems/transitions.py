@@ -50,7 +50,7 @@ class Transitions:
                 continue
             if initial or (st.mode == Mode.FAR
                            and ev.far.bound(i, poses, st) >= early * st.clearance):
-                if not self.screen(i, poses, st):
+                if not self.screen(i, poses, modes.pairs):
                     self.seek(i, poses, modes.pairs, u, t, False, initial)
                 continue
             if st.mode == Mode.FAR:
@@ -88,13 +88,13 @@ class Transitions:
                                      impact_loss_plus=modes.impact_loss)
         return x_new, modes
 
-    def screen(self, i, poses, st) -> bool:
-        """The broad phase (``options.broad_phase``) for far pair i (its `PairState` st): when
+    def screen(self, i, poses, states) -> bool:
+        """The broad phase (``options.broad_phase``) for far pair i (`PairState` states[i]): when
         the least gap G of its covers (a lower bound of its distance) is at least
         ``track_distance``, a seek could only leave it far, so it is not sought; it keeps G as
         its distance, with the far pair's clearance of `hybrid.after_seek`. Returns whether
         the pair was screened so."""
-        opt = self.options
+        st, opt = states[i], self.options
         if not opt.broad_phase:
             return False
         with self.timing.measure("seeking"):

@@ -21,16 +21,16 @@ SCENES = {"paper example": "contact: {pairs: complete}",
 def _narrow_phase(checks):
     screen = Transitions.screen
 
-    def checked(self, i, poses, st):
+    def checked(self, i, poses, states):
         gap = self.ev.far.cover_gap(i, poses)
         if not gap >= self.options.track_distance:
-            return screen(self, i, poses, st)
-        sought = copy.deepcopy(st)
+            return screen(self, i, poses, states)
+        sought = copy.deepcopy(states)
         self._seek(i, poses, sought, np.zeros(self.ev.nu), 0.0, False, False)
-        checks.append((gap, sought.distance))
-        if sought.mode != Mode.FAR:
+        checks.append((gap, sought[i].distance))
+        if sought[i].mode != Mode.FAR:
             return False                   # the narrow phase tracks it: seek for real
-        return screen(self, i, poses, st)
+        return screen(self, i, poses, states)
 
     return checked
 
