@@ -164,6 +164,13 @@ def handle_events(prob, dense, brackets, events, impulse_scale):
     return t_first, y
 
 
+def budget_error(max_steps, events):
+    """The NumericalError of an impact that did not end within ``max_steps`` steps."""
+    return NumericalError(f"LZB impact did not end within {max_steps} steps "
+                          f"(events so far: {len(events)})",
+                          couples=sorted({ev.couple for ev in events[-10:]}))
+
+
 def _step(solver, steps, max_steps, events):
     """One accepted DOP853 step; the number of steps so far."""
     msg = solver.step()
@@ -171,45 +178,52 @@ def _step(solver, steps, max_steps, events):
         raise NumericalError(f"LZB integration failed: {msg}")
     steps += 1
     if steps > max_steps:
-        raise NumericalError(f"LZB impact did not end within {max_steps} steps "
-                             f"(events so far: {len(events)})",
-                             couples=sorted({ev.couple for ev in events[-10:]}))
+        raise budget_error(max_steps, events)
     return steps
+
+
+def segment(prob, t, y, h, steps, history, events, *, rtol, max_steps, impulse_scale):
+    """One DOP853 integration from (t, y), first step h (None: chosen by scipy), until the
+    first event (applied; the restart point) or the end of the impact. Appends the normal
+    impulses after each accepted step to ``history``; returns (t, y, h, steps)."""
+    m_s, v_s = impulse_scale
+    P = prob.layout.P
+    solver = DOP853(prob.rhs, t, y, np.inf, rtol=rtol, atol=rtol * 1e-2, first_step=h)
+    prob.classify(y)
+    g_old = prob.event_values(y)
+    while True:
+        steps = _step(solver, steps, max_steps, events)
+        g_new = prob.event_values(solver.y)
+        h = solver.step_size
+        dense = solver.dense_output()
+        brackets = active_events(prob, dense, solver.t_old, solver.t, g_old, g_new)
+        if brackets:
+            t, y = handle_events(prob, dense, brackets, events, impulse_scale)
+            history.append(y[P][:prob.s] * m_s * v_s)
+            return t, y, h, steps
+        y, t = solver.y, solver.t
+        # A couple that separated unloaded waits for its approach (same rhs).
+        g_old = prob.event_values(y) if prob.classify(y) else g_new
+        history.append(y[P][:prob.s] * m_s * v_s)
+        if prob.finished(y):
+            return t, y, h, steps
 
 
 def integrate(prob, y, events, *, rtol, max_steps, impulse_scale):
     """The driver: scipy's DOP853 from event to event until the impact ends
     (`ImpactProblem.finished`); restarted at each event. Returns (y, steps, the normal
     impulses after each accepted step)."""
-    m_s, v_s = impulse_scale
-    P = prob.layout.P
     steps, history = 0, []
     t, h = 0.0, None
     while not prob.finished(y):
-        solver = DOP853(prob.rhs, t, y, np.inf, rtol=rtol, atol=rtol * 1e-2, first_step=h)
-        prob.classify(y)
-        g_old = prob.event_values(y)
-        while True:
-            steps = _step(solver, steps, max_steps, events)
-            g_new = prob.event_values(solver.y)
-            h = solver.step_size
-            dense = solver.dense_output()
-            brackets = active_events(prob, dense, solver.t_old, solver.t, g_old, g_new)
-            if brackets:
-                t, y = handle_events(prob, dense, brackets, events, impulse_scale)
-                history.append(y[P][:prob.s] * m_s * v_s)
-                break
-            y, t = solver.y, solver.t
-            # A couple that separated unloaded waits for its approach (same rhs).
-            g_old = prob.event_values(y) if prob.classify(y) else g_new
-            history.append(y[P][:prob.s] * m_s * v_s)
-            if prob.finished(y):
-                break
+        t, y, h, steps = segment(prob, t, y, h, steps, history, events, rtol=rtol,
+                                 max_steps=max_steps, impulse_scale=impulse_scale)
     return y, steps, history
 
 
 def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, mu_s=None,
-              law="paper", initial_energy=None, rtol=1e-10, max_steps=200_000) -> ImpactResult:
+              law="paper", initial_energy=None, rtol=1e-10, max_steps=200_000,
+              compiled=False) -> ImpactResult:
     """Solves a (multiple) impact by the LZB method at a fixed configuration.
 
     Parameters
@@ -226,6 +240,9 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     law : "paper" (Eq. 54), "mono" or "bi"; see the module docstring.
     initial_energy : stored energy E_j(t^-) per couple (default zero).
     rtol : relative accuracy of the impulse-domain integration.
+    compiled : integrate by the compiled kernel (`drake_dock.core.lzb.compiled`: Dormand-Prince
+        5(4) in numba, one call per impact where no couple sticks or is locked) instead of
+        scipy's DOP853; the same events and results to the integration's accuracy.
 
     Returns an `ImpactResult`. Raises ValueError naming the argument for degenerate input (M not
     SPD, wrong shapes, non-finite values, a couple already separating) and NumericalError when
@@ -283,8 +300,14 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     y = prob.y0.copy()
     if friction:
         select_modes(prob, y, [j for j in range(s) if x0[j] > 0 or un0[j] < 0], events, 0.0)
-    y, steps, history = integrate(prob, y, events, rtol=rtol, max_steps=max_steps,
-                                  impulse_scale=(m_s, v_s))
+    if compiled:
+        # Imported here: it imports numba, and this module.
+        from drake_dock.core.lzb.compiled import integrate_compiled
+        run = integrate_compiled
+    else:
+        run = integrate
+    y, steps, history = run(prob, y, events, rtol=rtol, max_steps=max_steps,
+                            impulse_scale=(m_s, v_s))
     L = prob.layout
     P = y[L.P] * m_s * v_s
     if not friction:
