@@ -9,7 +9,8 @@ The integrator is the Dormand-Prince 5(4) pair (Dormand and Prince, J. Comput. A
 local extrapolation (the 5th-order solution is kept), error in the root-mean-square norm
 scaled by atol + rtol max(|y|, |y_new|), step factor 0.9 err^(-1/5) within [0.2, 10].
 
-The kernel applies the events of the states with no sticking and no locked couple (maximal
+The phases (right-hand side, events, laws) are in `drake_dock.core.kernels.lzb_phases`. The
+kernel applies the events of the states with no sticking and no locked couple (maximal
 compression with e > 0, end of expansion, separation, re-compression, a frictionless
 re-impact, a slip reversal). An event that needs a stick-slip decision (`select_modes`) or a
 lock (e = 0) is handed back, undone, as status `PYEVENT` with the step's dense output: the
@@ -27,20 +28,15 @@ import math
 import numpy as np
 from numba import njit
 
+from drake_dock.core.kernels.lzb_phases import (APPROACH, COMPRESSION, EXPANSION, FRICTION,
+                                                NORMAL, apply_event,
+                                                classify, event_value, event_values, finished,
+                                                rhs)
+
 # Statuses.
 DONE, PYEVENT, BUDGET, STEP_FAILED, NONFINITE = 0, 1, 2, 3, 4
-# Phases (`drake_dock.core.lzb.state`) and event rows (`drake_dock.core.lzb.problem`).
-COMPRESSION, EXPANSION, LOCKED = 0, 1, 2
-NORMAL, FRICTION, APPROACH = 0, 1, 2
-# Event kinds logged by the kernel, as codes into KINDS.
-KINDS = ("max_compression", "recompression", "end", "re_impact")
-MAXC, RECOMP, END, REIMPACT = 0, 1, 2, 3
-# Restitution laws, as codes into LAW_NAMES.
-LAW_NAMES = ("paper", "mono", "bi")
-
-_CLEAR = 1e-14        # `drake_dock.core.lzb.solve._CLEAR`
+_CLEAR = 1e-14        # `drake_dock.core.lzb.driver._CLEAR`
 _N_INSIDE = 31        # samples inside a step: k / 32, k = 1..31 (`solve._INSIDE`)
-_V_TINY = 1e-12       # `ImpactProblem.v_tiny`
 
 # Dormand-Prince 5(4): nodes, coupling coefficients, 5th-order weights (= the last row),
 # error weights (5th minus 4th order) and the dense-output coefficients d.
@@ -57,182 +53,6 @@ E1, E3, E4, E5, E6, E7 = (71.0 / 57600.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253
 D1, D3, D4, D5, D6, D7 = (-12715105075.0 / 11282082432.0, 87487479700.0 / 32700410799.0,
                           -10690763975.0 / 1880347072.0, 701980252875.0 / 199316789632.0,
                           -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0)
-
-
-# The problem -------------------------------------------------------------------------------
-@njit(cache=True)
-def stored_energy(kappa, eta, x):
-    """Eq. (28) integrated (`laws.stored_energy`)."""
-    return kappa * max(x, 0.0) ** (eta + 1.0) / (eta + 1.0)
-
-
-@njit(cache=True)
-def indentation(kappa, eta, E):
-    """The inverse of `stored_energy` (`laws.indentation`)."""
-    return ((eta + 1.0) * max(E, 0.0) / kappa) ** (1.0 / (eta + 1.0))
-
-
-@njit(cache=True)
-def rhs(y, out, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam):
-    """dy/dtau into ``out`` (`ImpactProblem.rhs` with `forces.sliding_rates`: no couple stuck
-    or locked): lambda_n = kappa max(x, 0)^eta (Eq. 28), lambda_t = -mu lambda_n d along the
-    slip direction d (Eq. 27), du = G lambda, dP = lambda, the works of Eq. (30-31)."""
-    for j in range(s):
-        lam[j] = kappa[j] * max(y[j], 0.0) ** eta[j]
-    ox, ou, oP = 0, s, s + nu
-    ow = s + 2 * nu
-    for j in range(s):
-        un = y[ou + j]
-        dx = -rate[j] * un
-        if phase[j] == COMPRESSION and y[j] <= 0.0 and dx < 0.0:
-            dx = 0.0     # an unloaded couple indents only while it approaches
-        out[ox + j] = dx
-        power = lam[j] * un
-        cf = 0.0 if phase[j] == EXPANSION else 1.0
-        out[ow + j] = -power * cf
-        out[ow + s + j] = power * (cf - 1.0)
-        out[ow + 2 * s + j] = 0.0
-    if friction:
-        for j in range(s):
-            a, b = y[ou + s + 2 * j], y[ou + s + 2 * j + 1]
-            nt = math.sqrt(a * a + b * b)
-            if nt > _V_TINY:
-                d0, d1 = a / nt, b / nt
-            else:
-                d0, d1 = slip_dir[j, 0], slip_dir[j, 1]
-            ml = mu[j] * lam[j]
-            lam[s + 2 * j] = -ml * d0
-            lam[s + 2 * j + 1] = -ml * d1
-            out[ow + 2 * s + j] = ml * (d0 * a + d1 * b)
-    for i in range(nu):
-        acc = 0.0
-        for k in range(nu):
-            acc += G[i, k] * lam[k]
-        out[ou + i] = acc
-        out[oP + i] = lam[i]
-
-
-@njit(cache=True)
-def event_value(y, kind, j, s, friction, phase, sep, x_end, slip_dir):
-    """Row ``kind`` of couple j of `ImpactProblem.event_values` (no couple stuck or locked)."""
-    x, un = y[j], y[s + j]
-    if kind == NORMAL:
-        if phase[j] == COMPRESSION and not sep[j]:
-            return -un
-        if phase[j] == EXPANSION:
-            return x - x_end[j]
-        return np.inf
-    if kind == APPROACH:
-        if phase[j] == EXPANSION or sep[j]:
-            return un
-        return np.inf
-    if friction and x > 0.0:
-        o = 2 * s + 2 * j
-        return y[o] * slip_dir[j, 0] + y[o + 1] * slip_dir[j, 1]
-    return np.inf
-
-
-@njit(cache=True)
-def event_values(y, g, s, friction, phase, sep, x_end, slip_dir):
-    for kind in range(3):
-        for j in range(s):
-            g[kind, j] = event_value(y, kind, j, s, friction, phase, sep, x_end, slip_dir)
-
-
-@njit(cache=True)
-def classify(y, s, phase, sep):
-    """`ImpactProblem.classify`."""
-    changed = False
-    for j in range(s):
-        if phase[j] == COMPRESSION and not sep[j] and y[j] <= 0.0 and y[s + j] > 1e-12:
-            sep[j] = True
-            changed = True
-    return changed
-
-
-@njit(cache=True)
-def finished(y, s, kappa, eta, phase, settle):
-    """`ImpactProblem.finished` (no couple locked)."""
-    done = True
-    for j in range(s):
-        if y[j] > 0.0 or phase[j] == EXPANSION or y[s + j] < -1e-12:
-            done = False
-    if done:
-        return True
-    for j in range(s):
-        if y[s + j] < -settle:
-            return False
-    stored = 0.0
-    for j in range(s):
-        stored += stored_energy(kappa[j], eta[j], y[j])
-    return stored <= 0.5 * settle * settle
-
-
-# Events ------------------------------------------------------------------------------------
-@njit(cache=True)
-def _log(ev_imp, ev_kind, ev_couple, n, impulse, kind, j):
-    if n >= len(ev_kind):
-        m = 2 * len(ev_kind)
-        a, b, c = np.empty(m), np.empty(m, np.int64), np.empty(m, np.int64)
-        a[:n], b[:n], c[:n] = ev_imp[:n], ev_kind[:n], ev_couple[:n]
-        ev_imp, ev_kind, ev_couple = a, b, c
-    ev_imp[n], ev_kind[n], ev_couple[n] = impulse, kind, j
-    return ev_imp, ev_kind, ev_couple, n + 1
-
-
-@njit(cache=True)
-def apply_event(y, kind, j, impulse, s, nu, friction, kappa, eta, e, law, phase, sep, rate,
-                x_end, slip_dir, wc, e_start, wc_open, log):
-    """`ImpactProblem.apply_event` for the events the kernel takes; False (nothing changed)
-    for one that needs Python: a stick-slip decision or a lock."""
-    ev_imp, ev_kind, ev_couple, n = log
-    if kind == FRICTION:
-        o = 2 * s + 2 * j
-        nt = math.sqrt(y[o] ** 2 + y[o + 1] ** 2)
-        scale = 0.0
-        for i in range(s, s + nu):
-            scale = max(scale, abs(y[i]))
-        if nt <= 1e-9 * scale:
-            return False, log           # came to rest: `select_modes`
-        slip_dir[j, 0], slip_dir[j, 1] = y[o] / nt, y[o + 1] / nt
-        return True, log
-    if kind == APPROACH:
-        if phase[j] == EXPANSION:
-            phase[j], rate[j] = COMPRESSION, 1.0
-            e_start[j] = stored_energy(kappa[j], eta[j], y[j])
-            return True, _log(ev_imp, ev_kind, ev_couple, n, impulse, RECOMP, j)
-        if friction:
-            return False, log           # a re-impact decides stick or slip
-        sep[j] = False
-        y[j] = 0.0
-        return True, _log(ev_imp, ev_kind, ev_couple, n, impulse, REIMPACT, j)
-    if phase[j] == COMPRESSION and y[j] > 0.0:
-        if e[j] == 0.0:
-            return False, log           # a lock
-        E = stored_energy(kappa[j], eta[j], y[j])
-        work = E - e_start[j]
-        wc[j] += work
-        wc_open[j] += work
-        log = _log(ev_imp, ev_kind, ev_couple, n, impulse, MAXC, j)
-        r, xe = 1.0, 0.0
-        if law == 0:        # paper, Eq. (54)
-            y[j] = indentation(kappa[j], eta[j], E - (1.0 - e[j] * e[j]) * work)
-        elif law == 1:      # mono
-            xe = indentation(kappa[j], eta[j], (1.0 - e[j] * e[j]) * wc_open[j])
-        else:               # bi
-            r = 1.0 / (e[j] * e[j])
-        phase[j], rate[j], x_end[j] = EXPANSION, r, xe
-        return True, log
-    if phase[j] == COMPRESSION:
-        sep[j] = True
-        return True, log
-    if phase[j] == LOCKED:
-        return False, log
-    y[j] = 0.0
-    phase[j], rate[j], x_end[j] = COMPRESSION, 1.0, 0.0
-    e_start[j] = 0.0
-    wc_open[j] = 0.0
-    return True, _log(ev_imp, ev_kind, ev_couple, n, impulse, END, j)
 
 
 # Dense output and root finding ---------------------------------------------------------------
@@ -591,3 +411,15 @@ def _grown(hist, nh):
     out = np.empty((2 * len(hist), hist.shape[1]))
     out[:nh] = hist[:nh]
     return out
+
+
+def warm():
+    """Compiles (or loads) the kernel: two balls meeting at unit speed, with friction."""
+    s, nu = 1, 3
+    G = np.array([[2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]])
+    y = np.zeros(4 * s + 2 * nu)
+    y[s], y[s + 1] = -1.0, 0.5
+    one = np.ones(s)
+    lzb_impact(y, 0.0, 0.0, 0, 10_000, 1e-8, 1e-10, 1e-8, s, nu, G, one, 1.5 * one, 0.5 * one,
+               0.3 * one, True, 0, np.zeros(s, np.int64), np.zeros(s, np.bool_), one.copy(),
+               np.zeros(s), np.zeros((s, 2)), np.zeros(s), np.zeros(s), np.zeros(s), 1.0)

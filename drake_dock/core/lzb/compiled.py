@@ -1,10 +1,10 @@
 """The driver of the compiled LZB impact (`drake_dock.core.kernels.lzb`): `solve_lzb` with
-``compiled=True`` integrates by it instead of `drake_dock.core.lzb.solve.integrate`.
+``compiled=True`` integrates by it instead of `drake_dock.core.lzb.driver.integrate`.
 
 The kernel integrates the states where no couple sticks or is locked, events included, in one
 call. An event it hands back (a stick-slip decision, a lock) is applied here by the
 reference's `handle_events` on the kernel's dense output, and the states with sticking or
-locked couples are integrated by the reference's `segment` (scipy's DOP853) up to their next
+locked couples are integrated by the reference's `segment` (`drake_dock.core.lzb.driver`) (scipy's DOP853) up to their next
 event; then the kernel takes over again. The kernel's statuses become the reference's typed
 errors."""
 from __future__ import annotations
@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from drake_dock.core.kernels import lzb as kernel
-from drake_dock.core.lzb.solve import active_events, budget_error, handle_events, segment
+from drake_dock.core.kernels.lzb_phases import KINDS, LAW_NAMES
+from drake_dock.core.lzb.driver import active_events, budget_error, handle_events, segment
 from drake_dock.core.lzb.state import COMPRESSION, EXPANSION, LOCKED, ImpactEvent
 from drake_dock.errors import NumericalError
 
@@ -39,12 +40,12 @@ def _sync(prob):
 
 
 def integrate_compiled(prob, y, events, *, rtol, max_steps, impulse_scale):
-    """`drake_dock.core.lzb.solve.integrate` by the compiled kernel: the same events and
+    """`drake_dock.core.lzb.driver.integrate` by the compiled kernel: the same events and
     outputs, (y, steps, the normal impulses after each accepted step)."""
     m_s, v_s = impulse_scale
     s, nu = prob.s, prob.layout.nu
     G = np.ascontiguousarray(prob.G)
-    law = kernel.LAW_NAMES.index(prob.law)
+    law = LAW_NAMES.index(prob.law)
     steps, history = 0, []
     t, h = 0.0, None
     while not prob.finished(y):
@@ -60,7 +61,7 @@ def integrate_compiled(prob, y, events, *, rtol, max_steps, impulse_scale):
                               prob.wc_open, m_s * v_s)
         _sync(prob)
         ev_imp, ev_kind, ev_couple, n = log
-        events.extend(ImpactEvent(float(ev_imp[i]), kernel.KINDS[ev_kind[i]], int(ev_couple[i]))
+        events.extend(ImpactEvent(float(ev_imp[i]), KINDS[ev_kind[i]], int(ev_couple[i]))
                       for i in range(n))
         history.extend(hist[:nh])
         if status == kernel.BUDGET:
@@ -77,11 +78,3 @@ def integrate_compiled(prob, y, events, *, rtol, max_steps, impulse_scale):
             history.append(y[prob.layout.P][:s] * m_s * v_s)
     return y, steps, history
 
-
-def warm():
-    """Compiles (or loads) the kernel: a frictionless and a frictional impact of two balls."""
-    from drake_dock.core.lzb.solve import solve_lzb
-    M, Wn = np.eye(2), np.array([[-1.0], [1.0]])
-    solve_lzb(M, Wn, [1.0, 0.0], 1e7, 1.5, 0.5, compiled=True)
-    solve_lzb(M, Wn, [1.0, 0.0], 1e7, 1.5, 0.5, Wt=np.array([[0.0, 0.0], [1.0, 0.0]]), mu=0.3,
-              compiled=True)
