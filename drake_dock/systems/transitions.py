@@ -275,7 +275,8 @@ class Transitions:
         e = hybrid.zeno_restitution(approach, law.restitution, opt.zeno_speed)
         try:
             res = solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt, mu=law.mu,
-                            mu_s=ev.mu_s, law=law.impact_law, rtol=opt.impact_rtol)
+                            mu_s=ev.mu_s, law=law.impact_law, rtol=opt.impact_rtol,
+                            compiled=opt.lzb_compiled)
         except NumericalError as err:
             if os.environ.get("DRAKE_DOCK_DUMP_LZB"):
                 np.savez(os.environ["DRAKE_DOCK_DUMP_LZB"], M=M, Wn=Wn, Wt=Wt, v=v, e=e)

@@ -79,8 +79,9 @@ def cache_dir() -> pathlib.Path:
 
 def warm() -> None:
     """Compiles (or loads from the cache) every kernel by evaluating the kernels once."""
-    from drake_dock.core.kernels import constraints, cover, seek, tracked
+    from drake_dock.core.kernels import constraints, cover, lzb, seek, tracked
     tracked.warm()
+    lzb.warm()
     constraints.warm()
     seek.warm()
     cover.warm()

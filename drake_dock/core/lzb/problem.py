@@ -25,6 +25,7 @@ class ImpactProblem:
     def __init__(self, G, u0, kappa, eta, e, mu, mu_s, law, x0, friction, settle=1e-10):
         self.s = s = len(kappa)
         self.kappa, self.eta, self.e, self.mu, self.mu_s = kappa, eta, e, mu, mu_s
+        self.law = law
         self.unloading = laws.UNLOADING[law]
         self.friction = friction
         self.settle = settle

@@ -1,0 +1,196 @@
+"""The phases of a compiled LZB impact (`drake_dock.core.kernels.lzb`) over plain arrays: the
+right-hand side, the event functions, the end test and the events the kernel applies, as
+`drake_dock.core.lzb.problem.ImpactProblem` has them for states with no couple stuck or
+locked; the restitution laws of `drake_dock.core.lzb.laws` by code."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# Phases (`drake_dock.core.lzb.state`) and event rows (`drake_dock.core.lzb.problem`).
+COMPRESSION, EXPANSION, LOCKED = 0, 1, 2
+NORMAL, FRICTION, APPROACH = 0, 1, 2
+# Event kinds logged by the kernel, as codes into KINDS.
+KINDS = ("max_compression", "recompression", "end", "re_impact")
+MAXC, RECOMP, END, REIMPACT = 0, 1, 2, 3
+# Restitution laws, as codes into LAW_NAMES.
+LAW_NAMES = ("paper", "mono", "bi")
+_V_TINY = 1e-12       # `ImpactProblem.v_tiny`
+
+
+# The problem -------------------------------------------------------------------------------
+@njit(cache=True)
+def stored_energy(kappa, eta, x):
+    """Eq. (28) integrated (`laws.stored_energy`)."""
+    return kappa * max(x, 0.0) ** (eta + 1.0) / (eta + 1.0)
+
+
+@njit(cache=True)
+def indentation(kappa, eta, E):
+    """The inverse of `stored_energy` (`laws.indentation`)."""
+    return ((eta + 1.0) * max(E, 0.0) / kappa) ** (1.0 / (eta + 1.0))
+
+
+@njit(cache=True)
+def rhs(y, out, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam):
+    """dy/dtau into ``out`` (`ImpactProblem.rhs` with `forces.sliding_rates`: no couple stuck
+    or locked): lambda_n = kappa max(x, 0)^eta (Eq. 28), lambda_t = -mu lambda_n d along the
+    slip direction d (Eq. 27), du = G lambda, dP = lambda, the works of Eq. (30-31)."""
+    for j in range(s):
+        lam[j] = kappa[j] * max(y[j], 0.0) ** eta[j]
+    ox, ou, oP = 0, s, s + nu
+    ow = s + 2 * nu
+    for j in range(s):
+        un = y[ou + j]
+        dx = -rate[j] * un
+        if phase[j] == COMPRESSION and y[j] <= 0.0 and dx < 0.0:
+            dx = 0.0     # an unloaded couple indents only while it approaches
+        out[ox + j] = dx
+        power = lam[j] * un
+        cf = 0.0 if phase[j] == EXPANSION else 1.0
+        out[ow + j] = -power * cf
+        out[ow + s + j] = power * (cf - 1.0)
+        out[ow + 2 * s + j] = 0.0
+    if friction:
+        for j in range(s):
+            a, b = y[ou + s + 2 * j], y[ou + s + 2 * j + 1]
+            nt = math.sqrt(a * a + b * b)
+            if nt > _V_TINY:
+                d0, d1 = a / nt, b / nt
+            else:
+                d0, d1 = slip_dir[j, 0], slip_dir[j, 1]
+            ml = mu[j] * lam[j]
+            lam[s + 2 * j] = -ml * d0
+            lam[s + 2 * j + 1] = -ml * d1
+            out[ow + 2 * s + j] = ml * (d0 * a + d1 * b)
+    for i in range(nu):
+        acc = 0.0
+        for k in range(nu):
+            acc += G[i, k] * lam[k]
+        out[ou + i] = acc
+        out[oP + i] = lam[i]
+
+
+@njit(cache=True)
+def event_value(y, kind, j, s, friction, phase, sep, x_end, slip_dir):
+    """Row ``kind`` of couple j of `ImpactProblem.event_values` (no couple stuck or locked)."""
+    x, un = y[j], y[s + j]
+    if kind == NORMAL:
+        if phase[j] == COMPRESSION and not sep[j]:
+            return -un
+        if phase[j] == EXPANSION:
+            return x - x_end[j]
+        return np.inf
+    if kind == APPROACH:
+        if phase[j] == EXPANSION or sep[j]:
+            return un
+        return np.inf
+    if friction and x > 0.0:
+        o = 2 * s + 2 * j
+        return y[o] * slip_dir[j, 0] + y[o + 1] * slip_dir[j, 1]
+    return np.inf
+
+
+@njit(cache=True)
+def event_values(y, g, s, friction, phase, sep, x_end, slip_dir):
+    for kind in range(3):
+        for j in range(s):
+            g[kind, j] = event_value(y, kind, j, s, friction, phase, sep, x_end, slip_dir)
+
+
+@njit(cache=True)
+def classify(y, s, phase, sep):
+    """`ImpactProblem.classify`."""
+    changed = False
+    for j in range(s):
+        if phase[j] == COMPRESSION and not sep[j] and y[j] <= 0.0 and y[s + j] > 1e-12:
+            sep[j] = True
+            changed = True
+    return changed
+
+
+@njit(cache=True)
+def finished(y, s, kappa, eta, phase, settle):
+    """`ImpactProblem.finished` (no couple locked)."""
+    done = True
+    for j in range(s):
+        if y[j] > 0.0 or phase[j] == EXPANSION or y[s + j] < -1e-12:
+            done = False
+    if done:
+        return True
+    for j in range(s):
+        if y[s + j] < -settle:
+            return False
+    stored = 0.0
+    for j in range(s):
+        stored += stored_energy(kappa[j], eta[j], y[j])
+    return stored <= 0.5 * settle * settle
+
+
+# Events ------------------------------------------------------------------------------------
+@njit(cache=True)
+def _log(ev_imp, ev_kind, ev_couple, n, impulse, kind, j):
+    if n >= len(ev_kind):
+        m = 2 * len(ev_kind)
+        a, b, c = np.empty(m), np.empty(m, np.int64), np.empty(m, np.int64)
+        a[:n], b[:n], c[:n] = ev_imp[:n], ev_kind[:n], ev_couple[:n]
+        ev_imp, ev_kind, ev_couple = a, b, c
+    ev_imp[n], ev_kind[n], ev_couple[n] = impulse, kind, j
+    return ev_imp, ev_kind, ev_couple, n + 1
+
+
+@njit(cache=True)
+def apply_event(y, kind, j, impulse, s, nu, friction, kappa, eta, e, law, phase, sep, rate,
+                x_end, slip_dir, wc, e_start, wc_open, log):
+    """`ImpactProblem.apply_event` for the events the kernel takes; False (nothing changed)
+    for one that needs Python: a stick-slip decision or a lock."""
+    ev_imp, ev_kind, ev_couple, n = log
+    if kind == FRICTION:
+        o = 2 * s + 2 * j
+        nt = math.sqrt(y[o] ** 2 + y[o + 1] ** 2)
+        scale = 0.0
+        for i in range(s, s + nu):
+            scale = max(scale, abs(y[i]))
+        if nt <= 1e-9 * scale:
+            return False, log           # came to rest: `select_modes`
+        slip_dir[j, 0], slip_dir[j, 1] = y[o] / nt, y[o + 1] / nt
+        return True, log
+    if kind == APPROACH:
+        if phase[j] == EXPANSION:
+            phase[j], rate[j] = COMPRESSION, 1.0
+            e_start[j] = stored_energy(kappa[j], eta[j], y[j])
+            return True, _log(ev_imp, ev_kind, ev_couple, n, impulse, RECOMP, j)
+        if friction:
+            return False, log           # a re-impact decides stick or slip
+        sep[j] = False
+        y[j] = 0.0
+        return True, _log(ev_imp, ev_kind, ev_couple, n, impulse, REIMPACT, j)
+    if phase[j] == COMPRESSION and y[j] > 0.0:
+        if e[j] == 0.0:
+            return False, log           # a lock
+        E = stored_energy(kappa[j], eta[j], y[j])
+        work = E - e_start[j]
+        wc[j] += work
+        wc_open[j] += work
+        log = _log(ev_imp, ev_kind, ev_couple, n, impulse, MAXC, j)
+        r, xe = 1.0, 0.0
+        if law == 0:        # paper, Eq. (54)
+            y[j] = indentation(kappa[j], eta[j], E - (1.0 - e[j] * e[j]) * work)
+        elif law == 1:      # mono
+            xe = indentation(kappa[j], eta[j], (1.0 - e[j] * e[j]) * wc_open[j])
+        else:               # bi
+            r = 1.0 / (e[j] * e[j])
+        phase[j], rate[j], x_end[j] = EXPANSION, r, xe
+        return True, log
+    if phase[j] == COMPRESSION:
+        sep[j] = True
+        return True, log
+    if phase[j] == LOCKED:
+        return False, log
+    y[j] = 0.0
+    phase[j], rate[j], x_end[j] = COMPRESSION, 1.0, 0.0
+    e_start[j] = 0.0
+    wc_open[j] = 0.0
+    return True, _log(ev_imp, ev_kind, ev_couple, n, impulse, END, j)
