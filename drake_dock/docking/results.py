@@ -190,6 +190,7 @@ def summary(result, ts: dict) -> dict:
             "angular": _relative(np.linalg.norm(L - L[0], axis=1).max(), sL)},
         "energy_ledger": energy_ledger(ts),
         "first_contact_ring_distance_m": result.initial.d_contact,
+        "first_contact_lateral_offset_m": list(result.initial.contact_offset),
         "initial_ring_distance_m": result.initial.d0,
         "first_closing_couples": list(result.initial.closing_pairs),
         "samples": int(len(ts["t"])),

@@ -334,6 +334,7 @@ class InitialState:
     d_contact: float           # ring-face distance at first contact
     d0: float                  # initial ring-face distance
     closing_pairs: list
+    contact_offset: tuple = (0.0, 0.0)   # the ring centre's lateral offset at first contact
 
 
 def initial_state(scenario) -> InitialState:
@@ -376,7 +377,9 @@ def initial_state(scenario) -> InitialState:
     return InitialState(
         X_WB={"target": (R_WT, p_WT), "target_apds": (R_WA, p_WA), "chaser": (R_WC, p_WC)},
         V_WB={"target": (zero, zero), "target_apds": (zero, zero), "chaser": (w_WC, v_WC)},
-        d_contact=d_c, d0=d0, closing_pairs=closing)
+        d_contact=d_c, d0=d0, closing_pairs=closing,
+        contact_offset=tuple((np.array(approach.aim) - approach.height(d_c) * np.array(
+            ic.lateral_velocity) / ic.chaser_speed).tolist()))
 
 
 def contact_approach(scenario):
@@ -406,13 +409,12 @@ def contact_approach(scenario):
 
     s = 0.0
     if slope.any():
-        s = _consistent_height(mismatch, 2.0 * g.H + 0.05, float(np.linalg.norm(slope)))
+        s = _consistent_height(mismatch, 2.0 * g.H + 0.05)
         if s is None:
             raise NoPairCloses(
                 f"no straight approach at initial.lateral_velocity {ic.lateral_velocity} m/s "
-                f"has its first contact (contact.pairs: {which}) within "
-                f"{PLACEMENT_OFFSET_TOL * 1e3:g} mm of initial.lateral_offset "
-                f"{ic.lateral_offset} m: the first contact jumps past that offset")
+                f"has its first contact (contact.pairs: {which}) at or before "
+                f"initial.lateral_offset {ic.lateral_offset} m")
     a = approach(s)
     lam_c, closing = first_contact_or_faces(g, a, which)
     if not closing:
@@ -420,35 +422,16 @@ def contact_approach(scenario):
     return a, lam_c, closing
 
 
-# |s - h_c(aim(s))| below this is a root of the placement's fixed point, not a jump (m): a
-# jump in the first contact moves it by 0.1 mm or more.
-PLACEMENT_TOL = 1e-6
-# At a jump, the ring centre at first contact may miss initial.lateral_offset by this (m).
-PLACEMENT_OFFSET_TOL = 1e-3
-
-
-def _consistent_height(mismatch, s_max, slope, cells=46):
-    """The ring-face distance s in [0, s_max] with mismatch(s) = h_c(aim(s)) - s = 0, for a
-    lateral slope |v_lateral| / chaser_speed. brentq on the whole range first. The first contact
-    h_c jumps where it passes from one pair or feature to another, so a bracket may close on a
-    jump instead of a root: there the ring centre at first contact misses the offset by
-    |mismatch| slope, accepted up to `PLACEMENT_OFFSET_TOL`. Otherwise every sign change on a
-    grid of ``cells`` intervals is tried: the largest root, else the largest acceptable jump
-    (the highest first contact); None when there is neither."""
-    jumps = []
-
-    def bracket(lo, hi):
-        s = brentq(mismatch, lo, hi, xtol=1e-10)
-        r = abs(mismatch(s))
-        if r <= PLACEMENT_TOL:
-            return s
-        jumps.append((s, r))
-        return None
-
+def _consistent_height(mismatch, s_max, cells=46):
+    """The ring-face distance s in [0, s_max] with mismatch(s) = h_c(aim(s)) - s = 0, by brentq
+    over the whole range; where that range has no sign change, on the largest sign change of a
+    grid of ``cells`` intervals. The first contact h_c jumps where it passes from one pair or
+    feature to another, so the bracket may close on a jump instead of a root: the path at the
+    jump is taken, and the ring centre at first contact then misses the offset by
+    |mismatch(s)| |v_lateral| / chaser_speed (`InitialState.contact_offset`). None where no
+    grid interval changes sign."""
     try:
-        s = bracket(0.0, s_max)
-        if s is not None or jumps[-1][1] * slope <= PLACEMENT_OFFSET_TOL:
-            return s if s is not None else jumps[-1][0]
+        return brentq(mismatch, 0.0, s_max, xtol=1e-10)
     except ValueError:                                  # no sign change over the range
         pass
     grid = np.linspace(0.0, s_max, cells + 1)
@@ -457,11 +440,8 @@ def _consistent_height(mismatch, s_max, slope, cells=46):
         if f[k] == 0.0:
             return float(grid[k])
         if f[k] * f[k + 1] < 0:
-            s = bracket(grid[k], grid[k + 1])
-            if s is not None:
-                return s
-    ok = [s for s, r in jumps if r * slope <= PLACEMENT_OFFSET_TOL]
-    return max(ok) if ok else None
+            return brentq(mismatch, grid[k], grid[k + 1], xtol=1e-10)
+    return None
 
 
 # Deeper than this, a feature crossing the other APDS on a free approach is a contact (m).
