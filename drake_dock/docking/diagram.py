@@ -99,7 +99,12 @@ class CaptureMonitor(LeafSystem):
         return {"capture": self.to_go(context) - self.capture_distance}
 
 
-def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagram:
+def build_docking_diagram(scenario, meshcat=None, options=None,
+                          handovers=False) -> DockingDiagram:
+    """The Diagram of the scenario. ``handovers`` declares the edge/surface hand-overs of the
+    `complete` pairs (`pair_handovers`; docs/model.md, "Hand-over between an edge and a
+    surface"): off by default, because in the paper's geometry the ring's inside circle passes
+    exactly through the petal tips and the tracked couples there are handed back and forth."""
     builder = DiagramBuilder()
     scene_graph = builder.AddSystem(SceneGraph())
     dp = make_docking_plant(scenario, scene_graph)
@@ -118,7 +123,8 @@ def build_docking_diagram(scenario, meshcat=None, options=None) -> DockingDiagra
         wrench_bodies=("chaser",),
         extra_powers=[("stewart_damper_work", StewartDamperPower(dp))],
         energy_scale=0.5 * scenario.bodies.chaser.mass * scenario.initial.chaser_speed ** 2
-        or 1.0, handovers=[Handover(*h) for h in pair_handovers(scenario.geometry, specs)]))
+        or 1.0, handovers=[Handover(*h) for h in pair_handovers(scenario.geometry, specs)]
+        if handovers else []))
     contact.set_name("rigid_contact")
     to_pose = builder.AddSystem(MultibodyPositionToGeometryPose(dp.plant,
                                                                 input_multibody_state=True))
