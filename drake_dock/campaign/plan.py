@@ -139,16 +139,17 @@ def _raw(data: str, filename: str) -> dict:
     if "axes" in raw and not (isinstance(raw["axes"], list)
                               and all(isinstance(a, str) for a in raw["axes"])):
         raise InputError("axes", raw["axes"], "a list of two varied fields' dotted paths")
-    if not isinstance(raw.get("set", {}), dict) or not all(
-            isinstance(k, str) for k in raw.get("set", {})):
-        raise InputError("set", raw["set"], "a map from a scenario field's dotted path to a value")
+    overrides = raw.get("set") or {}
+    if not isinstance(overrides, dict) or not all(isinstance(k, str) for k in overrides):
+        raise InputError("set", overrides, "a map from a scenario field's dotted path to a value")
     raw["vary"] = _normalized_vary(raw.get("vary"))
     return raw
 
 
 def _base_scenario(scenario_file: Path, overrides: dict) -> Scenario:
     """The base scenario file with the plan's ``set`` values written into its fields, loaded
-    and validated as one scenario (a bad path or value is named as ``set.<path>``)."""
+    and validated as one scenario (a path through a value is named as ``set.<path>``; a path
+    or value the scenario refuses as ``set``, with the scenario's own message)."""
     if not overrides:
         return load_scenario(scenario_file)
     try:
@@ -158,7 +159,9 @@ def _base_scenario(scenario_file: Path, overrides: dict) -> Scenario:
     for path, value in overrides.items():
         node, parts = tree, path.split(".")
         for part in parts[:-1]:
-            node = node.setdefault(part, {})
+            if node.get(part) is None:                  # absent, or an empty section
+                node[part] = {}
+            node = node[part]
             if not isinstance(node, dict):
                 raise InputError(f"set.{path}", value, "the dotted path of a scenario field")
         node[parts[-1]] = value

@@ -69,34 +69,30 @@ class CaptureMonitor(LeafSystem):
                                      lambda c, o: o.SetFromVector([self.distance(c)]))
         self._witness = self.MakeWitnessFunction(
             "capture", WitnessFunctionDirection.kPositiveThenNonPositive,
-            lambda c: self.to_go(c) - self.capture_distance,
+            lambda c: self.to_go(c) - self.rule.axial,
             PublishEvent(lambda c, e: EventStatus.ReachedTermination(self, "capture")))
 
-    def _set(self, context):
+    def misalignment(self, context) -> tuple[float, float, float]:
+        """Axial and lateral offset (m) and tilt (rad) of the chaser ring (`misalignment`); the
+        axial offset is `axial_ring_distance`, the same arithmetic."""
         x = self._state.Eval(context)
         self.dp.plant.SetPositions(self._pc, x[:self.dp.plant.num_positions()])
-        return self._pc
+        return misalignment(*ring_poses(self.dp, self._pc))
 
     def distance(self, context) -> float:
         """The axial ring-centre distance (m)."""
-        return axial_ring_distance(self.dp, self._set(context))
-
-    def misalignment(self, context) -> tuple[float, float, float]:
-        """Axial and lateral offset (m) and tilt (rad) of the chaser ring (`misalignment`)."""
-        return misalignment(*ring_poses(self.dp, self._set(context)))
+        return self.misalignment(context)[0]
 
     def to_go(self, context) -> float:
         """The distance to capture (m, `CaptureRule.to_go`); the axial distance itself when the
         rule tests nothing else."""
-        if self.rule.lateral is None and self.rule.tilt_deg is None:
-            return self.distance(context)
         return self.rule.to_go(*self.misalignment(context))
 
     def DoGetWitnessFunctions(self, context):
         return [self._witness]
 
     def witness_values(self, context) -> dict:
-        return {"capture": self.to_go(context) - self.capture_distance}
+        return {"capture": self.to_go(context) - self.rule.axial}
 
 
 def build_docking_diagram(scenario, meshcat=None, options=None,

@@ -95,7 +95,7 @@ class OutcomeWatch:
 
 
 def progress_fraction(t: float, t_end: float, d: float, d_start: float, d_capture: float):
-    """How far the run is: the ring distance's way towards capture, or the time towards the
-    timeout, whichever is further."""
+    """How far the run is: the way of d (the distance to capture, `CaptureRule.to_go`) from
+    d_start towards d_capture, or the time towards the timeout, whichever is further."""
     way = (d_start - d) / (d_start - d_capture) if d_start > d_capture else 0.0
     return min(max(way, t / t_end, 0.0), 1.0)

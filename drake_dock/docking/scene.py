@@ -16,6 +16,7 @@ from drake_dock.core.patches import Patch, posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.docking.apds import (PAIR_SETS, ApdsGeometry, apds_patches, petal_edges,
                                       side_phi)
+from drake_dock.docking.penetration import deepest_penetration
 from drake_dock.docking.rotations import rot_vec, rot_x, rot_z  # noqa: F401 (re-exported)
 from drake_dock.errors import InputError, NumericalError
 
@@ -343,7 +344,6 @@ def initial_state(scenario) -> InitialState:
     d_contact + approach_travel, moving at chaser_speed towards the target; all else at rest.
     Raises `InputError` for a capture distance not below that initial ring distance."""
     ic = scenario.initial
-    g = scenario.geometry
     if ic.approach_travel < 0:
         raise InputError("initial.approach_travel", ic.approach_travel,
                          ">= 0 m (a negative travel means initial interpenetration)")
@@ -457,7 +457,6 @@ def _check_free_approach(g: ApdsGeometry, approach: Approach, which: str):
     other) goes on to the faces. A crossing within the tolerance of a petal's edge grazes it: in
     the paper's geometry (Rs = R - H cot(alpha1)) a ring's inside circle passes exactly through
     the petal tips of a coaxial approach."""
-    from drake_dock.docking.penetration import deepest_penetration
     lam0 = travel_grid(g, approach)[0]
     (R0, p0), (R1, p1) = approach.pose(lam0), approach.pose(0.0)
     eye, zero = np.eye(3), np.zeros(3)

@@ -177,7 +177,8 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
             approach(root)
         t = root.get_time()
         cap = dd.capture.GetMyContextFromRoot(root)
-        d, to_go = dd.capture.distance(cap), dd.capture.to_go(cap)
+        pose = dd.capture.misalignment(cap)
+        d, to_go = pose[0], dd.capture.rule.to_go(*pose)
         if progress is not None:
             progress(t, t_end, progress_fraction(t, t_end, to_go, watch.d_start,
                                                  sp.capture_distance))

@@ -24,11 +24,12 @@ from drake_dock.systems.contact_system import (COUPLE_SLICES, ContactOptions, Co
                                                Handover, RigidContactSystem)
 from drake_dock.core.handover import SurfaceEdge
 from drake_dock.core.patches import Annulus, Circle, PlaneRect, Segment
+from drake_dock.docking.rotations import rot_x
 from drake_dock.systems.simulator import make_simulator, make_witness_approach
 
 G = 9.81
 PAINLEVE_THETA = math.radians(30.0)
-ANNULUS_CENTRE_Y = 5.0    # m: where `disk_on_incline`'s ring face is centred
+ANNULUS_CENTRE_Y = 5.0    # m: `disk_on_incline`'s ring face is centred at y = -this
 # The small scenes integrate at SMALL_SCENE_ACCURACY (RK5) and locate their events to 1e-2 of
 # a context accuracy of at least WITNESS_ACCURACY_FLOOR, in seconds; `ContactOptions`' default
 # impact_rtol (1e-10) is `drake_dock.systems.simulator.tolerances`' value for it.
@@ -59,11 +60,6 @@ def _plant(gravity):
     return plant
 
 
-def rot_x(a):
-    c, s = math.cos(a), math.sin(a)
-    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
-
-
 def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restitution=0.0,
                     plane_end=50.0, face="plane", edge=False,
                     options=ContactOptions()) -> SmallScene:
@@ -74,6 +70,8 @@ def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restituti
     disk's path along x runs across it near rho = 5. With ``edge`` (on the plane) the plane's
     end is an edge too: the pair "rim_edge" (C-C, the segment x = plane_end) with a hand-over
     from and to "rim_plane" (`drake_dock.core.handover`)."""
+    if face == "annulus" and edge:
+        raise ValueError("disk_on_incline: the edge is the plane's (face='plane')")
     plant = _plant(G * np.array([math.sin(theta), 0.0, -math.cos(theta)]))
     I_ax = 0.5 * mass * radius ** 2
     I_d = 0.25 * mass * radius ** 2
