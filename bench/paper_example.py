@@ -6,8 +6,8 @@ spent isolating witness events (steps of more than 50 evaluations), and the rati
 runs, all measured in this run; and the same example with Drake's plain witness isolation
 (`simulate(..., witness_approach=False)`), for the ratio of the step shortening; and with a
 coarser step cap (``--coarse-step``), which is the output spacing, for its cost; and with the
-contact mathematics (couples, seeks, constraint solve, mode selection) in Python instead of
-the compiled kernels (`ContactOptions.compiled`), with
+contact mathematics (couples, seeks, constraint solve, mode selection, LZB) in Python instead
+of the compiled kernels (`ContactOptions.compiled`, `lzb_compiled`), with
 the difference of the capture times. Also the set-up (the initial state: the first-contact
 placement, its seeks, and their number; and that of another approach of the same geometry)
 and the kernels' cold and warm start (a fresh process that compiles them into an empty cache
@@ -61,8 +61,9 @@ def kernel_start(cache_dir):
 
 
 def python_path_diagram(scenario, dd):
-    """The diagram of ``dd``'s options with the contact mathematics in Python."""
-    options = dataclasses.replace(dd.contact.options, compiled=False)
+    """The diagram of ``dd``'s options with the contact mathematics in Python (the impacts by
+    the reference LZB, scipy's DOP853)."""
+    options = dataclasses.replace(dd.contact.options, compiled=False, lzb_compiled=False)
     return build_docking_diagram(scenario, options=options)
 
 

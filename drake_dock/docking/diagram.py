@@ -63,6 +63,8 @@ class CaptureMonitor(LeafSystem):
         self.rule = rule
         self.capture_distance = float(rule.axial)
         self._pc = dp.plant.CreateDefaultContext()
+        self._nq = dp.plant.num_positions()
+        self._last = (None, None)           # (positions as bytes, their misalignment)
         n = dp.plant.num_positions() + dp.plant.num_velocities()
         self._state = self.DeclareVectorInputPort("state", n)
         self.DeclareVectorOutputPort("ring_distance", 1,
@@ -75,9 +77,14 @@ class CaptureMonitor(LeafSystem):
     def misalignment(self, context) -> tuple[float, float, float]:
         """Axial and lateral offset (m) and tilt (rad) of the chaser ring (`misalignment`); the
         axial offset is `axial_ring_distance`, the same arithmetic."""
-        x = self._state.Eval(context)
-        self.dp.plant.SetPositions(self._pc, x[:self.dp.plant.num_positions()])
-        return misalignment(*ring_poses(self.dp, self._pc))
+        q = self._state.Eval(context)[:self._nq]
+        key = q.tobytes()
+        if key != self._last[0]:
+            # Drake asks again at equal positions (the witness at a step's end, the monitor,
+            # the ring distance output): the last answer is kept.
+            self.dp.plant.SetPositions(self._pc, q)
+            self._last = (key, misalignment(*ring_poses(self.dp, self._pc)))
+        return self._last[1]
 
     def distance(self, context) -> float:
         """The axial ring-centre distance (m)."""
