@@ -76,7 +76,7 @@ def main():
                     help="also run with this step cap (the output spacing), 0 to skip")
     ap.add_argument("--repeats", type=int, default=5,
                     help="runs of the example; the wall time printed is their median")
-    ap.add_argument("--compare-scheme", default="runge_kutta5",
+    ap.add_argument("--compare-scheme", default="bogacki_shampine3",
                     help="also run with this integration scheme ('' to skip)")
     ap.add_argument("--skip-cold", action="store_true",
                     help="skip the kernels' cold and warm start (two fresh processes)")

@@ -23,8 +23,9 @@ PALETTE = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:
            "tab:cyan", "tab:pink")
 IMPACT_GREY = "0.8"
 # A curve whose largest magnitude is below ROUND_OFF times the scale of its panel is zero to
-# round-off: it is not drawn, its magnitude is written in a note.
-ROUND_OFF = 1e-9
+# the simulation's precision (round-off, and the integrator's relative error control, 1e-6 by
+# default); it is not drawn (it would lie under the zero line), its magnitude is in a note.
+ROUND_OFF = 1e-6
 
 
 @dataclasses.dataclass
@@ -48,7 +49,8 @@ class FigureRecord:
 
 
 def negligible(y, scale) -> bool:
-    """True when ``y`` is zero to round-off relative to ``scale`` (exact zeros included)."""
+    """True when ``y`` is zero to the simulation's precision relative to ``scale``
+    (`ROUND_OFF`; exact zeros included)."""
     return float(np.max(np.abs(y), initial=0.0)) <= ROUND_OFF * float(scale)
 
 
@@ -83,8 +85,9 @@ class Sheet:
             ax.set_title("\n".join(above), loc="left", fontsize=8, color="0.15")
 
     def curves(self, ax, t, curves: dict, unit: str, scale=None, what="", **kw):
-        """Draws the curves (label -> y) that are not round-off relative to ``scale`` (default:
-        the largest magnitude among them); the others are named in a note with their size."""
+        """Draws the curves (label -> y) that are not zero to precision (`negligible`)
+        relative to ``scale`` (default: the largest magnitude among them); the others are named
+        in a note with their size."""
         if scale is None:
             scale = max((float(np.max(np.abs(y), initial=0.0)) for y in curves.values()),
                         default=0.0)

@@ -105,13 +105,14 @@ class SimulationParams:
 
 def default_simulator_config() -> SimulatorConfig:
     """Drake's simulator settings of a docking run (`drake_dock.systems.simulator`): the
-    third-order Bogacki-Shampine integrator with error control at ``accuracy`` (which also sets
-    the witness isolation window and LZB's accuracy: `drake_dock.systems.simulator.tolerances`)
+    fifth-order Runge-Kutta integrator with error control at ``accuracy`` (which also sets the
+    witness isolation window and LZB's accuracy: `drake_dock.systems.simulator.tolerances`)
     and its step capped at ``max_step_size`` (s), which is also the sample spacing of the
-    outputs. Bogacki-Shampine reuses its last stage (3 evaluations a step against RK5's 6):
-    where the step cap, not the accuracy, sets the step, it does the same work for half the
-    evaluations (bench/paper_example.py prints both; docs/performance.md)."""
-    return SimulatorConfig(integration_scheme="bogacki_shampine3", max_step_size=0.002,
+    outputs. At that cap the step is mostly the cap's, so the scheme's order sets the error:
+    Bogacki-Shampine (3 evaluations a step against RK5's 6) leaves the energy ledger open by
+    a few 1e-6 over an off-nominal run, RK5 closes it to 1e-7 (docs/model.md, "Integration";
+    bench/paper_example.py runs both)."""
+    return SimulatorConfig(integration_scheme="runge_kutta5", max_step_size=0.002,
                            accuracy=1e-6, use_error_control=True)
 
 

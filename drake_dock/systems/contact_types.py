@@ -2,6 +2,7 @@
 the abstract state, one evaluation, and the layout of each couple's output port."""
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 
@@ -111,7 +112,7 @@ class ContactModes:
         replaced, never written in place); the impact log's entries are never changed once
         logged, so the log is copied as a list of the same entries (Drake clones the abstract
         state at every event)."""
-        return ContactModes([dataclasses.replace(st) for st in self.pairs], list(self.impacts),
+        return ContactModes([copy.copy(st) for st in self.pairs], list(self.impacts),
                             self.impact_loss, self.mode_changes)
 
 
