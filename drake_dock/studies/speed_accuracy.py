@@ -13,6 +13,9 @@ self-convergence is shown by the run at 10x that accuracy, whose error is report
 Wall time covers Simulator.Initialize + AdvanceTo (build and the shared initial state
 excluded), for both models, all measured in the same run of the study.
 
+drake_dock runs with the scenario's integration scheme and with ``rigid_schemes`` (by
+default Bogacki-Shampine beside the default RK5), one family per scheme and step cap.
+
 The headline is the converged speed-up per metric and scene (`drake_dock.studies.work_precision`):
 the fastest compliant configuration converged within ``tolerance`` over the fastest converged
 drake_dock run. Where no compliant run is converged the line says so and gives the best
@@ -33,8 +36,9 @@ from drake_dock.studies.conditions import with_condition
 from drake_dock.studies.docking_metrics import (METRICS, UNITS, compliant_metrics,
                                                 contact_effect, errors, rigid_metrics,
                                                 scene_start)
-from drake_dock.studies.work_precision import (Point, any_run_speedups, converged_speedups,
-                                               points_csv, work_precision_figure)
+from drake_dock.studies.work_precision import (SCHEME_NAMES, Point, any_run_speedups,
+                                               converged_speedups, points_csv,
+                                               work_precision_figure)
 
 OFF_NOMINAL = {"chaser_speed": 0.1, "target_yaw_deg": 4.0}
 
@@ -60,6 +64,9 @@ class StudyPlan:
     # each accuracy is also run with these caps (error control then sets the steps; the
     # samples are sparser)
     rigid_max_steps: tuple = ()
+    # drake_dock's runs are repeated with these integration schemes besides the scenario's
+    # (one family each; the reference keeps the scenario's)
+    rigid_schemes: tuple = ("bogacki_shampine3",)
 
     @staticmethod
     def quick():
@@ -81,10 +88,13 @@ class StudyPlan:
 
 
 
-def _rigid_run(scenario, state, start, acc, max_step=None):
-    """(metrics, note, wall time) of drake_dock at accuracy ``acc`` (and step cap)."""
+def _rigid_run(scenario, state, start, acc, max_step=None, scheme=None):
+    """(metrics, note, wall time) of drake_dock at accuracy ``acc`` (and step cap, and
+    integration scheme)."""
     sc = copy.deepcopy(scenario)
     sc.simulator_config.accuracy = acc
+    if scheme is not None:
+        sc.simulator_config.integration_scheme = scheme
     if max_step is not None:
         sc.simulator_config.max_step_size = max_step
     try:
@@ -104,18 +114,23 @@ def run_scene(name, scenario, plan: StudyPlan, log=print) -> dict:
         raise DrakeDockError(f"{name}: the reference run failed: {note}")
     effect = contact_effect(ref, start)
     cap = scenario.simulator_config.max_step_size
-    points = [Point("drake_dock", "reference", f"drake_dock acc={plan.reference_accuracy:.0e}",
-                    "rigid", math.nan, cap, plan.reference_accuracy, wall, True, ref,
-                    errors(ref, ref, effect), scene=name)]
-    runs = [(10 * plan.reference_accuracy, None)] + [(a, None) for a in plan.rigid_accuracies]
-    runs += [(a, h) for h in plan.rigid_max_steps for a in plan.rigid_accuracies]
-    for i, (acc, h) in enumerate(runs):
-        m, note, wall = _rigid_run(scenario, state, start, acc, h)
-        label = f"drake_dock acc={acc:.0e}" + (f" step<={h:g}" if h is not None else "")
+    own = scenario.simulator_config.integration_scheme
+    points = [Point("drake_dock", "reference", f"drake_dock {SCHEME_NAMES.get(own, own)} "
+                    f"acc={plan.reference_accuracy:.0e}", "rigid", math.nan, cap,
+                    plan.reference_accuracy, wall, True, ref, errors(ref, ref, effect),
+                    scene=name, scheme=own)]
+    runs = [(own, 10 * plan.reference_accuracy, None)]
+    for scheme in dict.fromkeys((own, *plan.rigid_schemes)):
+        runs += [(scheme, a, None) for a in plan.rigid_accuracies]
+        runs += [(scheme, a, h) for h in plan.rigid_max_steps for a in plan.rigid_accuracies]
+    for i, (scheme, acc, h) in enumerate(runs):
+        m, note, wall = _rigid_run(scenario, state, start, acc, h, scheme)
+        label = (f"drake_dock {SCHEME_NAMES.get(scheme, scheme)} acc={acc:.0e}"
+                 + (f" step<={h:g}" if h is not None else ""))
         points.append(Point("drake_dock", "self-convergence" if i == 0 else "point", label,
                             "rigid", math.nan, cap if h is None else h, acc, wall,
                             m["capture_time"] is not None, m, errors(m, ref, effect), note,
-                            name))
+                            name, scheme))
         log(_fmt(points[-1]))
     # Hunt-Crossley dissipation matched to the restitution at the first impact's approach
     # speed (the chaser's speed along the couples' normal is unknown before the run: the

@@ -2,7 +2,7 @@
 points' CSV and the work-precision chart.
 
 A *family* is one method with fixed model and stiffness, ordered by step (SAP) or by accuracy
-(continuous RK3, and drake_dock at one step cap). A run is *converged* on a metric when its
+(continuous RK3, and drake_dock with one integration scheme at one step cap). A run is *converged* on a metric when its
 error and the error of every finer run of its family are within the tolerance (a run that
 does not capture is not). The converged speed-up of a metric is the fastest converged compliant
 run's wall time over the fastest converged drake_dock run's. The speed-up over *any* run
@@ -31,6 +31,7 @@ class Point:
     errors: dict
     note: str = ""
     scene: str = ""
+    scheme: str = ""     # drake_dock's integration scheme (SimulatorConfig.integration_scheme)
 
 
 @dataclasses.dataclass
@@ -46,7 +47,7 @@ class Reading:
 def family(p: Point):
     """(family key, fineness): a larger fineness is a finer run of the family."""
     if p.method == "drake_dock":
-        return ("drake_dock", p.step), -math.log10(p.accuracy)
+        return ("drake_dock", p.scheme, p.step), -math.log10(p.accuracy)
     if p.step > 0:
         return ("compliant", p.model, p.stiffness, "SAP"), -math.log10(p.step)
     return ("compliant", p.model, p.stiffness, "RK3"), -math.log10(p.accuracy)
@@ -93,8 +94,8 @@ def any_run_speedups(points, tol) -> dict:
                         points, k) for k in METRICS}
 
 
-CSV_FIELDS = ("scene", "method", "role", "label", "model", "stiffness", "step", "accuracy",
-              "wall_time", "captured", *METRICS, *(f"error_{k}" for k in METRICS), "note")
+CSV_FIELDS = ("scene", "method", "scheme", "role", "label", "model", "stiffness", "step",
+              "accuracy", "wall_time", "captured", *METRICS, *(f"error_{k}" for k in METRICS), "note")
 
 
 def points_csv(points) -> str:
@@ -102,7 +103,7 @@ def points_csv(points) -> str:
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(CSV_FIELDS)
     for p in points:
-        w.writerow([p.scene, p.method, p.role, p.label, p.model, f"{p.stiffness:.6g}",
+        w.writerow([p.scene, p.method, p.scheme, p.role, p.label, p.model, f"{p.stiffness:.6g}",
                     f"{p.step:.6g}", f"{p.accuracy:.6g}", f"{p.wall_time:.6f}", int(p.captured),
                     *("" if p.metrics[k] is None else repr(p.metrics[k]) for k in METRICS),
                     *("" if p.errors[k] is None else f"{p.errors[k]:.6e}" for k in METRICS),
@@ -110,9 +111,12 @@ def points_csv(points) -> str:
     return buf.getvalue()
 
 
+SCHEME_NAMES = {"runge_kutta5": "RK5", "bogacki_shampine3": "BS3", "runge_kutta3": "RK3"}
+
+
 def _group(p: Point) -> str:
     if p.method == "drake_dock":
-        return f"drake_dock (rigid, LZB), step <= {p.step:g} s"
+        return f"drake_dock {SCHEME_NAMES.get(p.scheme, p.scheme)}, step <= {p.step:g} s"
     if p.step > 0:
         return f"SAP {p.model} k={p.stiffness:.0e}"
     return f"continuous RK3 {p.model} k={p.stiffness:.0e}"
@@ -120,12 +124,16 @@ def _group(p: Point) -> str:
 
 def _style(key, groups, colour):
     if key.startswith("drake_dock"):
-        # The finest step cap solid black, coarser caps dashed in lighter greys.
-        dd = sorted((g for g in groups if g.startswith("drake_dock")),
+        # Per scheme (circles, diamonds): the finest step cap solid black, coarser caps dashed
+        # in lighter greys.
+        schemes = list(dict.fromkeys(g.split(",")[0] for g in groups
+                                     if g.startswith("drake_dock")))
+        scheme = key.split(",")[0]
+        dd = sorted((g for g in groups if g.split(",")[0] == scheme),
                     key=lambda g: float(g.split("<= ")[1].split()[0]))
         rank = dd.index(key)
-        return dict(lw=2.2, marker="o", color=("k", "0.4", "0.65", "0.8")[min(rank, 3)],
-                    ls="--" if rank else "-")
+        return dict(lw=2.2, marker="oDs"[min(schemes.index(scheme), 2)],
+                    color=("k", "0.4", "0.65", "0.8")[min(rank, 3)], ls="--" if rank else "-")
     return dict(lw=1, marker="s" if "SAP" in key else "^", ms=4, color=colour[key])
 
 

@@ -108,7 +108,7 @@ def quick_study(tmp_path_factory):
 def _family(r):
     """(settings but the step or accuracy, fineness) of a CSV row."""
     if r["method"] == "drake_dock":
-        return ("drake_dock", r["step"]), -math.log10(float(r["accuracy"]))
+        return ("drake_dock", r["scheme"], r["step"]), -math.log10(float(r["accuracy"]))
     if float(r["step"]) > 0:
         return ("SAP", r["model"], r["stiffness"]), -math.log10(float(r["step"]))
     return ("RK3", r["model"], r["stiffness"]), -math.log10(float(r["accuracy"]))
