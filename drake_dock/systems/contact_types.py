@@ -78,7 +78,7 @@ class ContactOptions:
     max_impacts: int = 10000
     compiled: bool = True            # the couples, seeks, constraint solve and mode selection
                                      # by the compiled kernels (False: in Python)
-    lzb_compiled: bool = False       # LZB impacts by the compiled kernel (`solve_lzb`'s
+    lzb_compiled: bool = True        # LZB impacts by the compiled kernel (`solve_lzb`'s
                                      # compiled; False: scipy's DOP853, the reference;
                                      # docs/performance.md, "The compiled LZB")
     broad_phase: bool = False        # a far pair whose covers are at least track_distance

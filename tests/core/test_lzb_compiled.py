@@ -4,7 +4,9 @@ a second implementation of the same equations with another integrator: at rtol 1
 post-impact velocities and impulses agree to 1e-9 relative and the phase events are the same
 in the same order; the errors are raised alike. Against the continuous limit of the chains as
 the reference is (`drake_dock.core.lzb.limit`)."""
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -149,3 +151,30 @@ def test_step_budget_raises_alike(compiled):
     M, Wn = chain(5)
     with pytest.raises(NumericalError, match="did not end within 20 steps"):
         solve_lzb(M, Wn, [1.0, 0, 0, 0, 0], 1e7, 1.5, 0.3, max_steps=20, compiled=compiled)
+
+
+REST_IMPACT = Path(__file__).with_name("lzb_rest_impact.json")
+
+
+@pytest.mark.parametrize("compiled", [False, True], ids=["reference", "compiled"])
+def test_a_couple_sliding_to_rest_while_turning_sticks(compiled):
+    """An impact of the docking scene (conditions sweep, random 7): couple 0 slides to rest
+    while its sliding direction turns by 90 deg. Its friction event (u_t along the last slip
+    direction down to the speed of rest) fires and it sticks; the impact ends within the
+    default step budget. Checked against the kinematics of v+ (the stuck couple's tangential
+    velocity is within the speed of rest) and between the two integrators."""
+    d = json.loads(REST_IMPACT.read_text())
+    M = np.zeros((d["n"], d["n"]))
+    for i, j, m in d["M_nonzeros"]:
+        M[i, j] = m
+    Wn, Wt, v = np.array(d["Wn"]), np.array(d["Wt"]), np.array(d["v_minus"])
+    args = (M, Wn, v, d["stiffness"], d["eta"], d["restitution"])
+    kw = dict(Wt=Wt, mu=d["mu"], rtol=d["rtol"])
+    r = solve_lzb(*args, **kw, compiled=compiled)
+    assert [e.kind for e in r.events] == ["max_compression", "stick", "end"]
+    assert [e.couple for e in r.events][:2] == [0, 0]
+    v_s = np.abs(Wn.T @ v).max()
+    assert np.linalg.norm(Wt[:, :2].T @ r.v_plus) <= 2 * d["rtol"] * v_s
+    if compiled:
+        ref = solve_lzb(*args, **kw)
+        assert np.abs(r.v_plus - ref.v_plus).max() <= 1e-7 * np.abs(ref.v_plus).max()

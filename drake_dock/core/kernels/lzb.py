@@ -67,20 +67,24 @@ def dense_at(rc, t_old, h, t, out, lo, hi):
 
 
 @njit(cache=True)
-def _root_value(rc, t_old, h, t, tmp, kind, j, s, friction, phase, sep, x_end, slip_dir):
+def _root_value(rc, t_old, h, t, tmp, kind, j, s, friction, phase, sep, x_end, slip_dir,
+                v_rest):
     dense_at(rc, t_old, h, t, tmp, 0, len(tmp))
-    return event_value(tmp, kind, j, s, friction, phase, sep, x_end, slip_dir)
+    return event_value(tmp, kind, j, s, friction, phase, sep, x_end, slip_dir, v_rest)
 
 
 @njit(cache=True)
-def event_time(rc, t_old, h, kind, j, ta, tb, tmp, s, friction, phase, sep, x_end, slip_dir):
+def event_time(rc, t_old, h, kind, j, ta, tb, tmp, s, friction, phase, sep, x_end, slip_dir,
+               v_rest):
     """The zero in [ta, tb] of couple j's event function of row ``kind`` on the dense output
     (ta when it starts on the boundary): Brent's method (Brent, *Algorithms for Minimization
     without Derivatives*, 1973, ch. 4), to xtol 1e-15 max(1, |tb|) and rtol 4 eps."""
-    fa = _root_value(rc, t_old, h, ta, tmp, kind, j, s, friction, phase, sep, x_end, slip_dir)
+    fa = _root_value(rc, t_old, h, ta, tmp, kind, j, s, friction, phase, sep, x_end, slip_dir,
+                     v_rest)
     if fa <= 0.0:
         return ta
-    fb = _root_value(rc, t_old, h, tb, tmp, kind, j, s, friction, phase, sep, x_end, slip_dir)
+    fb = _root_value(rc, t_old, h, tb, tmp, kind, j, s, friction, phase, sep, x_end, slip_dir,
+                     v_rest)
     if fb > 0.0:
         return tb
     xtol, rtol = 1e-15 * max(1.0, abs(tb)), 4.0 * 2.220446049250313e-16
@@ -119,13 +123,13 @@ def event_time(rc, t_old, h, kind, j, ta, tb, tmp, s, friction, phase, sep, x_en
         a, fa = b, fb
         b += d if abs(d) > tol else (tol if m > 0.0 else -tol)
         fb = _root_value(rc, t_old, h, b, tmp, kind, j, s, friction, phase, sep, x_end,
-                         slip_dir)
+                         slip_dir, v_rest)
     return b
 
 
 @njit(cache=True)
 def active_events(rc, t_old, t_new, g0, g1, s, friction, phase, sep, x_end, slip_dir, tmp,
-                  br_kind, br_j, br_a, br_b):
+                  br_kind, br_j, br_a, br_b, v_rest):
     """`solve.active_events`: the brackets (row, couple, ta, tb) of the step, friction rows
     first, then the normal and approach rows sampled inside the step; their number."""
     nb = 0
@@ -143,9 +147,9 @@ def active_events(rc, t_old, t_new, g0, g1, s, friction, phase, sep, x_end, slip
         dense_at(rc, t_old, h, T[k + 1], tmp, 0, 2 * s)
         for j in range(s):
             samples[k, 0, j] = event_value(tmp, NORMAL, j, s, friction, phase, sep, x_end,
-                                           slip_dir)
+                                           slip_dir, v_rest)
             samples[k, 1, j] = event_value(tmp, APPROACH, j, s, friction, phase, sep, x_end,
-                                           slip_dir)
+                                           slip_dir, v_rest)
     for r in range(2):
         kind = NORMAL if r == 0 else APPROACH
         for j in range(s):
@@ -203,7 +207,7 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
     t_old = t
     while not finished(y, s, kappa, eta, phase, settle):
         classify(y, s, phase, sep)
-        event_values(y, g0, s, friction, phase, sep, x_end, slip_dir)
+        event_values(y, g0, s, friction, phase, sep, x_end, slip_dir, settle)
         rhs(y, k1, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam)
         if h <= 0.0:
             # The initial step (Hairer, Norsett and Wanner, Sect. II.4).
@@ -283,9 +287,9 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                 rc[4, i] = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i]
                                 + D6 * k6[i] + D7 * k7[i])
             h_used = h
-            event_values(yn, g1, s, friction, phase, sep, x_end, slip_dir)
+            event_values(yn, g1, s, friction, phase, sep, x_end, slip_dir, settle)
             nb = active_events(rc, t_old, t_new, g0, g1, s, friction, phase, sep, x_end,
-                               slip_dir, tmp, br_kind, br_j, br_a, br_b)
+                               slip_dir, tmp, br_kind, br_j, br_a, br_b, settle)
             if nb > 0:
                 # `solve.handle_events`, as a transaction.
                 sv_y[:] = y
@@ -296,7 +300,7 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                 for b in range(nb):
                     roots[b] = event_time(rc, t_old, h_used, br_kind[b], br_j[b], br_a[b],
                                           br_b[b], tmp, s, friction, phase, sep, x_end,
-                                          slip_dir)
+                                          slip_dir, settle)
                     if roots[b] < roots[first]:
                         first = b
                 t_first = roots[first]
@@ -307,7 +311,7 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                 impulse *= imp_scale
                 ok, log = apply_event(y, br_kind[first], br_j[first], impulse, s, nu,
                                       friction, kappa, eta, e, law, phase, sep, rate, x_end,
-                                      slip_dir, wc, e_start, wc_open, log)
+                                      slip_dir, wc, e_start, wc_open, log, settle)
                 # The others at the same instant, in the order (time, row, couple).
                 for b in range(nb):
                     order[b] = b
@@ -327,10 +331,11 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                         break
                     if b != first and roots[b] <= t_first + same and event_value(
                             y, br_kind[b], br_j[b], s, friction, phase, sep, x_end,
-                            slip_dir) <= 0.0:
+                            slip_dir, settle) <= 0.0:
                         ok, log = apply_event(y, br_kind[b], br_j[b], impulse, s, nu,
                                               friction, kappa, eta, e, law, phase, sep, rate,
-                                              x_end, slip_dir, wc, e_start, wc_open, log)
+                                              x_end, slip_dir, wc, e_start, wc_open, log,
+                                              settle)
                 # `ImpactProblem.turn_at_once`.
                 for _ in range(2 * s):
                     if not ok:
@@ -354,7 +359,7 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                     kind = NORMAL if phase[jt] == COMPRESSION else APPROACH
                     ok, log = apply_event(y, kind, jt, impulse, s, nu, friction, kappa, eta,
                                           e, law, phase, sep, rate, x_end, slip_dir, wc,
-                                          e_start, wc_open, log)
+                                          e_start, wc_open, log, settle)
                 if not ok:
                     y[:] = sv_y
                     phase[:], sep[:], rate[:], x_end[:] = sv_phase, sv_sep, sv_rate, sv_xe
@@ -372,7 +377,7 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
             for i in range(N):
                 k1[i] = k7[i]
             if classify(y, s, phase, sep):
-                event_values(y, g0, s, friction, phase, sep, x_end, slip_dir)
+                event_values(y, g0, s, friction, phase, sep, x_end, slip_dir, settle)
             else:
                 g0[:, :] = g1
             nh = _history(hist, nh, y, s, nu, imp_scale)

@@ -74,8 +74,9 @@ def rhs(y, out, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam):
 
 
 @njit(cache=True)
-def event_value(y, kind, j, s, friction, phase, sep, x_end, slip_dir):
-    """Row ``kind`` of couple j of `ImpactProblem.event_values` (no couple stuck or locked)."""
+def event_value(y, kind, j, s, friction, phase, sep, x_end, slip_dir, v_rest):
+    """Row ``kind`` of couple j of `ImpactProblem.event_values` (no couple stuck or locked;
+    ``v_rest``, the sliding speed at which a couple has come to rest)."""
     x, un = y[j], y[s + j]
     if kind == NORMAL:
         if phase[j] == COMPRESSION and not sep[j]:
@@ -89,15 +90,16 @@ def event_value(y, kind, j, s, friction, phase, sep, x_end, slip_dir):
         return np.inf
     if friction and x > 0.0:
         o = 2 * s + 2 * j
-        return y[o] * slip_dir[j, 0] + y[o + 1] * slip_dir[j, 1]
+        return y[o] * slip_dir[j, 0] + y[o + 1] * slip_dir[j, 1] - v_rest
     return np.inf
 
 
 @njit(cache=True)
-def event_values(y, g, s, friction, phase, sep, x_end, slip_dir):
+def event_values(y, g, s, friction, phase, sep, x_end, slip_dir, v_rest):
     for kind in range(3):
         for j in range(s):
-            g[kind, j] = event_value(y, kind, j, s, friction, phase, sep, x_end, slip_dir)
+            g[kind, j] = event_value(y, kind, j, s, friction, phase, sep, x_end, slip_dir,
+                                     v_rest)
 
 
 @njit(cache=True)
@@ -143,9 +145,11 @@ def _log(ev_imp, ev_kind, ev_couple, n, impulse, kind, j):
 
 @njit(cache=True)
 def apply_event(y, kind, j, impulse, s, nu, friction, kappa, eta, e, law, phase, sep, rate,
-                x_end, slip_dir, wc, e_start, wc_open, log):
+                x_end, slip_dir, wc, e_start, wc_open, log, v_rest):
     """`ImpactProblem.apply_event` for the events the kernel takes; False (nothing changed)
-    for one that needs Python: a stick-slip decision or a lock."""
+    for one that needs Python: a stick-slip decision or a lock. A sliding couple's friction
+    event is a rest (`friction.on_friction_event`) where |u_t| <= max(2 v_rest, 1e-9 of the
+    largest velocity), else a turn of its direction."""
     ev_imp, ev_kind, ev_couple, n = log
     if kind == FRICTION:
         o = 2 * s + 2 * j
@@ -153,7 +157,7 @@ def apply_event(y, kind, j, impulse, s, nu, friction, kappa, eta, e, law, phase,
         scale = 0.0
         for i in range(s, s + nu):
             scale = max(scale, abs(y[i]))
-        if nt <= 1e-9 * scale:
+        if nt <= max(1e-9 * scale, 2.0 * v_rest):
             return False, log           # came to rest: `select_modes`
         slip_dir[j, 0], slip_dir[j, 1] = y[o] / nt, y[o + 1] / nt
         return True, log

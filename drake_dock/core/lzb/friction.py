@@ -32,8 +32,10 @@ def select_modes(prob, y, js, events, impulse):
     lam_n = probe_loads(prob, y)
     was = prob.stuck.copy()
     rest = []
+    # At rest: within twice the speed of rest (`ImpactProblem.event_values`), or round-off.
+    v_rest = max(1e-12 * scale, 2.0 * prob.settle)
     for j in js:
-        if np.linalg.norm(ut[j]) > 1e-12 * scale:
+        if np.linalg.norm(ut[j]) > v_rest:
             prob.stuck[j] = False
             prob.slip_dir[j] = ut[j] / np.linalg.norm(ut[j])
         else:
@@ -84,7 +86,10 @@ def on_friction_event(prob, y, j, events, impulse):
     else:
         ut = tangential_pairs(prob, y)[j]
         scale = np.abs(y[prob.layout.u]).max()
-        if np.linalg.norm(ut) <= 1e-9 * scale:
+        # At rest: |u_t| within twice the speed at which the event fires (the relative
+        # velocity that ends the impact, `ImpactProblem.event_values`), or 1e-9 of the
+        # largest velocity.
+        if np.linalg.norm(ut) <= max(1e-9 * scale, 2.0 * prob.settle):
             select_modes(prob, y, [j], events, impulse)
         else:
             prob.slip_dir[j] = ut / np.linalg.norm(ut)

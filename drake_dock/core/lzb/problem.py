@@ -98,7 +98,9 @@ class ImpactProblem:
     def event_values(self, y):
         """Per couple, functions whose crossing from > 0 to <= 0 is a phase event (rows:
         NORMAL = maximal compression, end of expansion or release of a locked couple;
-        FRICTION; APPROACH = re-compression in expansion, re-loading of a separated couple)."""
+        FRICTION = a sliding couple's u_t along its slip direction down to ``settle``, the
+        speed of rest (it came to rest, or turned), or a sticking couple's force at its static
+        cone; APPROACH = re-compression in expansion, re-loading of a separated couple)."""
         s = self.s
         x = y[self.layout.x]
         g = np.full((3, s), np.inf)
@@ -107,7 +109,8 @@ class ImpactProblem:
             # No couple sticks: the loaded ones (x > 0) slide.
             ut = tangential_pairs(self, y)
             loaded = x > 0
-            g[FRICTION][loaded] = np.einsum("ij,ij->i", ut, self.slip_dir)[loaded]
+            g[FRICTION][loaded] = (np.einsum("ij,ij->i", ut, self.slip_dir)[loaded]
+                                   - self.settle)
         elif self.friction or self.locked.any():
             lam_n, lam_t = forces(self, y)
             g[NORMAL][self.locked] = lam_n[self.locked]
@@ -115,7 +118,8 @@ class ImpactProblem:
                 ut = tangential_pairs(self, y)
                 loaded = lam_n > 0
                 slip = loaded & ~self.stuck
-                g[FRICTION][slip] = np.einsum("ij,ij->i", ut[slip], self.slip_dir[slip])
+                g[FRICTION][slip] = (np.einsum("ij,ij->i", ut[slip], self.slip_dir[slip])
+                                     - self.settle)
                 st = loaded & self.stuck
                 g[FRICTION][st] = self.mu_s[st] * lam_n[st] - np.linalg.norm(lam_t[st], axis=1)
         return g
