@@ -166,6 +166,12 @@ def summary_lines(result) -> list:
                      f" (linear), {max(r['momentum_drift_angular'] for r in ran):.2e} "
                      f"(angular); largest energy-ledger closure error "
                      f"{max(abs(r['energy_closure']) for r in ran):.2e}")
+    walls = sorted(r["wall_time_s"] for r in rows if "wall_time_s" in r)
+    if walls:
+        n = len(walls)
+        median = walls[n // 2] if n % 2 else 0.5 * (walls[n // 2 - 1] + walls[n // 2])
+        lines.append(f"median wall time per run {median:.3g} s (simulation and outputs; the "
+                     f"interpenetration check excluded)")
     errors = {}
     for r in rows:
         if r["outcome"] == "error":

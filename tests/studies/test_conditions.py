@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from drake_dock.studies.conditions import (IDSS_BOX, ConditionsPlan, conditions, rows_csv,
+                                           summary_lines,
                                            with_condition, write_conditions)
 
 PLAN = ConditionsPlan(random=200, corners=32, seed=11)
@@ -69,3 +70,12 @@ def test_rows_are_written_and_read_back(tmp_path):
     assert float(back[0]["penetration_m"]) == 2e-3 and back[1]["reason"] == "NumericalError: x"
     assert (tmp_path / "out" / "conditions.png").stat().st_size > 10000
     assert rows_csv(rows) == (tmp_path / "out" / "conditions.csv").read_text()
+
+
+def test_the_summary_prints_the_median_wall_time_per_run():
+    """The median of the rows' wall times (numpy's, from the same rows), errors included."""
+    walls = [0.31, 2.5, 0.07, 11.0, 0.9, 4.2]
+    rows = [{"name": f"random {k}", "outcome": "jammed" if k % 3 else "error",
+             "reason": "NumericalError: x", "wall_time_s": w} for k, w in enumerate(walls)]
+    line, = [ln for ln in summary_lines({"rows": rows}) if ln.startswith("median wall")]
+    assert float(line.split()[5]) == pytest.approx(np.median(walls), rel=1e-3)
