@@ -48,8 +48,7 @@ def ring_poses(dp: DockingPlant, plant_context):
 
 def axial_ring_distance(dp: DockingPlant, plant_context) -> float:
     """Distance from the target's ring centre to the chaser's, along the target APDS axis."""
-    R_t, p_t, _, p_c = ring_poses(dp, plant_context)
-    return float(R_t[:, 2] @ (p_c - p_t))
+    return misalignment(*ring_poses(dp, plant_context))[0]
 
 
 class CaptureMonitor(LeafSystem):
@@ -76,7 +75,7 @@ class CaptureMonitor(LeafSystem):
 
     def misalignment(self, context) -> tuple[float, float, float]:
         """Axial and lateral offset (m) and tilt (rad) of the chaser ring (`misalignment`); the
-        axial offset is `axial_ring_distance`, the same arithmetic."""
+        axial offset is `axial_ring_distance`."""
         q = self._state.Eval(context)[:self._nq]
         key = q.tobytes()
         if key != self._last[0]:

@@ -22,9 +22,9 @@ DPI = 100
 PALETTE = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:olive",
            "tab:cyan", "tab:pink")
 IMPACT_GREY = "0.8"
-# A curve whose largest magnitude is below ROUND_OFF times the scale of its panel is zero to
-# the simulation's precision (round-off, and the integrator's relative error control, 1e-6 by
-# default); it is not drawn (it would lie under the zero line), its magnitude is in a note.
+# A curve whose largest magnitude is below ROUND_OFF times the scale of its panel lies under
+# the zero line (an axis of a few hundred pixels resolves about 1e-3 of it): it is not drawn,
+# its magnitude is written in a note.
 ROUND_OFF = 1e-6
 
 
@@ -49,8 +49,7 @@ class FigureRecord:
 
 
 def negligible(y, scale) -> bool:
-    """True when ``y`` is zero to the simulation's precision relative to ``scale``
-    (`ROUND_OFF`; exact zeros included)."""
+    """True when ``y`` is below `ROUND_OFF` of ``scale`` (exact zeros included)."""
     return float(np.max(np.abs(y), initial=0.0)) <= ROUND_OFF * float(scale)
 
 
@@ -102,7 +101,7 @@ class Sheet:
             names = ", ".join(s[0] for s in small)
             top = max(s[1] for s in small)
             self.note(ax, f"{what}{names}: zero throughout" if top == 0.0 else
-                      f"{what}{names} not plotted, zero to numerical precision:\n"
+                      f"{what}{names} not plotted, zero at this scale:\n"
                       f"|.| <= {top:.1e} {unit}, below {ROUND_OFF:g} of the scale "
                       f"{scale:.3g} {unit}", inside=not drawn)
             if not drawn:

@@ -2,10 +2,10 @@
 points' CSV and the work-precision chart.
 
 A *family* is one method with fixed model and stiffness, ordered by step (SAP) or by accuracy
-(continuous RK3, and drake_dock with one integration scheme at one step cap). A run is *converged* on a metric when its
-error and the error of every finer run of its family are within the tolerance (a run that
-does not capture is not). The converged speed-up of a metric is the fastest converged compliant
-run's wall time over the fastest converged drake_dock run's. The speed-up over *any* run
+(continuous RK3, and drake_dock with one integration scheme at one step cap). A run is
+*converged* on a metric when its error and the error of every finer run of its family are
+within the tolerance (a run that does not capture is not). The converged speed-up of a metric
+is the fastest converged compliant run's wall time over the fastest converged drake_dock run's. The speed-up over *any* run
 within the tolerance is also given: a coarse run can land within it by chance.
 """
 import csv
@@ -95,7 +95,8 @@ def any_run_speedups(points, tol) -> dict:
 
 
 CSV_FIELDS = ("scene", "method", "scheme", "role", "label", "model", "stiffness", "step",
-              "accuracy", "wall_time", "captured", *METRICS, *(f"error_{k}" for k in METRICS), "note")
+              "accuracy", "wall_time", "captured", *METRICS,
+              *(f"error_{k}" for k in METRICS), "note")
 
 
 def points_csv(points) -> str:

@@ -18,6 +18,14 @@ def _sticking_forces(prob, lam_n, mask):
     return stick_forces(prob, lam_n, lam_t, mask)
 
 
+def rest_speed(prob, scale) -> float:
+    """The tangential speed within which a couple is at rest: twice the speed at which a
+    sliding couple's friction event fires (``prob.settle``, the relative velocity that ends the
+    impact: `ImpactProblem.event_values`), or 1e-9 of the largest velocity ``scale``. The
+    compiled kernel's `apply_event` uses the same."""
+    return max(1e-9 * scale, 2.0 * prob.settle)
+
+
 def select_modes(prob, y, js, events, impulse):
     """Stick or slip for the couples ``js`` (loaded or loading, Eq. 27), decided jointly with
     the couples that stick now, since their sticking forces depend on each other: a couple
@@ -32,8 +40,7 @@ def select_modes(prob, y, js, events, impulse):
     lam_n = probe_loads(prob, y)
     was = prob.stuck.copy()
     rest = []
-    # At rest: within twice the speed of rest (`ImpactProblem.event_values`), or round-off.
-    v_rest = max(1e-12 * scale, 2.0 * prob.settle)
+    v_rest = rest_speed(prob, scale)
     for j in js:
         if np.linalg.norm(ut[j]) > v_rest:
             prob.stuck[j] = False
@@ -70,8 +77,8 @@ def select_modes(prob, y, js, events, impulse):
 def on_friction_event(prob, y, j, events, impulse):
     """Couple j's friction event function crossed zero: a sticking couple's force reached the
     static cone (it slips along minus that force, the others that stick are decided again with
-    it), or a sliding couple's u_t turned by more than 90 deg (it came to rest: decide; or it
-    reversed: follow it)."""
+    it), or a sliding couple's u_t along its slip direction fell to the speed of rest (within
+    `rest_speed` it came to rest: decide; otherwise its direction turned: follow it)."""
     if prob.stuck[j]:
         lam_n = probe_loads(prob, y)
         mask = prob.stuck & ((lam_n > 0) | (np.arange(prob.s) == j))
@@ -86,10 +93,7 @@ def on_friction_event(prob, y, j, events, impulse):
     else:
         ut = tangential_pairs(prob, y)[j]
         scale = np.abs(y[prob.layout.u]).max()
-        # At rest: |u_t| within twice the speed at which the event fires (the relative
-        # velocity that ends the impact, `ImpactProblem.event_values`), or 1e-9 of the
-        # largest velocity.
-        if np.linalg.norm(ut) <= max(1e-9 * scale, 2.0 * prob.settle):
+        if np.linalg.norm(ut) <= rest_speed(prob, scale):
             select_modes(prob, y, [j], events, impulse)
         else:
             prob.slip_dir[j] = ut / np.linalg.norm(ut)
