@@ -15,9 +15,10 @@ import copy
 import math
 import time
 
+import numpy as np
+
 from drake_dock.campaign.plan import set_field
 from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.plant import stewart_history
 from drake_dock.docking.results import summary, timeseries
 from drake_dock.docking.scenario import validate
 from drake_dock.docking.simulate import simulate
@@ -75,17 +76,20 @@ def input_columns(values: dict) -> dict:
     return out
 
 
-def stewart_peaks(result) -> tuple[float, float]:
+def stewart_peaks(ts: dict) -> tuple[float, float]:
     """The largest translational deflection (m) of the Stewart element and the largest force
-    (N) it exerts on the target APDS, over the recorded samples."""
-    stroke, force = stewart_history(result.dd.dp, result.record.x)
+    (N) it exerts on the target APDS, over the recorded samples of a `timeseries` (the values
+    of `drake_dock.docking.plant.stewart_history`, from the states the timeseries evaluates)."""
+    stroke = np.array([np.linalg.norm(x) for x in ts["stewart_x"]])
+    force = np.array([np.linalg.norm(f) for f in ts["stewart_force_W"]])
     return float(stroke.max(initial=0.0)), float(force.max(initial=0.0))
 
 
 def measure(result) -> dict:
     """The row's result columns of a finished run (RESULT_COLUMNS but wall_time)."""
-    s = summary(result, timeseries(result))
-    stroke, force = stewart_peaks(result)
+    ts = timeseries(result)
+    s = summary(result, ts)
+    stroke, force = stewart_peaks(ts)
     fm = s["final_misalignment"]
     row = {"outcome": s["outcome"], "reason": s["outcome_reason"],
            "capture_time": s["capture_time_s"], "end_time": s["end_time_s"],

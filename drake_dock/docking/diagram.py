@@ -101,10 +101,25 @@ class CaptureMonitor(LeafSystem):
         return {"capture": self.to_go(context) - self.rule.axial}
 
 
+def contact_options(scenario, options: ContactOptions | None = None) -> ContactOptions:
+    """The contact system's options for the scenario: ``options``, by default ContactOptions
+    with LZB's accuracy following the simulator's (`drake_dock.systems.simulator.tolerances`);
+    where their ``broad_phase`` is None, the scene's policy: the broad phase screens the far
+    pairs of every set but `paper`, whose 12 pairs are sought as in Sect. 5.1 (docs/model.md,
+    "Hybrid simulation"). An explicit True or False is kept."""
+    if options is None:
+        options = ContactOptions(impact_rtol=tolerances(scenario.simulator_config).impact_rtol)
+    if options.broad_phase is None:
+        options = dataclasses.replace(options, broad_phase=scenario.contact.pairs != "paper")
+    return options
+
+
 def build_docking_diagram(scenario, meshcat=None, options=None,
                           handovers=False) -> DockingDiagram:
-    """The Diagram of the scenario. ``handovers`` declares the edge/surface hand-overs of the
-    `complete` pairs (`pair_handovers`; docs/model.md, "Hand-over between an edge and a
+    """The Diagram of the scenario, its contact system with `contact_options` (scenario,
+    options): given options keep their fields, and a ``broad_phase`` left None takes the
+    scene's policy as the default options do. ``handovers`` declares the edge/surface hand-overs
+    of the `complete` pairs (`pair_handovers`; docs/model.md, "Hand-over between an edge and a
     surface"): off by default, because in the paper's geometry the ring's inside circle passes
     exactly through the petal tips and the tracked couples there are handed back and forth."""
     builder = DiagramBuilder()
@@ -114,12 +129,7 @@ def build_docking_diagram(scenario, meshcat=None, options=None,
     specs = scenario_pairs(scenario)
     pairs = [ContactPair(p.name, p.kind, frames[p.body1], p.patch1, frames[p.body2], p.patch2)
              for p in specs]
-    if options is None:
-        # LZB's accuracy follows the simulator's (`drake_dock.systems.simulator.tolerances`).
-        # The broad phase screens the far pairs of the complete set; the paper's 12 pairs are
-        # sought as in Sect. 5.1 (docs/model.md, "Hybrid simulation").
-        options = ContactOptions(impact_rtol=tolerances(scenario.simulator_config).impact_rtol,
-                                 broad_phase=scenario.contact.pairs != "paper")
+    options = contact_options(scenario, options)
     contact = builder.AddSystem(RigidContactSystem(
         dp.plant, pairs, scenario.contact, options,
         wrench_bodies=("chaser",),

@@ -170,6 +170,12 @@ def stewart_deflection(dp: DockingPlant, plant_context):
     return x, RollPitchYaw(X_AC.rotation()).vector()
 
 
+def stewart_force(dp: DockingPlant, plant_context) -> np.ndarray:
+    """The Stewart element's force on the target APDS (N, world frame): the translational part
+    of the bushing's spatial force on its frame C."""
+    return dp.bushing.CalcBushingSpatialForceOnFrameC(plant_context).translational()
+
+
 def stewart_history(dp: DockingPlant, X) -> tuple[np.ndarray, np.ndarray]:
     """The Stewart element's stroke |x| (m, the translational deflection of
     `stewart_deflection`) and the magnitude of its force on the target APDS (N) at each plant
@@ -179,7 +185,7 @@ def stewart_history(dp: DockingPlant, X) -> tuple[np.ndarray, np.ndarray]:
     for k, x in enumerate(X):
         dp.plant.SetPositionsAndVelocities(pc, x)
         stroke[k] = np.linalg.norm(stewart_deflection(dp, pc)[0])
-        force[k] = np.linalg.norm(dp.bushing.CalcBushingSpatialForceOnFrameC(pc).translational())
+        force[k] = np.linalg.norm(stewart_force(dp, pc))
     return stroke, force
 
 

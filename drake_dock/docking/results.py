@@ -8,7 +8,8 @@ lambda_n[N,12]; lambda_t[N,12,2];
 u[N,12,3] (couple parameters, unused entries 0); p1_W[N,12,3], p2_W[N,12,3]; frame_W[N,12,3,3]
 (columns ta, tb, n: the contact frame, n from the couple's body 2 to its body 1; the identity
 for far couples); stewart_x[N,3] (m), stewart_rpy[N,3] (rad) (the Stewart element's deflection,
-`drake_dock.docking.plant.stewart_deflection`); sample_kind[N]
+`drake_dock.docking.plant.stewart_deflection`); stewart_force_W[N,3] (N, its force on the
+target APDS in the world frame, `drake_dock.docking.plant.stewart_force`); sample_kind[N]
 (0 step end, 1 just before an impact, 2 just after); ring_distance[N]; energy[N,k] with
 energy_names[k]; impact_t[M], impact_couples[M,12] (bool), impact_normal_impulse[M,12],
 impact_tangential_impulse[M,12,2], impact_restitution[M].
@@ -23,7 +24,7 @@ from drake_dock.core.hybrid import Mode
 from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.outcome import misalignment
 from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
-                                      stewart_potential)
+                                      stewart_force, stewart_potential)
 from drake_dock.docking.scene import CHASER_APDS, scenario_pairs
 
 IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or sticking)
@@ -40,7 +41,7 @@ def timeseries(result) -> dict:
     v_WB, w_WB = np.zeros((N, 3, 3)), np.zeros((N, 3, 3))
     p_WA, R_WA = np.zeros((N, 2, 3)), np.zeros((N, 2, 3, 3))
     pe = np.zeros(N)
-    sx, srpy = np.zeros((N, 3)), np.zeros((N, 3))
+    sx, srpy, sf = np.zeros((N, 3)), np.zeros((N, 3)), np.zeros((N, 3))
     for k in range(N):
         plant.SetPositionsAndVelocities(pc, X[k])
         for j, name in enumerate(BODY_NAMES):
@@ -54,6 +55,7 @@ def timeseries(result) -> dict:
             p_WA[k, j], R_WA[k, j] = Xa.translation(), Xa.rotation().matrix()
         pe[k] = stewart_potential(dd.dp, pc)
         sx[k], srpy[k] = stewart_deflection(dd.dp, pc)
+        sf[k] = stewart_force(dd.dp, pc)
     C = np.asarray(rec.couples)
     S = COUPLE_SLICES
     status = C[:, :, S["status"]][..., 0].astype(np.int8)
@@ -76,7 +78,7 @@ def timeseries(result) -> dict:
         gap=C[:, :, S["gap"]][..., 0], lambda_n=C[:, :, S["lambda_n"]][..., 0],
         lambda_t=C[:, :, S["lambda_t"]], u=C[:, :, S["u"]], p1_W=C[:, :, S["p1"]],
         p2_W=C[:, :, S["p2"]], frame_W=C[:, :, S["frame"]].reshape(N, -1, 3, 3),
-        stewart_x=sx, stewart_rpy=srpy, sample_kind=np.asarray(rec.kind, dtype=np.int8),
+        stewart_x=sx, stewart_rpy=srpy, stewart_force_W=sf, sample_kind=np.asarray(rec.kind, dtype=np.int8),
         ring_distance=np.asarray(rec.ring_distance), energy=energy,
         energy_names=np.array(energy_names),
         impact_t=np.array([imp["t"] for imp in result.impacts], dtype=float),

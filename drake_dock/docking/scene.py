@@ -435,12 +435,14 @@ def _consistent_height(mismatch, s_max, cells=46):
     except ValueError:                                  # no sign change over the range
         pass
     grid = np.linspace(0.0, s_max, cells + 1)
-    f = [mismatch(x) for x in grid]
+    f_above = mismatch(grid[cells])                     # scanned from the top, evaluated lazily
     for k in range(cells - 1, -1, -1):
-        if f[k] == 0.0:
+        f_k = mismatch(grid[k])
+        if f_k == 0.0:
             return float(grid[k])
-        if f[k] * f[k + 1] < 0:
+        if f_k * f_above < 0:
             return brentq(mismatch, grid[k], grid[k + 1], xtol=1e-10)
+        f_above = f_k
     return None
 
 

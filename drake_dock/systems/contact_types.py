@@ -81,8 +81,11 @@ class ContactOptions:
     lzb_compiled: bool = True        # LZB impacts by the compiled kernel (`solve_lzb`'s
                                      # compiled; False: scipy's DOP853, the reference;
                                      # docs/performance.md, "The compiled LZB")
-    broad_phase: bool = False        # a far pair whose covers are at least track_distance
-                                     # apart is not sought (`Transitions.screen`)
+    broad_phase: bool | None = None  # a far pair whose covers are at least track_distance
+                                     # apart is not sought (`Transitions.screen`). None: the
+                                     # scene's policy (`docking.diagram.contact_options`: on
+                                     # for every pair set but paper); off where no scene
+                                     # resolves it (a contact system built directly)
 
 
 @dataclasses.dataclass

@@ -55,3 +55,20 @@ def test_broad_phase_equals_the_narrow_phase_bitwise(name, monkeypatch):
             assert np.array_equal(a, b)
         else:
             assert a == b
+
+
+@pytest.mark.parametrize("pairs, screens", [("complete", True), ("paper", False)])
+def test_options_a_caller_passes_take_the_scenes_broad_phase_policy(pairs, screens):
+    """Options passed to `build_docking_diagram` with other fields changed and broad_phase left
+    at its default: the complete set's far pairs are screened (the run's screening counters),
+    the paper's are all sought; an explicit False is kept."""
+    from drake_dock.docking.diagram import build_docking_diagram
+    from drake_dock.systems.contact_types import ContactOptions
+    s = load_scenario(data=f"contact: {{pairs: {pairs}}}")
+    dd = build_docking_diagram(s, options=ContactOptions(reseek_early=0.8, impact_rtol=1e-9))
+    assert dd.contact.options.broad_phase is screens
+    assert dd.contact.options.reseek_early == 0.8 and dd.contact.options.impact_rtol == 1e-9
+    r = simulate(s, dd=dd, duration=0.01)
+    assert (sum(r.timing["screens_per_pair"].values()) > 0) is screens
+    off = build_docking_diagram(s, options=ContactOptions(reseek_early=0.8, broad_phase=False))
+    assert off.contact.options.broad_phase is False

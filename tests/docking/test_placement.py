@@ -161,6 +161,39 @@ def test_the_fixed_point_is_a_root_or_the_jump_the_bracket_closes_on():
     assert _consistent_height(lambda s: 1.0 + s, 0.45) is None
 
 
+def _eager_grid_height(mismatch, s_max, cells=46):
+    """The grid fallback of `_consistent_height` evaluated everywhere before the scan (a second
+    implementation: the largest grid interval that changes sign, brentq on it)."""
+    from scipy.optimize import brentq
+    grid = np.linspace(0.0, s_max, cells + 1)
+    f = [mismatch(x) for x in grid]
+    changes = [k for k in range(cells) if f[k] == 0.0 or f[k] * f[k + 1] < 0]
+    if not changes:
+        return None
+    k = changes[-1]
+    return float(grid[k]) if f[k] == 0.0 else brentq(mismatch, grid[k], grid[k + 1], xtol=1e-10)
+
+
+@pytest.mark.parametrize("a, b", [(0.105, 0.455), (0.1, 0.3), (0.003, 0.2)])
+def test_the_grid_fallback_evaluates_from_the_top_and_stops_at_the_first_sign_change(a, b):
+    """mismatch(s) = (s - a)(s - b), positive at both ends of [0, 0.46] (no sign change for the
+    whole-range brentq): the fallback returns the upper root b (to xtol), the same bits as the
+    eager scan, and with b in the top grid interval it evaluates fewer than cells + 1 times."""
+    from drake_dock.docking.scene import _consistent_height
+    calls = []
+
+    def mismatch(s):
+        calls.append(s)
+        return (s - a) * (s - b)
+
+    s_max, cells = 0.46, 46
+    got = _consistent_height(mismatch, s_max, cells)
+    assert got == pytest.approx(b, abs=1e-9)
+    assert got == _eager_grid_height(lambda s: (s - a) * (s - b), s_max, cells)
+    if b > s_max * (cells - 1) / cells:
+        assert len(calls) < cells + 1
+
+
 def test_a_jump_of_the_first_contact_is_placed_and_its_offset_reported():
     """IDSS sample 29: the first contact jumps at the placement's fixed point, so no path has it
     exactly at the requested offset: the path at the jump is taken, and the ring centre's offset
