@@ -61,7 +61,7 @@ def _plant(gravity):
 
 
 def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restitution=0.0,
-                    plane_end=50.0, face="plane", edge=False,
+                    plane_end=50.0, face="plane", edge=False, edge_first=False,
                     options=ContactOptions()) -> SmallScene:
     """A uniform disk (rim = a Circle, C-S) on a plane inclined by theta, its axle along y;
     down-slope is +x; the plane patch ends at x = ``plane_end``. I_axle = m r^2 / 2.
@@ -69,7 +69,8 @@ def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restituti
     (u = (rho, theta), a polar parametrisation) centred at y = -``ANNULUS_CENTRE_Y``, so that the
     disk's path along x runs across it near rho = 5. With ``edge`` (on the plane) the plane's
     end is an edge too: the pair "rim_edge" (C-C, the segment x = plane_end) with a hand-over
-    from and to "rim_plane" (`drake_dock.core.handover`)."""
+    from and to "rim_plane" (`drake_dock.core.handover`), declared after it (``edge_first``:
+    before it, the pairs' other order)."""
     if face == "annulus" and edge:
         raise ValueError("disk_on_incline: the edge is the plane's (face='plane')")
     plant = _plant(G * np.array([math.sin(theta), 0.0, -math.cos(theta)]))
@@ -94,8 +95,9 @@ def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restituti
     handovers = []
     if edge:
         # The plane's parameters are (x + 50, y + 5); the segment's e gives y = 10 e - 5.
-        pairs.append(ContactPair("rim_edge", "CC", rim, circle, plant.world_frame(),
-                                 Segment([plane_end, -5.0, 0.0], [plane_end, 5.0, 0.0])))
+        pairs.insert(0 if edge_first else 1, ContactPair(
+            "rim_edge", "CC", rim, circle, plant.world_frame(),
+            Segment([plane_end, -5.0, 0.0], [plane_end, 5.0, 0.0])))
         handovers.append(Handover("rim_edge", "rim_plane", SurfaceEdge(
             0, True, lambda e: 10.0 * e, lambda f: 0.1 * f)))
     system = RigidContactSystem(plant, pairs, ContactLaw(mu=mu, mu_s=mu_s,

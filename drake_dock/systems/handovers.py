@@ -62,3 +62,13 @@ class HandoverLinks:
         that is not in contact; else None."""
         return next(((j, uj) for j, uj in self.due(i, u, n, R2)
                      if not states[j].mode.in_contact), None)
+
+
+def applied(due: dict) -> dict:
+    """The hand-overs an event makes of those due, {pair i: (pair j, j's couple)}, decided on the
+    states the event found (`HandoverLinks.target`): {j: i} where j takes the couple of the one
+    pair whose couple is due to it and does not hand its own couple on. A chain, an exchange or
+    two couples due to one pair wait for the next event (their couples are sought where they
+    leave their domains), so that no outcome depends on the pairs' order."""
+    targets = [j for j, _ in due.values()]
+    return {j: i for i, (j, _) in due.items() if j not in due and targets.count(j) == 1}

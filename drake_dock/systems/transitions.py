@@ -18,6 +18,7 @@ from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import (InputError, NumericalError, SeekingError, SingularCoupleError,
                                ZenoError)
+from drake_dock.systems.handovers import applied
 
 
 class Transitions:
@@ -40,31 +41,25 @@ class Transitions:
         ctx = ev.set_scratch(q, v)
         poses, twists = ev.frame_kinematics(ctx)
         initial = all(st.ref_X21 is None and st.mode == Mode.FAR for st in modes.pairs)
-        handed = {}         # pair handed to -> pair it continues (`drake_dock.core.handover`)
         # 1. Seeking: at initialisation, for far pairs whose clearance is used up, and for
         #    couples at a domain end or with a singular Jacobian; hand-overs between an edge
-        #    pair and a surface pair.
+        #    pair and a surface pair. Every decision reads the pairs' states as the pass found
+        #    them or as it leaves them, never half-way, so that it does not depend on the
+        #    pairs' order: the couples are evaluated and the hand-overs applied first, then the
+        #    pairs are sought, then the carried clearances are set.
+        couples, handed = self._handovers(modes.pairs, poses, twists, u)
+        sought = []         # (pair, `seek`'s return) of each seek
         for i, st in enumerate(modes.pairs):
-            sl = ev.couple_slice(i)
-            if i in handed:
+            if i in handed or i in handed.values():
                 continue
             if initial or (st.mode == Mode.FAR
                            and ev.far.bound(i, poses, st) >= early * st.clearance):
                 if not self.screen(i, poses, modes.pairs):
-                    self.seek(i, poses, modes.pairs, u, t, False, initial)
+                    sought.append((i, self.seek(i, poses, modes.pairs, u, t, False, initial)))
                 continue
             if st.mode == Mode.FAR:
                 continue
-            p = self.pairs[i]
-            a, b = ev.fidx[i]
-            c = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
-                                twists[b], u[sl], st.sigma)
-            u[sl] = c.u
-            to = ev.links.target(i, c.u, c.n, poses[b][0], modes.pairs)
-            if to is not None:
-                self.hand_over(i, *to, c.n, poses, modes.pairs, u)
-                handed[to[0]] = i
-                continue
+            p, c = self.pairs[i], couples[i]
             margin = np.concatenate([p.patch1.margin(c.u[:p.patch1.dim]),
                                      p.patch2.margin(c.u[p.patch1.dim:])]) / ev.spans[i]
             if c.conditioning <= opt.conditioning_min and st.mode.in_contact:
@@ -72,7 +67,9 @@ class Transitions:
                     f"the Jacobian of a couple in contact turned singular (Eq. 39 fails; "
                     f"conditioning {c.conditioning:.2e})", time=t, couples=[p.name])
             if margin.min() <= 0.0 or c.conditioning <= opt.conditioning_min:
-                self.seek(i, poses, modes.pairs, u, t, st.mode.in_contact)
+                sought.append((i, self.seek(i, poses, modes.pairs, u, t, st.mode.in_contact)))
+        for i, after in sought:
+            self.carry(i, after, modes.pairs)
         # 2. Impacts and 3. modes.
         n_impacts = len(modes.impacts)
         with self.timing.measure("impacts"):
@@ -87,6 +84,27 @@ class Transitions:
                                      pairs_plus=copy.deepcopy(modes.pairs),
                                      impact_loss_plus=modes.impact_loss)
         return x_new, modes
+
+    def _handovers(self, states, poses, twists, u) -> tuple[dict, dict]:
+        """The couples of the pairs that are not far (written into u) and their hand-overs
+        (`HandoverLinks.target` on the states the event found, `applied`), made (`hand_over`):
+        returns ({pair: its couple}, {pair handed to: pair it continues})."""
+        ev, due, couples = self.ev, {}, {}
+        for i, st in enumerate(states):
+            if st.mode == Mode.FAR:
+                continue
+            p, sl = self.pairs[i], ev.couple_slice(i)
+            a, b = ev.fidx[i]
+            c = couples[i] = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2,
+                                             poses[b], twists[b], u[sl], st.sigma)
+            u[sl] = c.u
+            to = ev.links.target(i, c.u, c.n, poses[b][0], states)
+            if to is not None:
+                due[i] = to
+        handed = applied(due)
+        for j, i in handed.items():
+            self.hand_over(i, j, due[i][1], couples[i].n, poses, states, u)
+        return couples, handed
 
     def screen(self, i, poses, states) -> bool:
         """The broad phase (``options.broad_phase``) for far pair i (`PairState` states[i]): when
@@ -130,13 +148,26 @@ class Transitions:
         """Sect. 5.1 for pair i (its `PairState` states[i], its couple written into u), and the
         mode that follows (`hybrid.after_seek`). At the initial seek a pair with a declared
         ``sigma`` whose couple lies on the wrong side by more than ``impact_gap_tol`` is
-        refused: the bodies start interpenetrating."""
+        refused: the bodies start interpenetrating. A couple due to a linked pair leaves the
+        pair far; whether that pair carries it is for `carry`, once the pass has set every
+        pair's state: returns ``carry``'s argument."""
         name = self.pairs[i].name
         with self.timing.measure("seeking"):
             try:
-                self._seek(i, poses, states, u, time, was_contact, initial)
+                return self._seek(i, poses, states, u, time, was_contact, initial)
             finally:
                 self.timing.count_seek(name)
+
+    def carry(self, i, after, states):
+        """The far clearance of sought pair i whose couple is due to linked pairs (``after`` =
+        (distance, crossing, was_contact, those pairs), `seek`'s return) that one of them
+        carries, i.e. is not far (`hybrid.after_seek`)."""
+        distance, crossing, was_contact, due = after
+        if any(states[j].mode != Mode.FAR for j in due):
+            opt, st = self.options, states[i]
+            st.mode, st.clearance = hybrid.after_seek(distance, False, crossing, was_contact,
+                                                      opt.track_distance, opt.reseek_floor,
+                                                      carried=True)
 
     def _seek(self, i, poses, states, u, time, was_contact, initial):
         ev, opt, p, st = self.ev, self.options, self.pairs[i], states[i]
@@ -177,15 +208,14 @@ class Transitions:
         # couple over the face) is the linked pair's, not this pair's.
         due = [j for j, _ in ev.links.due(i, uc, sigma * raw.n if usable else None,
                                           poses[b][0])]
-        carried = any(states[j].mode != Mode.FAR for j in due)
         mode, clearance = hybrid.after_seek(c.distance, usable and not due, crossing,
-                                            was_contact, opt.track_distance, opt.reseek_floor,
-                                            carried)
+                                            was_contact, opt.track_distance, opt.reseek_floor)
         if mode == Mode.TRACKED:
             st.sigma = sigma
         else:
             st.clearance = clearance
         st.mode, st.slide_dir = mode, None
+        return c.distance, crossing, was_contact, due
 
     def impacts_and_modes(self, t, modes, ctx, q, v, u, inputs, current, handed=None):
         """2. The LZB impact of the couples hit (Sect. 6) and 3. the modes of the contact set

@@ -3,6 +3,7 @@ frictionless off a plane's end onto the edge there (`disk_on_incline` with ``edg
 over the edge like a particle on a cylinder of radius r and leaves it at the closed-form angle
 cos(theta_c) = (2 + v0^2 / (g r)) / 3; the run between and after is checked against that closed
 form and energy conservation."""
+import copy
 import math
 
 import numpy as np
@@ -64,3 +65,98 @@ def test_disk_hands_over_to_the_edge_and_leaves_it_at_the_closed_form_angle(run)
     ke = 0.5 * sc.params["mass"] * V0 ** 2
     assert abs((e1[0] + e1[1]) - (e0[0] + e0[1])) < 1e-8 * ke
     assert sc.system.get_modes(ctx).impacts == []
+
+
+
+def _through_the_handover(edge_first):
+    """The frictionless disk of `run` with the pairs in the given order, past the hand-over
+    from the plane to the edge: its state, the couples (by name) and the seeks per pair."""
+    sc = disk_on_incline(0.0, mu=0.0, plane_end=END, edge=True, edge_first=edge_first)
+    r = sc.params["radius"]
+    sim, root, ctx = start(sc.system, lambda c: sc.set_state(
+        c, (np.eye(3), np.array([0, 0, r])), (np.zeros(3), np.array([V0, 0, 0]))))
+    sim.AdvanceTo(END / V0 + 0.02)
+    x = ctx.get_continuous_state_vector().CopyToVector()
+    couples = {n: couple(sc.system, ctx, n) for n in ("rim_plane", "rim_edge")}
+    return (x[:sc.system.nq + sc.system.nv], couples,
+            sc.system.timing.shares(1.0)["seeks_per_pair"])
+
+
+def _handover_event(edge_first):
+    """One event (`Transitions.resolve`) of the disk of `run`, pairs in the given order, moved
+    3 mm on from 2 mm before the plane's end, so that the plane pair's couple has passed the
+    edge, with the edge pair (far) due to be sought too (its clearance set to 0): per pair its
+    mode, sigma, distance and couple, the body state after and the seeks per pair."""
+    sc = disk_on_incline(0.0, mu=0.0, plane_end=END, edge=True, edge_first=edge_first)
+    system, r = sc.system, sc.params["radius"]
+    sim, root, ctx = start(system, lambda c: sc.set_state(
+        c, (np.eye(3), np.array([0, 0, r])), (np.zeros(3), np.array([V0, 0, 0]))))
+    sim.AdvanceTo(END / V0 - 2e-3)
+    x = ctx.get_continuous_state_vector().CopyToVector()
+    x[4] += 3e-3                                    # the disk's centre (q = [quaternion, p])
+    ctx.get_mutable_continuous_state_vector().SetFromVector(x)
+    modes = copy.deepcopy(system.get_modes(ctx))
+    names = [p.name for p in system.pairs]
+    modes.pairs[names.index("rim_edge")].clearance = 0.0
+    system.timing.reset()
+    x_new, after = system.transitions.resolve(ctx.get_time(), x, modes, system._inputs(ctx),
+                                              lambda: system._cache.Eval(ctx))
+    u = x_new[system.nq + system.nv:]
+    pairs = {n: (st.mode, st.sigma, st.distance, u[system.evaluator.couple_slice(k)])
+             for k, (n, st) in enumerate(zip(names, after.pairs))}
+    return pairs, x_new[:system.nq + system.nv], dict(system.timing.seeks)
+
+
+def test_an_event_hands_over_alike_whichever_pair_comes_first():
+    """At one event the plane pair's couple passes the edge and goes to the edge pair, declared
+    after it and before it (``edge_first``): the target is not sought in either order, and the
+    modes, sigmas, distances, couples and body state are the same."""
+    after, x_after, seeks_after = _handover_event(edge_first=False)
+    before, x_before, seeks_before = _handover_event(edge_first=True)
+    assert after["rim_edge"][0] == Mode.SLIDING and after["rim_plane"][0] == Mode.FAR
+    assert seeks_before == seeks_after and "rim_edge" not in seeks_after
+    for name in after:
+        assert before[name][:2] == after[name][:2], name
+        np.testing.assert_allclose(before[name][2], after[name][2], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(before[name][3], after[name][3], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(x_before, x_after, rtol=0, atol=1e-12)
+
+
+def test_the_handover_does_not_depend_on_the_pairs_order():
+    """The plane pair hands its couple to the edge pair declared after it (the `run` order) and
+    before it (``edge_first``): the same modes, couples, body state and seeks per pair over the
+    run (the edge pair far and carried by the plane pair before, whichever pair is sought
+    first at the initial event)."""
+    x_after, c_after, seeks_after = _through_the_handover(edge_first=False)
+    x_before, c_before, seeks_before = _through_the_handover(edge_first=True)
+    assert c_after["rim_edge"]["status"] == Mode.SLIDING
+    assert c_after["rim_plane"]["status"] == Mode.FAR
+    assert seeks_before == seeks_after
+    for name in c_after:
+        for k in ("status", "gap", "u", "lambda_n"):
+            np.testing.assert_allclose(c_before[name][k], c_after[name][k], rtol=0,
+                                       atol=1e-12, err_msg=f"{name} {k}")
+    np.testing.assert_allclose(x_before, x_after, rtol=0, atol=1e-12)
+
+
+def test_the_handovers_applied_do_not_depend_on_the_pairs_labels():
+    """`applied` on random hand-overs due among 6 pairs (single ones, chains, exchanges, two
+    couples due to one pair): relabelling the pairs relabels the hand-overs made, and each made
+    one is a pair taking the only couple due to it while not handing its own on."""
+    from drake_dock.systems.handovers import applied
+    rng = np.random.default_rng(5)
+    made_some = waited = 0
+    for _ in range(200):
+        n = 6
+        due = {int(i): (int(j), None) for i, j in zip(rng.permutation(n)[:rng.integers(0, 5)],
+                                                      rng.integers(0, n, size=5)) if i != j}
+        made = applied(due)
+        made_some += bool(made)
+        waited += len(made) < len(due)
+        for j, i in made.items():
+            assert due[i][0] == j and j not in due
+            assert [k for k, (t, _) in due.items() if t == j] == [i]
+        perm = rng.permutation(n)
+        relabelled = {int(perm[i]): (int(perm[j]), None) for i, (j, _) in due.items()}
+        assert applied(relabelled) == {int(perm[j]): int(perm[i]) for j, i in made.items()}
+    assert made_some > 50 and waited > 50
