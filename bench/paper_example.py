@@ -25,27 +25,58 @@ import tempfile
 import time
 
 import numpy as np
-from pydrake.systems.framework import DiagramBuilder
 
 from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.plant import add_docking_plant, set_initial_state
+from drake_dock.docking.plant import set_initial_state
 from drake_dock.core.kernels.compile_cache import warm
 from drake_dock.docking.scene import contact_approach, first_contact_seeks, initial_state
 from drake_dock.docking.simulate import simulate
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.systems.simulator import make_simulator
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from floors import empty_leaf_cost, free_flight  # noqa: E402  (a sibling bench module)
 
 
-def free_flight(scenario, state, t_end):
-    builder = DiagramBuilder()
-    dp = add_docking_plant(builder, scenario)
-    diagram = builder.Build()
-    sim = make_simulator(diagram, scenario.simulator_config, lambda root: set_initial_state(
-        dp, dp.plant.GetMyMutableContextFromRoot(root), state))
-    t0 = time.perf_counter()
-    sim.Initialize()
-    sim.AdvanceTo(t_end)
-    return time.perf_counter() - t0
+def drake_calls(dd, state, rows=3, repeats=2000):
+    """Wall seconds of the calls to Drake one evaluation of the contact system makes with the
+    plant as calculator (`drake_dock.systems.evaluation.PlantEvaluator.evaluate`) with ``rows``
+    contact rows, nothing else, timed in a loop at the initial state (best of 5): the scratch
+    state, every frame's pose and twist, per row two point Jacobians and two bias
+    accelerations, inverse dynamics twice, the force elements, the mass matrix and q'(v)."""
+    from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
+    ev = dd.contact.evaluator
+    plant, ctx, world = ev.plant, ev.ctx, ev.plant.world_frame()
+    pc = dd.dp.plant.CreateDefaultContext()
+    set_initial_state(dd.dp, pc, state)
+    q, v = dd.dp.plant.GetPositions(pc), dd.dp.plant.GetVelocities(pc)
+    zero, none, fe = np.zeros(ev.nv), MultibodyForces(plant), MultibodyForces(plant)
+    kv, pt = JacobianWrtVariable.kV, np.zeros(3)
+    pairs = ev.pairs[:rows]
+
+    def once():
+        plant.SetPositions(ctx, q)
+        plant.SetVelocities(ctx, v)
+        for f in ev.frames:
+            X, V = f.CalcPoseInWorld(ctx), f.CalcSpatialVelocityInWorld(ctx)
+            X.rotation().matrix(), X.translation(), V.rotational(), V.translational()
+        for p in pairs:
+            for f in (p.frame1, p.frame2):
+                plant.CalcJacobianTranslationalVelocity(ctx, kv, f, pt, world, world)
+                plant.CalcBiasTranslationalAcceleration(ctx, kv, f, pt, world, world)
+        plant.CalcInverseDynamics(ctx, zero, none)
+        plant.CalcForceElementsContribution(ctx, fe)
+        plant.CalcInverseDynamics(ctx, zero, fe)
+        plant.CalcMassMatrix(ctx)
+        plant.MapVelocityToQDot(ctx, v)
+
+    once()
+    best = np.inf
+    for _ in range(5):
+        t0 = time.perf_counter()
+        for _ in range(repeats):
+            once()
+        best = min(best, (time.perf_counter() - t0) / repeats)
+    return best
 
 
 def kernel_start(cache_dir):
@@ -115,7 +146,9 @@ def main():
         raise SystemExit("repeated runs differ: the simulation is not deterministic")
     walls = [x.wall_time for x in runs]
     wall = float(np.median(walls))
-    t_free = free_flight(scenario, state, r.end_time)
+    t_free, n_free = free_flight(scenario, state, r.end_time)
+    t_calls = drake_calls(dd, state)
+    t_leaf = empty_leaf_cost(scenario.simulator_config.integration_scheme)
     py = simulate(scenario, state=state, dd=python_path_diagram(scenario, dd))
     plain = None
     if not args.skip_plain:
@@ -169,6 +202,14 @@ def main():
           f"ratio {py.wall_time / wall:.2f}x")
     print(f"same plant without contact (Drake alone): {t_free:.4f} s")
     print(f"ratio to the plant alone: {wall / t_free:.0f}x")
+    per_eval = t_free / n_free + t_leaf + t_calls
+    print(f"floor of the plant as calculator: {1e6 * per_eval:.1f} us per evaluation (the "
+          f"plant's own {1e6 * t_free / n_free:.1f} us, an empty Python LeafSystem's "
+          f"{1e6 * t_leaf:.1f} us, the Drake calls of one contact evaluation with 3 rows "
+          f"{1e6 * t_calls:.1f} us); at drake_dock's {r.evaluations} evaluations "
+          f"{r.evaluations * per_eval:.4f} s, ratio floor to the plant alone "
+          f"{r.evaluations * per_eval / t_free:.1f}x; drake_dock is "
+          f"{wall / (r.evaluations * per_eval):.1f}x that floor")
     print(f"target: ratio to the plant alone <= 5x: "
           + ("met" if wall / t_free <= 5 else f"NOT met ({wall / t_free / 5:.1f}x over)"))
     print(f"target: set-up <= 0.02 s: "

@@ -19,12 +19,9 @@ Errors are relative to each metric's contact effect, as in the study
 import argparse
 import copy
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
-from pydrake.systems.analysis import SimulatorConfig
-from pydrake.systems.framework import LeafSystem
 
 from drake_dock.studies.compliant import (CompliantConfig, hunt_crossley_dissipation,
                                           run_compliant)
@@ -33,38 +30,9 @@ from drake_dock.docking.simulate import simulate
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.docking_metrics import (METRICS, compliant_metrics, contact_effect,
                                                 errors, rigid_metrics, scene_start)
-from drake_dock.systems.simulator import make_simulator
 
 sys.path.insert(0, str(Path(__file__).parent))
-from paper_example import free_flight  # noqa: E402  (a sibling bench script)
-
-
-class _Empty(LeafSystem):
-    """Two states, a derivative that copies numbers: the least a Python LeafSystem costs."""
-
-    def __init__(self):
-        super().__init__()
-        self.DeclareContinuousState(2)
-        self.n = 0
-
-    def DoCalcTimeDerivatives(self, context, derivatives):
-        self.n += 1
-        x = context.get_continuous_state_vector().CopyToVector()
-        derivatives.get_mutable_vector().SetFromVector([x[1], -1e4 * x[0]])
-
-
-def empty_leaf_cost(scheme, n_min=3000) -> float:
-    """Wall seconds per derivative evaluation of `_Empty` under ``scheme``."""
-    s = _Empty()
-    sim = make_simulator(s, SimulatorConfig(integration_scheme=scheme, accuracy=1e-3),
-                         lambda root: root.SetContinuousState([1.0, 0.0]))
-    t0 = time.perf_counter()
-    sim.Initialize()
-    t = 0.0
-    while s.n < n_min:
-        t += 0.1
-        sim.AdvanceTo(t)
-    return (time.perf_counter() - t0) / s.n
+from floors import empty_leaf_cost, free_flight  # noqa: E402  (a sibling bench module)
 
 
 def main():
@@ -101,7 +69,7 @@ def main():
             m = compliant_metrics(r, start)
             rows.append((cfg.label(), r.wall_time, err(m) if r.captured else None))
     leaf = empty_leaf_cost(scenario.simulator_config.integration_scheme)
-    t_free = free_flight(fast, state, ref["capture_time"])
+    t_free, _ = free_flight(fast, state, ref["capture_time"])
     print("coarse compliant runs (point contact, SAP), errors against drake_dock at 1e-8:")
     for label, wall, e in rows:
         es = ("no capture" if e is None else
