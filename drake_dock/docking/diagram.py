@@ -115,13 +115,12 @@ def contact_options(scenario, options: ContactOptions | None = None) -> ContactO
 
 
 def build_docking_diagram(scenario, meshcat=None, options=None,
-                          handovers=False) -> DockingDiagram:
+                          handovers=True) -> DockingDiagram:
     """The Diagram of the scenario, its contact system with `contact_options` (scenario,
     options): given options keep their fields, and a ``broad_phase`` left None takes the
     scene's policy as the default options do. ``handovers`` declares the edge/surface hand-overs
-    of the `complete` pairs (`pair_handovers`; docs/model.md, "Hand-over between an edge and a
-    surface"): off by default, because in the paper's geometry the ring's inside circle passes
-    exactly through the petal tips and the tracked couples there are handed back and forth."""
+    among the scenario's pairs (`pair_handovers`: those of the `complete` set; the paper's 12
+    have none; docs/model.md, "Hand-over between an edge and a surface")."""
     builder = DiagramBuilder()
     scene_graph = builder.AddSystem(SceneGraph())
     dp = make_docking_plant(scenario, scene_graph)

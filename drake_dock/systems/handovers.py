@@ -57,6 +57,14 @@ class HandoverLinks:
                 S = self.pairs[j].patch2
                 yield j, np.array(rule.to_surface(edge, 1, u, S.lower, S.upper))
 
+    def outward_rate(self, j, i, udot) -> float:
+        """The rate of surface pair j's held parameter at its edge shared with edge pair i,
+        from its couple's rate udot (Eq. 47), positive out of the domain."""
+        dim1 = self.pairs[j].patch1.dim
+        edge = next(e for k, e in self.of_surface[j] if k == i)
+        rate = float(udot[dim1 + edge.fixed])
+        return rate if edge.upper else -rate
+
     def target(self, i, u, n, R2, states):
         """Where pair i's couple is handed (`due`): (pair j, j's couple) for the first pair j
         that is not in contact; else None."""

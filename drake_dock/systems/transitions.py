@@ -99,12 +99,44 @@ class Transitions:
                                              poses[b], twists[b], u[sl], st.sigma)
             u[sl] = c.u
             to = ev.links.target(i, c.u, c.n, poses[b][0], states)
-            if to is not None:
+            if to is not None and self._accepts(i, to, c.n, poses, twists):
                 due[i] = to
         handed = applied(due)
         for j, i in handed.items():
             self.hand_over(i, j, due[i][1], couples[i].n, poses, states, u)
         return couples, handed
+
+    def _accepts(self, i, to, n, poses, twists) -> bool:
+        """Rules for a hand-over due from pair i (couple normal n) to pair j (``to`` = (j, j's
+        couple on the edge)), on j's couple there (Eq. 47, with the sigma that keeps n):
+        - j's couple must be regular (conditioning above ``conditioning_min``): a ring coaxial
+          with a petal's cone has no isolated couple with it, and a singular couple would
+          jump at its first projection.
+        - j's couple must be the same pair of points as i's: its closest-point conditions
+          (Eq. 37-38) hold there to within ``drift_tol`` of its domain (one Newton step moves
+          it less). They hold exactly at the guard's zero; a guard found negative at a later
+          event, after the couple went on along the edge, is past it.
+        When a rule fails, pair i keeps its couple; a surface couple past its edge is then
+        sought again, as at any domain end.
+        - edge to surface: j's couple must move into its domain, the rate of its held
+          parameter pointing inwards (`HandoverLinks.outward_rate` < 0). Otherwise it would
+          reach the edge again at once and be handed back: off contact the edge guard and the
+          surface couple's domain end need not agree, and a couple would go to and fro at
+          every event. It stays with the edge pair."""
+        ev = self.ev
+        j, uj = to
+        p = self.pairs[j]
+        a, b = ev.fidx[j]
+        still = (np.zeros(3),) * 2
+        raw = evaluate_couple(p.kind, p.patch1, poses[a], still, p.patch2, poses[b], still, uj,
+                              1.0, project=False)
+        cj = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
+                             twists[b], uj, handover.carried_sigma(n, raw.n))
+        if cj.conditioning <= self.options.conditioning_min:
+            return False
+        if (np.abs(cj.drift) / ev.spans[j]).max() > self.options.drift_tol:
+            return False
+        return i not in ev.links.of_edge or ev.links.outward_rate(j, i, cj.udot) < 0.0
 
     def screen(self, i, poses, states) -> bool:
         """The broad phase (``options.broad_phase``) for far pair i (`PairState` states[i]): when

@@ -51,6 +51,12 @@ def _cond(ev, E, st, i):
     return 1.0 if c is None else c.conditioning - ev.options.conditioning_min
 
 
+# The hand-over guard's witness fires at n . b = -GUARD_BAND: a couple that rides on the
+# switching surface (n . b = 0 to round-off, as where a symmetric motion keeps a ring's circle
+# over a petal's edge) does not trigger an event at every step.
+GUARD_BAND = 1e-9
+
+
 def _handover(ev, E, st, i):
     """The guard of an edge pair with a declared hand-over (`drake_dock.core.handover`): n . b,
     positive while its curve lies beyond the edge; at its zero the couple passes onto the
@@ -58,7 +64,7 @@ def _handover(ev, E, st, i):
     c = E.evals[i]
     if c is None:
         return 1.0
-    return ev.links.guard(i, c.n, c.u, E.poses[ev.fidx[i][1]][0])
+    return ev.links.guard(i, c.n, c.u, E.poses[ev.fidx[i][1]][0]) + GUARD_BAND
 
 
 def _lambda(ev, E, st, i):
