@@ -5,11 +5,13 @@ isolated couple with a cone and the edge guard of a symmetric motion sits at zer
 hand-over that falls due there is refused, and the run equals the run without hand-overs
 (second implementation: no pair can be handed over) to the integrator's tolerance; without
 the rules the same run hands couples to and fro and ends in a `DriftError`."""
+import math
+
 import pytest
 
 from drake_dock.docking.diagram import build_docking_diagram
 from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.scene import initial_state
+from drake_dock.docking.scene import contact_approach, initial_state
 from drake_dock.docking.simulate import simulate
 from drake_dock.errors import DriftError
 from drake_dock.systems.transitions import Transitions
@@ -49,3 +51,25 @@ def test_without_the_rules_the_couples_go_to_and_fro(scenario, monkeypatch):
     monkeypatch.setattr(Transitions, "_accepts", lambda self, *args: True)
     with pytest.raises(DriftError):
         _run(scenario, True)
+
+
+def test_the_complete_set_shifts_the_paper_example_by_its_first_contact(scenario):
+    """With the complete set the first contact of the paper example's approach is the rings'
+    inside circles grazing the other APDS's tip arcs, at the ring-face distance H (closed form:
+    the inside circle's radius is R - H cot(alpha1), the tip arcs' radius). The paper's pairs
+    close later, at their own first-contact distance, and nothing acts in between: every impact
+    and the capture are the paper pairs' run shifted by the difference of the two distances
+    over the closing speed (to 1e-6 s)."""
+    s, _ = scenario
+    g = s.geometry
+    assert abs(g.R - g.H / math.tan(g.alpha1) - g.Rs) <= 1e-12
+    paper = load_scenario()
+    _, lam_complete, closing = contact_approach(s)
+    _, lam_paper, _ = contact_approach(paper)
+    assert abs(lam_complete - g.H) <= 1e-9 and all("tip" in name for name in closing)
+    shift = (lam_complete - lam_paper) / s.initial.chaser_speed
+    r, ref = simulate(s), simulate(paper)
+    assert r.outcome == ref.outcome == "captured" and len(r.impacts) == len(ref.impacts) > 0
+    assert abs(r.capture_time - ref.capture_time - shift) <= 1e-6
+    for a, b in zip(r.impacts, ref.impacts):
+        assert a["couples"] == b["couples"] and abs(a["t"] - b["t"] - shift) <= 1e-6
