@@ -53,6 +53,11 @@ class PainleveError(NumericalError):
     """No consistent contact mode, or several (Painleve inconsistency or indeterminacy)."""
 
 
+class PainleveInconsistency(PainleveError):
+    """No consistent contact mode: the rigid model with this friction has no solution (the
+    contact system resolves it by an impact without collision unless told to stop)."""
+
+
 class SingularContactError(NumericalError):
     """The constraint equations of the contact set are singular (redundant or degenerate
     contact Jacobian); the rigid model cannot distribute the contact forces."""

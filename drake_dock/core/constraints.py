@@ -43,7 +43,8 @@ import math
 
 import numpy as np
 
-from drake_dock.errors import NumericalError, PainleveError, SingularContactError
+from drake_dock.errors import (NumericalError, PainleveError, PainleveInconsistency,
+                               SingularContactError)
 
 STICK, SLIDE, DETACH = "stick", "slide", "detach"
 MAX_ENUMERATED = 8
@@ -266,9 +267,9 @@ def select_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9
             near.append(sol)
     found = found or near
     if not found:
-        raise PainleveError("no consistent contact mode (Painleve inconsistency: the rigid "
-                            "model with this friction has no solution)", time=time,
-                            couples=names)
+        raise PainleveInconsistency(
+            "no consistent contact mode (Painleve inconsistency: the rigid model with this "
+            "friction has no solution)", time=time, couples=names)
     # Preference among consistent choices: more sticking couples, then more couples in contact.
     avoid = avoid or [()] * k
     found.sort(key=lambda s: (sum(m in a for m, a in zip(s.modes, avoid)),

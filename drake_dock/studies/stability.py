@@ -144,7 +144,9 @@ def stiffness_ratio_case(ratios, *, eta=1.5, log=print) -> dict:
 def high_friction_case(mus, *, scenario=None, docking_mus=(), log=print) -> dict:
     rod = []
     for mu in mus:
-        sc = painleve_rod(PAINLEVE_THETA, mu=mu)
+        # The rigid model alone: stop at the paradox (the contact system would otherwise
+        # resolve it by an impact without collision, `ContactOptions.painleve`).
+        sc = painleve_rod(PAINLEVE_THETA, mu=mu, options=ContactOptions(painleve="error"))
         X, V = painleve_state(sc)
         lam_cf, mu_c = painleve_closed_form(mu)
         try:

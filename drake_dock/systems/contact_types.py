@@ -76,6 +76,9 @@ class ContactOptions:
                                      # track_distance (`seek_couple`): their distance only sets
                                      # the clearance, which keeps track_distance / 2 in hand
     max_impacts: int = 10000
+    painleve: str = "impact"         # no consistent mode (`PainleveInconsistency`): "impact",
+                                     # an impact without collision (`drake_dock.core.iwc`), or
+                                     # "error", stop with it
     compiled: bool = True            # the couples, seeks, constraint solve and mode selection
                                      # by the compiled kernels (False: in Python)
     lzb_compiled: bool = True        # LZB impacts by the compiled kernel (`solve_lzb`'s

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from drake_dock.core import handover as rule
-from drake_dock.core.hybrid import Mode
+from drake_dock.core.couple import evaluate_couple
 
 
 class HandoverLinks:
@@ -80,3 +80,35 @@ def applied(due: dict) -> dict:
     leave their domains), so that no outcome depends on the pairs' order."""
     targets = [j for j, _ in due.values()]
     return {j: i for i, (j, _) in due.items() if j not in due and targets.count(j) == 1}
+
+
+def accepts(ev, i, to, n, poses, twists) -> bool:
+    """Rules for a hand-over due from pair i of the `PlantEvaluator` ``ev`` (couple normal n)
+    to pair j (``to`` = (j, j's couple on the edge)), on j's couple there (Eq. 47, with the
+    sigma that keeps n):
+    - j's couple must be regular (conditioning above ``conditioning_min``): a ring coaxial
+      with a petal's cone has no isolated couple with it, and a singular couple would jump at
+      its first projection.
+    - j's couple must be the same pair of points as i's: its closest-point conditions
+      (Eq. 37-38) hold there to within ``drift_tol`` of its domain (one Newton step moves it
+      less). They hold exactly at the guard's zero; a guard found negative at a later event,
+      after the couple went on along the edge, is past it.
+    - edge to surface: j's couple must move into its domain, the rate of its held parameter
+      pointing inwards (`HandoverLinks.outward_rate` < 0). Otherwise it would reach the edge
+      again at once and be handed back: off contact the edge guard and the surface couple's
+      domain end need not agree, and a couple would go to and fro at every event.
+    When a rule fails, pair i keeps its couple; a surface couple past its edge is then sought
+    again, as at any domain end."""
+    j, uj = to
+    p = ev.pairs[j]
+    a, b = ev.fidx[j]
+    still = (np.zeros(3),) * 2
+    raw = evaluate_couple(p.kind, p.patch1, poses[a], still, p.patch2, poses[b], still, uj,
+                          1.0, project=False)
+    cj = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
+                         twists[b], uj, rule.carried_sigma(n, raw.n))
+    if cj.conditioning <= ev.options.conditioning_min:
+        return False
+    if (np.abs(cj.drift) / ev.spans[j]).max() > ev.options.drift_tol:
+        return False
+    return i not in ev.links.of_edge or ev.links.outward_rate(j, i, cj.udot) < 0.0

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import copy
-import os
 
 import numpy as np
 
@@ -13,11 +12,11 @@ from drake_dock.core.couple import evaluate_couple
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import constraints as compiled_constraints
 from drake_dock.core.kernels import seek as compiled_seek
-from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
-from drake_dock.errors import (InputError, NumericalError, SeekingError, SingularCoupleError,
-                               ZenoError)
+from drake_dock.errors import (InputError, PainleveInconsistency, SeekingError,
+                               SingularCoupleError, ZenoError)
+from drake_dock.systems import handovers, impacts
 from drake_dock.systems.handovers import applied
 
 
@@ -99,44 +98,12 @@ class Transitions:
                                              poses[b], twists[b], u[sl], st.sigma)
             u[sl] = c.u
             to = ev.links.target(i, c.u, c.n, poses[b][0], states)
-            if to is not None and self._accepts(i, to, c.n, poses, twists):
+            if to is not None and handovers.accepts(ev, i, to, c.n, poses, twists):
                 due[i] = to
         handed = applied(due)
         for j, i in handed.items():
             self.hand_over(i, j, due[i][1], couples[i].n, poses, states, u)
         return couples, handed
-
-    def _accepts(self, i, to, n, poses, twists) -> bool:
-        """Rules for a hand-over due from pair i (couple normal n) to pair j (``to`` = (j, j's
-        couple on the edge)), on j's couple there (Eq. 47, with the sigma that keeps n):
-        - j's couple must be regular (conditioning above ``conditioning_min``): a ring coaxial
-          with a petal's cone has no isolated couple with it, and a singular couple would
-          jump at its first projection.
-        - j's couple must be the same pair of points as i's: its closest-point conditions
-          (Eq. 37-38) hold there to within ``drift_tol`` of its domain (one Newton step moves
-          it less). They hold exactly at the guard's zero; a guard found negative at a later
-          event, after the couple went on along the edge, is past it.
-        When a rule fails, pair i keeps its couple; a surface couple past its edge is then
-        sought again, as at any domain end.
-        - edge to surface: j's couple must move into its domain, the rate of its held
-          parameter pointing inwards (`HandoverLinks.outward_rate` < 0). Otherwise it would
-          reach the edge again at once and be handed back: off contact the edge guard and the
-          surface couple's domain end need not agree, and a couple would go to and fro at
-          every event. It stays with the edge pair."""
-        ev = self.ev
-        j, uj = to
-        p = self.pairs[j]
-        a, b = ev.fidx[j]
-        still = (np.zeros(3),) * 2
-        raw = evaluate_couple(p.kind, p.patch1, poses[a], still, p.patch2, poses[b], still, uj,
-                              1.0, project=False)
-        cj = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
-                             twists[b], uj, handover.carried_sigma(n, raw.n))
-        if cj.conditioning <= self.options.conditioning_min:
-            return False
-        if (np.abs(cj.drift) / ev.spans[j]).max() > self.options.drift_tol:
-            return False
-        return i not in ev.links.of_edge or ev.links.outward_rate(j, i, cj.udot) < 0.0
 
     def screen(self, i, poses, states) -> bool:
         """The broad phase (``options.broad_phase``) for far pair i (`PairState` states[i]): when
@@ -287,7 +254,7 @@ class Transitions:
                 raise ZenoError(f"more than max_impacts = {opt.max_impacts} impacts",
                                 time=t, couples=[self.pairs[i].name for i in hit])
             S = hybrid.impact_set(hit, [st.mode for st in states], vn)
-            v, vn_plus, approach = self.impact(t, modes, ctx, poses, evs, S, v)
+            v, vn_plus, approach = impacts.lzb_impact(ev, t, modes, ctx, poses, evs, S, v)
             for i, c in zip(S, hybrid.closed_after_impact(vn_plus, approach)):
                 if c:
                     closed.append(i)       # closed at the end of the impact: in contact
@@ -304,8 +271,21 @@ class Transitions:
         rows = [ev.row(i, evs[i], poses, ctx) for i in cand]
         M, Minv, a0, _, _ = ev.free_acceleration(ctx, v, inputs)
         select = compiled_constraints.select_modes if opt.compiled else select_modes
-        sol = select(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
-                     avoid=[() if hit else leaving.get(i, ()) for i in cand])
+        avoid = [() if hit else leaving.get(i, ()) for i in cand]
+        try:
+            sol = select(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
+                         avoid=avoid)
+        except PainleveInconsistency as paradox:
+            if opt.painleve != "impact":
+                raise
+            # The impact without collision (`drake_dock.core.iwc`), then the modes again.
+            v = impacts.without_collision(ev, t, modes, M, rows, v, paradox)
+            poses = evaluate_all(v)
+            ev.set_scratch(q, v)
+            rows = [ev.row(i, evs[i], poses, ctx) for i in cand]
+            M, Minv, a0, _, _ = ev.free_acceleration(ctx, v, inputs)
+            sol = select(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
+                         avoid=[()] * len(cand))
         cons = []
         for j, i in enumerate(cand):
             st = states[i]
@@ -324,31 +304,3 @@ class Transitions:
             v, removed = hybrid.project_velocity(M, Minv, np.column_stack(cons), v)
             modes.impact_loss += removed
         return v
-
-    def impact(self, t, modes, ctx, poses, evs, S, v):
-        """The LZB impact of the couples S (Sect. 6, with the Zeno guard), logged in
-        ``modes``; returns (v+, the couples' v_n+, the approach speed)."""
-        ev, opt, law = self.ev, self.options, self.law
-        rows = [ev.row(i, evs[i], poses, ctx) for i in S]
-        Wn = np.column_stack([r.Wn for r in rows])
-        Wt = np.column_stack([r.Wt for r in rows])
-        M = ev.plant.CalcMassMatrix(ctx)
-        approach = float(-min(r.vn for r in rows))
-        e = hybrid.zeno_restitution(approach, law.restitution, opt.zeno_speed)
-        try:
-            res = solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt, mu=law.mu,
-                            mu_s=ev.mu_s, law=law.impact_law, rtol=opt.impact_rtol,
-                            compiled=opt.lzb_compiled)
-        except NumericalError as err:
-            if os.environ.get("DRAKE_DOCK_DUMP_LZB"):
-                np.savez(os.environ["DRAKE_DOCK_DUMP_LZB"], M=M, Wn=Wn, Wt=Wt, v=v, e=e)
-            raise NumericalError(f"{err} (approach speed {approach:.3e} m/s)", time=t,
-                                 couples=[self.pairs[i].name for i in S]) from None
-        lost = res.kinetic_energy_minus - res.kinetic_energy_plus
-        modes.impacts.append({"t": t, "couples": [self.pairs[i].name for i in S],
-                              "restitution": e,
-                              "normal_impulse": res.normal_impulse.tolist(),
-                              "tangential_impulse": res.tangential_impulse.tolist(),
-                              "energy_lost": lost})
-        modes.impact_loss += lost
-        return res.v_plus, Wn.T @ res.v_plus, approach

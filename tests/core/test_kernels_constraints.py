@@ -10,7 +10,8 @@ import pytest
 
 from drake_dock.core import constraints as ref
 from drake_dock.core.kernels import constraints as KC
-from drake_dock.errors import NumericalError, PainleveError, SingularContactError
+from drake_dock.errors import (NumericalError, PainleveInconsistency,
+                               SingularContactError)
 from test_constraints import G, OMEGA, random_scene, rod
 
 FIELDS = ("vdot", "lam_n", "lam_t", "generalized_force")
@@ -140,7 +141,7 @@ def test_select_modes_equals_the_reference(scene):
     # The scenes reach every mode (and, on general scenes, the Painleve paradox).
     assert {ref.SLIDE, ref.DETACH} <= kinds
     if scene == "general":
-        assert {ref.STICK, "PainleveError"} <= kinds
+        assert {ref.STICK, "PainleveInconsistency"} <= kinds
 
 
 def rod_critical_mu(theta):
@@ -163,7 +164,7 @@ def test_painleve_rod_on_both_sides_of_the_critical_friction(factor):
     a, b = results
     assert_same_outcome(a, b)
     if factor > 1:
-        assert a[0] is PainleveError and "no consistent" in a[1]
+        assert a[0] is PainleveInconsistency and "no consistent" in a[1]
     else:
         assert a.modes == (ref.SLIDE,)
         c, sn = math.cos(theta), math.sin(theta)

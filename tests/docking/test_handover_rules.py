@@ -1,4 +1,4 @@
-"""The rules that keep a hand-over from going to and fro (`Transitions._accepts`): on the
+"""The rules that keep a hand-over from going to and fro (`drake_dock.systems.handovers.accepts`): on the
 paper example with `contact.pairs: complete` and the edge/surface hand-overs declared, the
 ring's circles stay clear of the petals while the rings are coaxial, where a circle has no
 isolated couple with a cone and the edge guard of a symmetric motion sits at zero. Every
@@ -14,7 +14,7 @@ from drake_dock.docking.scenario import load_scenario
 from drake_dock.docking.scene import contact_approach, initial_state
 from drake_dock.docking.simulate import simulate
 from drake_dock.errors import DriftError
-from drake_dock.systems.transitions import Transitions
+from drake_dock.systems import handovers
 
 COMPLETE = "contact: {pairs: complete}"
 
@@ -32,13 +32,13 @@ def _run(scenario, handovers):
 
 def test_refused_handovers_leave_the_run_unchanged(scenario, monkeypatch):
     decided = []
-    accepts = Transitions._accepts
+    accepts = handovers.accepts
 
-    def counted(self, *args):
-        decided.append(accepts(self, *args))
+    def counted(*args):
+        decided.append(accepts(*args))
         return decided[-1]
 
-    monkeypatch.setattr(Transitions, "_accepts", counted)
+    monkeypatch.setattr(handovers, "accepts", counted)
     r = _run(scenario, True)
     ref = _run(scenario, False)
     assert len(decided) > 0 and not any(decided)
@@ -48,7 +48,7 @@ def test_refused_handovers_leave_the_run_unchanged(scenario, monkeypatch):
 
 
 def test_without_the_rules_the_couples_go_to_and_fro(scenario, monkeypatch):
-    monkeypatch.setattr(Transitions, "_accepts", lambda self, *args: True)
+    monkeypatch.setattr(handovers, "accepts", lambda *args: True)
     with pytest.raises(DriftError):
         _run(scenario, True)
 

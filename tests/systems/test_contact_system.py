@@ -223,9 +223,9 @@ def painleve_A(p, s):
     return 1 / p["mass"] + l * c * (l * c + p["mu"] * s * (l * sn + rho)) / p["I"]
 
 
-def painleve_start(mu, omega=0.0):
+def painleve_start(mu, omega=0.0, options=ContactOptions()):
     theta = math.radians(30.0)
-    sc = painleve_rod(theta, mu=mu)
+    sc = painleve_rod(theta, mu=mu, options=options)
     p = sc.params
     l, rho = p["l"], p["rho"]
     ax = np.array([math.cos(theta), 0, math.sin(theta)])
@@ -240,12 +240,75 @@ def painleve_start(mu, omega=0.0):
 
 def test_painleve_inconsistency_is_reported():
     """mu = 3 at 30 deg: A < 0 for the tip sliding towards -x and gravity pushes the tip into
-    the plane (b < 0): no consistent mode."""
-    sc, X, V, _ = painleve_start(3.0)
+    the plane (b < 0): no consistent mode; with ``painleve="error"`` the run stops there."""
+    sc, X, V, _ = painleve_start(3.0, options=ContactOptions(painleve="error"))
     assert painleve_A(sc.params, -1.0) < 0
     with pytest.raises(PainleveError, match="tip_plane") as err:
         start(sc.system, lambda c: sc.set_state(c, X, V))
     assert err.value.time == 0.0
+
+
+def _tip_impulse(p, v_tip):
+    """The planar sticking impulse (P_x, P_z) at the rod's tip that stops the tip's velocity
+    v_tip = (v_x, v_z), and the kinetic energy it takes: for a planar body, a point impulse P
+    at r = (r_x, r_z) from the mass centre changes the point's velocity by K P with
+    K = I2 / m + [r_z, -r_x]^T [r_z, -r_x] / I, so P = -K^-1 v_tip (Cramer's rule) and the
+    loss is v_tip . K^-1 v_tip / 2."""
+    th, l, rho = p["theta"], p["l"], p["rho"]
+    rx, rz = -l * math.cos(th), -(l * math.sin(th) + rho)
+    a, b = 1 / p["mass"] + rz * rz / p["I"], -rz * rx / p["I"]
+    d = 1 / p["mass"] + rx * rx / p["I"]
+    det = a * d - b * b
+    Px = -(d * v_tip[0] - b * v_tip[1]) / det
+    Pz = -(-b * v_tip[0] + a * v_tip[1]) / det
+    return Px, Pz, -0.5 * (Px * v_tip[0] + Pz * v_tip[1])
+
+
+def test_painleve_inconsistency_is_an_impact_without_collision():
+    """The same rod with the default ``painleve="impact"``: at t = 0 an impact without
+    collision (Genot and Brogliato) stops the tip. Its impulse and energy loss are the planar
+    closed form's (to 1e-9), inside the cone (|P_t| <= mu P_n); the tip then sticks and the rod
+    pivots about it, and the energy ledger (kinetic + potential + impact loss + friction loss)
+    stays closed (to 1e-8 of the initial energy) through 0.3 s."""
+    sc, X, V, _ = painleve_start(3.0)
+    sim, root, ctx = start(sc.system, lambda c: sc.set_state(c, X, V))
+    imp = sc.system.get_modes(ctx).impacts
+    assert len(imp) == 1 and imp[0]["without_collision"] and imp[0]["t"] == 0.0
+    Px, Pz, lost = _tip_impulse(sc.params, (-1.0, 0.0))
+    assert Pz > 0 and abs(Px) <= sc.params["mu"] * Pz
+    np.testing.assert_allclose(imp[0]["normal_impulse"], [Pz], rtol=1e-9)
+    np.testing.assert_allclose(imp[0]["tangential_impulse"][0][0], Px, rtol=1e-9)
+    np.testing.assert_allclose(imp[0]["energy_lost"], lost, rtol=1e-9)
+    e0 = energy(sc.system, ctx)
+    total0 = e0[0] + e0[1] + lost
+    for T in (0.1, 0.3):
+        sim.AdvanceTo(T)
+        c = couple(sc.system, ctx, "tip_plane")
+        assert c["status"] == Mode.STICKING and np.abs(c["vt"]).max() < 1e-9
+        e = energy(sc.system, ctx)
+        assert abs(e[0] + e[1] + e[5] + e[2] - total0) <= 1e-8 * total0
+
+
+def test_impact_without_collision_on_the_planar_rod():
+    """`impact_without_collision` on the rod's planar rows (mass centre translation and the
+    spin about y) against the planar closed form: the impulse to 1e-12 and the tip stopped;
+    for a tip moving up and forward the sticking impulse would pull (P_z < 0): None."""
+    from drake_dock.core.iwc import impact_without_collision
+    sc, _, _, _ = painleve_start(3.0)
+    p = sc.params
+    Px, Pz, _ = _tip_impulse(p, (1.0, 0.5))
+    assert Pz < 0
+    th, l, rho = p["theta"], p["l"], p["rho"]
+    rx, rz = -l * math.cos(th), -(l * math.sin(th) + rho)
+    # Generalized velocity (v_x, v_y, v_z, omega_y), the tip's rows n = z and t = (x, y).
+    M = np.diag([p["mass"], p["mass"], p["mass"], p["I"]])
+    Wn = np.array([[0.0], [0.0], [1.0], [-rx]])
+    Wt = np.array([[1.0, 0.0], [0.0, 1.0], [0.0, 0.0], [rz, 0.0]])
+    assert impact_without_collision(M, Wn, Wt, np.array([1.0, 0.0, 0.5, 0.0]), 3.0) is None
+    res = impact_without_collision(M, Wn, Wt, np.array([-1.0, 0.0, 0.0, 0.0]), 3.0)
+    np.testing.assert_allclose([res.P_t[0, 0], res.P_n[0]], _tip_impulse(p, (-1.0, 0.0))[:2],
+                               rtol=1e-12)
+    assert abs(res.P_t[0, 1]) <= 1e-15 and np.abs(Wn.T @ res.v_plus).max() < 1e-15
 
 
 def test_painleve_indeterminacy_is_reported():

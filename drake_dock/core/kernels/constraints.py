@@ -23,7 +23,8 @@ from numba import njit, types
 from numba.extending import intrinsic
 
 from drake_dock.core import constraints as ref
-from drake_dock.errors import NumericalError, PainleveError, SingularContactError
+from drake_dock.errors import (NumericalError, PainleveError, PainleveInconsistency,
+                               SingularContactError)
 
 STICK, SLIDE, DETACH = 0, 1, 2
 CODE = {ref.STICK: STICK, ref.SLIDE: SLIDE, ref.DETACH: DETACH}
@@ -376,9 +377,9 @@ def select_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9
         np.ascontiguousarray(Minv, dtype=float), np.asarray(a0, dtype=float), W, bias, gap, vn,
         vt, mu, mu_s, av, float(v_slip), float(omega), float(rtol), ref.TIE_RTOL)
     if st == NONE_CONSISTENT:
-        raise PainleveError("no consistent contact mode (Painleve inconsistency: the rigid "
-                            "model with this friction has no solution)", time=time,
-                            couples=names)
+        raise PainleveInconsistency(
+            "no consistent contact mode (Painleve inconsistency: the rigid model with this "
+            "friction has no solution)", time=time, couples=names)
     modes = tuple(NAME[m] for m in M_[best])
     if st == INDETERMINATE:
         raise PainleveError(
