@@ -29,7 +29,8 @@ import math
 import numpy as np
 
 from drake_dock.core.handover import SurfaceEdge
-from drake_dock.core.patches import Annulus, Arc, Circle, Cone, PolarCurve, Reparametrized
+from drake_dock.core.patches import (Annulus, Arc, Circle, Cone, Point, PolarCurve,
+                                     Reparametrized)
 from drake_dock.errors import InputError
 
 # The contact sets a docking scene names (`contact.pairs`; `drake_dock.docking.scene.apds_pairs`):
@@ -281,6 +282,22 @@ def ring_face(g: ApdsGeometry) -> Annulus:
     return Annulus(g.Rs, g.R, 0.0)
 
 
+# The radius of a petal corner (the paper gives none): the corner is a sphere of this radius
+# about the point where a guide side meets its tip arc (docs/model.md, "The petal corner").
+CORNER_RADIUS = 1e-3
+
+
+def petal_corner(g: ApdsGeometry, i: int) -> Point:
+    """The corner at the top of guide side i (zeta = H), where it meets the tip arc of its
+    petal: the tip arc's lower end for odd i, its upper end for even i; a `Point` of radius
+    `CORNER_RADIUS`."""
+    if i not in range(1, 7):
+        raise InputError("petal corner", i, "1..6")
+    tip = tip_arc(g, (i + 1) // 2)
+    th = tip.lower if i % 2 else tip.upper
+    return Point(tip.position(th), CORNER_RADIUS)
+
+
 @dataclasses.dataclass
 class ApdsPatches:
     sides: dict      # i -> guide side n_i
@@ -289,12 +306,14 @@ class ApdsPatches:
     tips: dict       # k -> tip arc of petal k
     rim: Circle      # outside circle of the ring
     face: Annulus    # the ring's face
+    corners: dict = dataclasses.field(default_factory=dict)   # i -> corner at side i's top
 
 
 def apds_patches(g: ApdsGeometry) -> ApdsPatches:
     return ApdsPatches({i: guide_side(g, i) for i in range(1, 7)},
                        {k: guide_surface(g, k) for k in (1, 2, 3)}, ring_circle(g),
-                       {k: tip_arc(g, k) for k in (1, 2, 3)}, ring_rim(g), ring_face(g))
+                       {k: tip_arc(g, k) for k in (1, 2, 3)}, ring_rim(g), ring_face(g),
+                       {i: petal_corner(g, i) for i in range(1, 7)})
 
 
 # Visual mesh --------------------------------------------------------------------------------

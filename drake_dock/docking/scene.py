@@ -33,7 +33,7 @@ class PairSpec:
     points from Body 2 to Body 1 (Definition 2)."""
 
     name: str
-    kind: str            # "CC" or "CS"
+    kind: str            # "CC", "CS" or "PC" (a point on Body 1)
     body1: str
     patch1: Patch
     body2: str
@@ -61,6 +61,8 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         pairs += edge_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
         pairs += tip_surface_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
         pairs += tip_surface_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
+        pairs += corner_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
+        pairs += corner_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
     return pairs
 
 
@@ -78,6 +80,15 @@ def edge_pairs(P, one, other) -> list[PairSpec]:
     out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
     out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
     return out
+
+
+def corner_pairs(P, one, other) -> list[PairSpec]:
+    """APDS ``other``'s six petal corners (Body 1, `petal_corner`) against APDS ``one``'s
+    ring inside circle (Body 2), pc_<Y>corner<i>_<X>ring (point-curve, kind "PC"; X the ring's
+    APDS, Y the corner's): corner i is where guide side i meets its tip arc."""
+    (x, b_ring), (y, b_corner) = one, other
+    return [PairSpec(f"pc_{y}corner{i}_{x}ring", "PC", b_corner, P.corners[i], b_ring, P.ring)
+            for i in range(1, 7)]
 
 
 def tip_surface_pairs(P, one, other, R) -> list[PairSpec]:
@@ -237,7 +248,7 @@ def travel_grid(g: ApdsGeometry, approach: Approach, step=None):
 
 
 # Covers of the search (`drake_dock.core.covers`): cells per parameter and per block.
-COVER_CELLS = {1: (256, 16), 2: (32, 8)}
+COVER_CELLS = {0: (1, 1), 1: (256, 16), 2: (32, 8)}
 
 
 def pair_covers(pr: PairSpec):

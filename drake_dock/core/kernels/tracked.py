@@ -11,9 +11,11 @@ from drake_dock.core.kernels.jets import N_PARAMS, patch_spec
 
 
 class TrackedCouples:
-    """Pairs given as (kind "CC"/"CS", patch1, patch2, (frame index 1, frame index 2)).
-    `supported` is False when a patch has no kernel description (`patch_spec`); the caller
-    then evaluates the couples in Python."""
+    """Pairs given as (kind "CC"/"CS"/"PC", patch1, patch2, (frame index 1, frame index 2)).
+    `supported` is False when a patch of a C-C or C-S pair has no kernel description
+    (`patch_spec`); the caller then evaluates the couples in Python. The kernels have no
+    point-curve couple: the "PC" pairs are listed in ``python`` and left to the caller's
+    Python path (`drake_dock.core.couple.evaluate_couple`), whatever ``supported``."""
 
     def __init__(self, pairs):
         k = len(pairs)
@@ -24,7 +26,11 @@ class TrackedCouples:
         self.spans = np.ones((k, 3))
         self.dims = np.zeros(k, dtype=np.int64)
         self.supported = True
+        self.python = [i for i, (kind, *_) in enumerate(pairs) if kind == "PC"]
         for i, (kind, p1, p2, (a, b)) in enumerate(pairs):
+            if kind == "PC":
+                self.dims[i] = p1.dim + p2.dim
+                continue
             s1, s2 = patch_spec(p1), patch_spec(p2)
             if s1 is None or s2 is None or p1.dim != 1 or p2.dim != (1 if kind == "CC" else 2):
                 self.supported = False
