@@ -50,7 +50,7 @@ import numpy as np
 
 # One couple is evaluated in plain floats (3-tuples); its frame and the frame's rates by the
 # compiled code the couple kernels share (`drake_dock.core.kernels.frames`).
-from drake_dock.core.kernels.frames import frame_rates_cc, frame_rates_cs
+from drake_dock.core.kernels.frames import frame_rates_cc, frame_rates_cs, frame_rates_pc
 from drake_dock.core.vec3 import add as _add, axpy as _axpy, cross as _cr, dot as _dot, \
     rot as _rot, sub as _sub
 from drake_dock.errors import SingularCoupleError
@@ -273,8 +273,9 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
 
 def _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, project):
     """`evaluate_couple` for kind "PC" (module docstring): patch 1 a `Point`, patch 2 a curve,
-    u = (s,). The rates follow as for C-C: s' = -Ft / Fu (Eq. 47 with F = t2 . d), d' = v_rel -
-    t2 s', n' = sigma (d' - dh (dh . d')) / |d| (dh = d / |d|), c = -(w2 x t2) s' (Eq. 52)."""
+    u = (s,). s' = -Ft / Fu (Eq. 47 with F = t2 . d); the frame and its rates from d' = v_rel -
+    t2 s' and t2' = w2 x t2 + k2 s' (`frame_rates_pc`: n' = sigma (d' - dh (dh . d')) / |d|,
+    dh = d / |d|; c = -(w2 x t2) s', Eq. 52)."""
     (R1, p1o), (R2, p2o) = _pose(X1), _pose(X2)
     w1, v1 = (float_vec(x) for x in V1)
     w2, v2 = (float_vec(x) for x in V2)
@@ -309,17 +310,8 @@ def _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, projec
     # Eq. (47); a singular Fu (p on a circle's axis) gives zero, reported by `conditioning`.
     sdot = -Ft / Fu if cond > 1e-14 else 0.0
     sig = float(sigma)
-    dh = (d[0] / dist, d[1] / dist, d[2] / dist)
-    n = (sig * dh[0], sig * dh[1], sig * dh[2])
-    ddot = _axpy(-sdot, t2, v_rel)
-    a = _dot(dh, ddot)
-    ndot = tuple(sig * (x - a * y) / dist for x, y in zip(ddot, dh))
-    lt = math.sqrt(_dot(t2, t2))
-    ta = (t2[0] / lt, t2[1] / lt, t2[2] / lt)
-    t2dot = _axpy(sdot, k2, w2t2)
-    b = _dot(ta, t2dot)
-    tadot = tuple((x - b * y) / lt for x, y in zip(t2dot, ta))
-    conv = (-sdot * w2t2[0], -sdot * w2t2[1], -sdot * w2t2[2])
+    n, ndot, ta, tadot, conv = frame_rates_pc(d, t2, _axpy(-sdot, t2, v_rel),
+                                              _axpy(sdot, k2, w2t2), tuple(w2), sdot, sig)
     tb = _cr(n, ta)
     tbdot = _add(_cr(ndot, ta), _cr(n, tadot))
     return CoupleEval(

@@ -15,6 +15,7 @@ from drake_dock.core.constraints import (SLIDE, STICK, ContactRow, friction_powe
 from drake_dock.core.couple import evaluate_couple, float_pose, float_vec
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels.couples import DRIFT_REL as KERNEL_DRIFT_REL
+from drake_dock.core.kernels.couples import GAP as KERNEL_GAP
 from drake_dock.errors import DriftError, SingularCoupleError
 from drake_dock.systems.contact_types import Evaluation
 from drake_dock.systems.far_pairs import FarPairs
@@ -148,6 +149,11 @@ class PlantEvaluator:
                                          np.array([V[0] for V in twists]),
                                          np.array([V[1] for V in twists]), u, sigma, active,
                                          drift_feedback=fb)
+        for i in self.kernel.pc.tolist():
+            if active[i] and math.isnan(out[i, KERNEL_GAP]):
+                raise SingularCoupleError("point-curve couple: the point lies on the curve "
+                                          "(|d| = 0), its normal is undefined", time=t,
+                                          couples=[self.pairs[i].name])
         rel = out[:, KERNEL_DRIFT_REL]
         if (rel > self.options.drift_tol).any():
             i = int(np.argmax(rel > self.options.drift_tol))
