@@ -282,20 +282,28 @@ def ring_face(g: ApdsGeometry) -> Annulus:
     return Annulus(g.Rs, g.R, 0.0)
 
 
-# The radius of a petal corner (the paper gives none): the corner is a sphere of this radius
-# about the point where a guide side meets its tip arc (docs/model.md, "The petal corner").
+# The petal corner's sphere (the paper gives no rounding): radius r, its centre 2 r outward of
+# the corner along the APDS radius, so that a coaxial ring circle of radius Rs = R - H cot
+# alpha1, which passes exactly through the corners, clears it by r (docs/model.md, "The petal
+# corner").
 CORNER_RADIUS = 1e-3
 
 
-def petal_corner(g: ApdsGeometry, i: int) -> Point:
+def corner_point(g: ApdsGeometry, i: int) -> np.ndarray:
     """The corner at the top of guide side i (zeta = H), where it meets the tip arc of its
-    petal: the tip arc's lower end for odd i, its upper end for even i; a `Point` of radius
-    `CORNER_RADIUS`."""
+    petal: the tip arc's lower end for odd i, its upper end for even i."""
     if i not in range(1, 7):
         raise InputError("petal corner", i, "1..6")
     tip = tip_arc(g, (i + 1) // 2)
-    th = tip.lower if i % 2 else tip.upper
-    return Point(tip.position(th), CORNER_RADIUS)
+    return tip.position(tip.lower if i % 2 else tip.upper)
+
+
+def petal_corner(g: ApdsGeometry, i: int) -> Point:
+    """The sphere of petal corner i (`corner_point`): radius `CORNER_RADIUS`, centred 2
+    `CORNER_RADIUS` outward of the corner along the APDS radius."""
+    c = corner_point(g, i)
+    out = np.array([c[0], c[1], 0.0]) / math.hypot(c[0], c[1])
+    return Point(c + 2.0 * CORNER_RADIUS * out, CORNER_RADIUS)
 
 
 @dataclasses.dataclass

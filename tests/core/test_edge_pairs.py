@@ -14,7 +14,7 @@ from drake_dock.core.kernels.jets import jet, patch_spec
 from drake_dock.core.kernels.tracked import TrackedCouples
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
-from drake_dock.docking.apds import ApdsGeometry, apds_patches
+from drake_dock.docking.apds import ApdsGeometry, apds_patches, corner_point
 from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec
 from edge_scenes import (CORNER, arc_over_cone, rim_over_face, ring_over_arc, ring_over_segment,
                          tip_handover)
@@ -178,8 +178,16 @@ def test_complete_set_names_and_patches(geom):
             assert (pc.patch2.radius, pc.patch2.height) == (geom.Rs, 0.0)
             side = P.sides[i]
             ends = side.position(np.array([side.lower, side.upper]))
-            np.testing.assert_allclose(pc.patch1.p, ends[np.argmax(ends[:, 2])], atol=1e-15)
-            assert pc.patch1.p[2] == pytest.approx(geom.H, abs=1e-15)
+            corner = ends[np.argmax(ends[:, 2])]      # the side's top, on the tip arc
+            np.testing.assert_allclose(corner_point(geom, i), corner, atol=1e-15)
+            r = pc.patch1.radius
+            assert r > 0 and pc.patch1.p[2] == pytest.approx(geom.H, abs=1e-15)
+            # The sphere's centre 2 r outward: a coaxial ring circle of radius
+            # R - H cot(alpha1) passes the corner at distance 2 r from it.
+            rho = math.hypot(*pc.patch1.p[:2])
+            assert rho == pytest.approx(math.hypot(*corner[:2]) + 2 * r, abs=1e-15)
+            (a, b), (c, d) = pc.patch1.p[:2], corner[:2]
+            assert a * d - b * c == pytest.approx(0.0, abs=1e-15)
     side = new["cc_Cring_T3"]
     assert side.kind == "CC" and type(side.patch2) is type(P.sides[3])
     for patch, expected in ((side.patch2, P.sides[3]), (side.patch1, P.ring)):

@@ -183,3 +183,53 @@ def test_compiled_kernel_equals_python(r_pt):
     out, _ = on.evaluate(X, np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)),
                          np.array([0.0]), np.ones(1), np.ones(1, dtype=np.bool_))
     assert math.isnan(on.couple_eval(out, 0).gap)
+
+
+def test_scene_corner_pairs_random_poses_raise_only_typed_errors():
+    """The 12 corner pairs of `contact.pairs: complete` at seeded random chaser poses (tilt to
+    20 deg, offsets to 0.3 m, ring distances -0.2 to 0.4 m, any roll) and with the corner
+    placed on the ring's axis and on the circle: the seek, the contact-form finish and the
+    evaluation give finite results in the domain or a typed error, never a Python or numpy
+    one."""
+    from drake_dock.docking.apds import ApdsGeometry
+    from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec, rot_z
+    from drake_dock.errors import DrakeDockError
+    pairs = [p for p in apds_pairs(ApdsGeometry(), "complete") if p.kind == "PC"]
+    assert len(pairs) == 12
+    rng = np.random.default_rng(18)
+    usable = 0
+    for pr in pairs:
+        for _ in range(20):
+            R = rot_vec(rng.uniform(-0.35, 0.35, 3) * (1, 1, 0)) @ rot_z(rng.uniform(-1, 1)) \
+                @ R_MATCHED
+            poses = {"target_apds": (np.eye(3), np.zeros(3)),
+                     "chaser_apds": (R, np.array([*rng.uniform(-0.3, 0.3, 2),
+                                                  rng.uniform(-0.2, 0.4)]))}
+            X1, X2 = poses[pr.body1], poses[pr.body2]
+            V = (rng.normal(size=3) * 0.1, rng.normal(size=3) * 0.1)
+            try:
+                c = seek_couple(posed(pr.patch1, *X1), posed(pr.patch2, *X2))
+                assert np.isfinite(c.distance) and 0.0 <= c.u2[0] < 2 * math.pi
+                f = contact_couple("PC", pr.patch1, X1, pr.patch2, X2, c, conditioning_min=1e-6)
+                if f.usable:
+                    usable += 1
+                    ev = evaluate_couple("PC", pr.patch1, X1, V, pr.patch2, X2, V, f.u, 1.0)
+                    assert np.all(np.isfinite(ev.udot)) and math.isfinite(ev.bias_n)
+                    assert ev.gap == pytest.approx(c.distance, abs=1e-12)
+            except DrakeDockError:
+                pass
+    assert usable > 100
+    # Degenerate: the corner on the other ring's axis, and on its circle.
+    pr = pairs[0]
+    p = pr.patch1.p
+    for o in (np.array([p[0], p[1], p[2] - 0.3]),
+              p - np.array([pr.patch2.radius, 0.0, 0.0])):
+        X2 = (np.eye(3), o)
+        c = seek_couple(posed(pr.patch1, np.eye(3), np.zeros(3)), posed(pr.patch2, *X2))
+        f = contact_couple("PC", pr.patch1, (np.eye(3), np.zeros(3)), pr.patch2, X2, c,
+                           conditioning_min=1e-6)
+        try:
+            evaluate_couple("PC", pr.patch1, (np.eye(3), np.zeros(3)), V, pr.patch2, X2, V,
+                            f.u, 1.0)
+        except SingularCoupleError:
+            pass
