@@ -28,7 +28,9 @@ the corner lies outside its sphere's tube about the curve), g = sigma |d| - r, t
 Its Jacobian is the scalar Fu = k2 . d - t2 . t2 (for a circle of radius R, -R rho_p with
 rho_p the distance of p from the axis: singular on the axis, where every s is closest); its
 conditioning is |Fu| / (t2 . t2 + |k2| |d|). d = 0 (the corner on the curve, r deeper than a
-touch) has no normal: `SingularCoupleError`.
+touch) has no normal: `SingularCoupleError`. A point-curve couple is a potential contact only
+with the point on the concave side of the curve (`point_curve_side`; docs/model.md, "The petal
+corner").
 
 Relative velocity (Eq. 23-25) of the material points at the couple, v_rel = v_1(P_1) - v_2(P_2);
 g' = n . v_rel exactly at the couple (the points' own motion along the tangents is
@@ -154,6 +156,15 @@ def _pc_conditioning(Fu, d, T2, K2):
     t2, k2 = T2[0], K2[0][0]
     den = _dot(t2, t2) + math.sqrt(_dot(k2, k2) * _dot(d, d))
     return abs(Fu[0][0]) / den if den > 0 else 0.0
+
+
+def point_curve_side(patch2, R2, s, n) -> float:
+    """The cosine between a point-curve couple's normal n (world) and the curve's curvature
+    direction c''(s) (its frame turned by R2): positive while the point lies on the concave
+    side of the curve, inside a circle's passage (1 where the curve is straight)."""
+    k = _rot(float_pose((R2, (0.0, 0.0, 0.0)))[0], patch2.jet([float(s)])[2][0][0])
+    nk = math.sqrt(_dot(k, k))
+    return _dot(float_vec(n), k) / nk if nk > 0.0 else 1.0
 
 
 def float_pose(X):

@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from drake_dock.core import vec3 as v3
-from drake_dock.core.couple import closest_point_conditions
+from drake_dock.core.couple import closest_point_conditions, point_curve_side
 from drake_dock.core.patches import Circle
 from drake_dock.errors import SeekingError
 
@@ -327,7 +327,9 @@ def seek_point_curve(P1, P2, *, n_grid=64, max_iter=30) -> Couple:
     form: s is the polar angle of p projected onto the circle's plane (in P2's frame), and with
     p on the axis (every s is closest) s = 0, a couple that is not isolated (its conditioning is
     0, `contact_couple` refuses it). Otherwise a grid of ``n_grid`` points over the domain,
-    finished by Newton on F = t2 . d (Eq. 37 for a point) clipped to the domain."""
+    finished by Newton on F = t2 . d (Eq. 37 for a point) clipped to the domain. The couple is
+    ``interior`` only inside the curve's domain and with p on its concave side (inside a
+    circle's passage, `point_curve_side`): elsewhere it is not a potential contact."""
     pt, curve = P1.patch, P2.patch
     p = P1.position(np.zeros(0))
     q = P2.R.T @ (p - P2.p)                      # p in the curve's frame
@@ -354,11 +356,14 @@ def seek_point_curve(P1, P2, *, n_grid=64, max_iter=30) -> Couple:
                 break
         s = curve.wrap(s)
     p2 = P2.position(s)
-    dist = float(np.linalg.norm(p - p2)) - pt.radius
+    d = p - p2
+    dist = float(np.linalg.norm(d)) - pt.radius
     if not math.isfinite(dist):
         raise SeekingError("no finite distance between the point and the curve (a non-finite "
                            "pose)")
-    return Couple(np.zeros(0), s, p, p2, dist, it, is_interior(curve, s))
+    # A potential contact only on the curve's concave side (`point_curve_side`).
+    concave = point_curve_side(curve, P2.R, s[0], d) > 0.0
+    return Couple(np.zeros(0), s, p, p2, dist, it, is_interior(curve, s) and concave)
 
 
 def is_interior(patch, u, rtol=1e-9) -> bool:
@@ -395,7 +400,8 @@ def contact_couple(kind, patch1, X1, patch2, X2, c: Couple, *, conditioning_min,
     u0 = c.u
     n1 = patch1.dim
     if not c.interior:
-        return ContactCouple(u0, False, "the closest couple lies on a domain end")
+        return ContactCouple(u0, False, "the closest couple lies on a domain end (a point-curve "
+                                        "couple: or on the curve's convex side)")
     _, _, cond = closest_point_conditions(kind, patch1, X1, patch2, X2, u0, conditioning=True)
     if not cond > 10 * conditioning_min:
         return ContactCouple(u0, False, f"the couple is not isolated (J conditioning "

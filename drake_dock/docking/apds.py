@@ -282,10 +282,10 @@ def ring_face(g: ApdsGeometry) -> Annulus:
     return Annulus(g.Rs, g.R, 0.0)
 
 
-# The petal corner's sphere (the paper gives no rounding): radius r, its centre 2 r outward of
-# the corner along the APDS radius, so that a coaxial ring circle of radius Rs = R - H cot
-# alpha1, which passes exactly through the corners, clears it by r (docs/model.md, "The petal
-# corner").
+# The petal corner's sphere (the paper gives no rounding): radius r through the corner, its
+# centre r outward of it along the APDS radius, so that a coaxial ring circle of radius
+# Rs = R - H cot alpha1, which passes exactly through the corners, has the centre on its convex
+# side (docs/model.md, "The petal corner").
 CORNER_RADIUS = 1e-3
 
 
@@ -299,11 +299,12 @@ def corner_point(g: ApdsGeometry, i: int) -> np.ndarray:
 
 
 def petal_corner(g: ApdsGeometry, i: int) -> Point:
-    """The sphere of petal corner i (`corner_point`): radius `CORNER_RADIUS`, centred 2
-    `CORNER_RADIUS` outward of the corner along the APDS radius."""
+    """The sphere of petal corner i (`corner_point`): radius `CORNER_RADIUS`, centred
+    `CORNER_RADIUS` outward of the corner along the APDS radius (the sphere passes through
+    the corner)."""
     c = corner_point(g, i)
     out = np.array([c[0], c[1], 0.0]) / math.hypot(c[0], c[1])
-    return Point(c + 2.0 * CORNER_RADIUS * out, CORNER_RADIUS)
+    return Point(c + CORNER_RADIUS * out, CORNER_RADIUS)
 
 
 @dataclasses.dataclass

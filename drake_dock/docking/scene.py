@@ -29,8 +29,8 @@ CC_SIDE_PAIRS = ((1, 5), (2, 4), (3, 3), (4, 2), (5, 1), (6, 6))
 
 @dataclasses.dataclass(frozen=True)
 class PairSpec:
-    """A potential contact pair. Body 1 carries the curve (Sect. 4.3); the normal of its couple
-    points from Body 2 to Body 1 (Definition 2)."""
+    """A potential contact pair. Body 1 carries the curve (Sect. 4.3), or the point of a
+    point-curve pair; the normal of its couple points from Body 2 to Body 1 (Definition 2)."""
 
     name: str
     kind: str            # "CC", "CS" or "PC" (a point on Body 1)
@@ -45,8 +45,10 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     2.2 and 8.1, six guide side vs guide side (C-C, Body 1 = the chaser's side, as in Sect. 3.2),
     three chaser-ring vs target-surface and three target-ring vs chaser-surface (C-S, Body 1 =
     the ring). ``complete`` adds, for each APDS against the other (`edge_pairs`): the ring's
-    inside circle vs each guide side and each tip arc (C-C), and the ring's outside circle vs
-    the other ring's face (C-S)."""
+    inside circle vs each guide side and each tip arc (C-C), the ring's outside circle vs
+    the other ring's face (C-S), the tip arcs vs the guide surfaces they can face (C-S,
+    `tip_surface_pairs`) and the other APDS's petal corners vs the ring's inside circle
+    (point-curve, `corner_pairs`)."""
     if which not in PAIR_SETS:
         raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)

@@ -76,6 +76,8 @@ class PlantEvaluator:
             from drake_dock.core.kernels import constraints as solver
             self.solver = solver
         self.far = FarPairs(pairs, self.fidx)
+        # The point-curve pairs: their side witness (`witnesses`).
+        self.side_pairs = frozenset(i for i, p in enumerate(self.pairs) if p.kind == "PC")
         self.links = HandoverLinks(self.pairs, handovers)
         self.evaluations = 0
         self._zero_v = np.zeros(self.nv)         # never written

@@ -182,10 +182,10 @@ def test_complete_set_names_and_patches(geom):
             np.testing.assert_allclose(corner_point(geom, i), corner, atol=1e-15)
             r = pc.patch1.radius
             assert r > 0 and pc.patch1.p[2] == pytest.approx(geom.H, abs=1e-15)
-            # The sphere's centre 2 r outward: a coaxial ring circle of radius
-            # R - H cot(alpha1) passes the corner at distance 2 r from it.
+            # The sphere's centre r outward: the sphere passes through the corner, and a
+            # coaxial ring circle of radius R - H cot(alpha1) has its centre on the convex side.
             rho = math.hypot(*pc.patch1.p[:2])
-            assert rho == pytest.approx(math.hypot(*corner[:2]) + 2 * r, abs=1e-15)
+            assert rho == pytest.approx(math.hypot(*corner[:2]) + r, abs=1e-15)
             (a, b), (c, d) = pc.patch1.p[:2], corner[:2]
             assert a * d - b * c == pytest.approx(0.0, abs=1e-15)
     side = new["cc_Cring_T3"]

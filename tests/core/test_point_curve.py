@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from drake_dock.core.couple import closest_point_conditions, evaluate_couple
+from drake_dock.core.couple import closest_point_conditions, evaluate_couple, point_curve_side
 from drake_dock.core.patches import Arc, Circle, Point, posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import SingularCoupleError
@@ -52,6 +52,13 @@ def test_point_passing_circle_distance_and_normal(m1, r_pt):
         assert abs(ev.ta @ (X2[0] @ np.array([-math.sin(s), math.cos(s), 0.0]))) \
             == pytest.approx(1.0, abs=1e-12)
         assert ev.conditioning > 0.0
+        # The side: the cosine of n with the curvature direction -e_rho, (R - rho_p) / |d|;
+        # a potential contact (``interior``) only inside the passage, rho_p < R.
+        q = X2[0].T @ (p - X2[1])
+        rho_p = math.hypot(q[0], q[1])
+        side = (R_C - rho_p) / math.sqrt((rho_p - R_C) ** 2 + q[2] ** 2)
+        assert point_curve_side(ring, X2[0], c.u2[0], ev.n) == pytest.approx(side, abs=1e-12)
+        assert c.interior == (rho_p < R_C)
 
 
 @pytest.mark.parametrize("m1", MOVING)
