@@ -240,3 +240,4 @@ def test_scene_corner_pairs_random_poses_raise_only_typed_errors():
                             f.u, 1.0)
         except SingularCoupleError:
             pass
+
