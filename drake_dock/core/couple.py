@@ -12,6 +12,7 @@ degenerate):
 
     CC:  F = [t1 . d,  t2 . d]
     CS:  F = [s_u . d,  s_v . d,  t1 . N],   N = s_u x s_v
+    PC:  F = [t2 . d]                  (patch 1 a point p, `Point`; u = (s,) of the curve)
 
 Where the gap is not zero they are the conditions of minimal distance (d parallel to the normal,
 perpendicular to the curve tangents). Their Jacobian Fu = dF/du is the paper's J of Eq. (40);
@@ -20,6 +21,16 @@ Eq. (47) follows from dF/dt = 0 along the motion: u' = -Fu^-1 (dF/dt at fixed u)
 Contact frame (Definition 2): n = sigma N/|N| (CS) or sigma (t1 x t2)/|t1 x t2| (CC), sigma = +-1
 fixed when the pair becomes potential so that n points from Body 2 to Body 1 (docs/model.md);
 tangents ta = s_u/|s_u| (CS) or t2/|t2| (CC), tb = n x ta. Signed gap g = n . d.
+
+Point-curve ("PC", a petal corner against a ring's inside circle): patch 1 is a point p (a
+sphere of radius r, `drake_dock.core.patches.Point`), d = p - c(s); n = sigma d/|d| (sigma = +1:
+the corner lies outside its sphere's tube about the curve), g = sigma |d| - r, ta = t2/|t2|.
+Its Jacobian is the scalar Fu = k2 . d - t2 . t2 (for a circle of radius R, -R rho_p with
+rho_p the distance of p from the axis: singular on the axis, where every s is closest); its
+conditioning is |Fu| / (t2 . t2 + |k2| |d|). d = 0 (the corner on the curve, r deeper than a
+touch) has no normal: `SingularCoupleError`. A point-curve couple is a potential contact only
+with the point on the concave side of the curve (`point_curve_side`; docs/model.md, "The petal
+corner").
 
 Relative velocity (Eq. 23-25) of the material points at the couple, v_rel = v_1(P_1) - v_2(P_2);
 g' = n . v_rel exactly at the couple (the points' own motion along the tangents is
@@ -41,9 +52,10 @@ import numpy as np
 
 # One couple is evaluated in plain floats (3-tuples); its frame and the frame's rates by the
 # compiled code the couple kernels share (`drake_dock.core.kernels.frames`).
-from drake_dock.core.kernels.frames import frame_rates_cc, frame_rates_cs
+from drake_dock.core.kernels.frames import frame_rates_cc, frame_rates_cs, frame_rates_pc
 from drake_dock.core.vec3 import add as _add, axpy as _axpy, cross as _cr, dot as _dot, \
     rot as _rot, sub as _sub
+from drake_dock.errors import SingularCoupleError
 
 
 def _solve(A, b):
@@ -104,6 +116,10 @@ def _geometry(patch, R, u):
 
 
 def _residual(kind, d, T1, K1, T2, K2):
+    if kind == "PC":
+        # The analogue of Eq. (37) for a point: d (p - c(s)) . t2 = 0; d/ds = k2 . d - t2 . t2.
+        t2, k2 = T2[0], K2[0][0]
+        return [_dot(t2, d)], [[_dot(k2, d) - _dot(t2, t2)]]
     t1, k1 = T1[0], K1[0][0]
     if kind == "CC":
         t2, k2 = T2[0], K2[0][0]
@@ -134,6 +150,23 @@ def _conditioning(Fu, T1, T2):
     return abs(_det(Fu)) / den if den > 0 else 0.0
 
 
+def _pc_conditioning(Fu, d, T2, K2):
+    """|Fu| / (t2 . t2 + |k2| |d|) in [0, 1] of a point-curve couple: 1 with p on the curve, 0
+    with p on a circle's axis (the couple is not isolated)."""
+    t2, k2 = T2[0], K2[0][0]
+    den = _dot(t2, t2) + math.sqrt(_dot(k2, k2) * _dot(d, d))
+    return abs(Fu[0][0]) / den if den > 0 else 0.0
+
+
+def point_curve_side(patch2, R2, s, n) -> float:
+    """The cosine between a point-curve couple's normal n (world) and the curve's curvature
+    direction c''(s) (its frame turned by R2): positive while the point lies on the concave
+    side of the curve, inside a circle's passage (1 where the curve is straight)."""
+    k = _rot(float_pose((R2, (0.0, 0.0, 0.0)))[0], patch2.jet([float(s)])[2][0][0])
+    nk = math.sqrt(_dot(k, k))
+    return _dot(float_vec(n), k) / nk if nk > 0.0 else 1.0
+
+
 def float_pose(X):
     """A pose (R, p) as (rows of R as lists, p as a tuple) of floats, the form the couple
     evaluation works in; a pose already in that form is returned as is."""
@@ -162,7 +195,9 @@ def closest_point_conditions(kind, patch1, X1, patch2, X2, u, *, conditioning=Fa
     d = _sub(_add(r1, p1), _add(r2, p2))
     F, Fu = _residual(kind, d, T1, K1, T2, K2)
     if conditioning:
-        return np.array(F), np.array(Fu), _conditioning(Fu, T1, T2)
+        cond = (_pc_conditioning(Fu, d, T2, K2) if kind == "PC"
+                else _conditioning(Fu, T1, T2))
+        return np.array(F), np.array(Fu), cond
     return np.array(F), np.array(Fu)
 
 
@@ -171,6 +206,8 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
     """Evaluates the couple whose state is ``u_state`` for body poses X_i = (R_i, p_i) and
     twists V_i = (w_i, v_i). With ``project`` one Newton step on F(u) = 0 corrects the drift of
     the integrated couple before anything else is computed (its size is returned)."""
+    if kind == "PC":
+        return _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, project)
     n1 = patch1.dim
     (R1, p1o), (R2, p2o) = _pose(X1), _pose(X2)
     w1, v1 = (float_vec(x) for x in V1)
@@ -243,3 +280,56 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
         u=U[0], drift=U[1], residual=residual, udot=U[2], conditioning=cond, p1=V[0],
         p2=V[1], n=V[2], ta=V[3], tb=V[4], gap=_dot(n, d), v_rel=V[5],
         vn=_dot(n, v_rel), vt=T[0], bias_n=_dot(n, conv) + _dot(ndot, v_rel), bias_t=T[1])
+
+
+def _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, project):
+    """`evaluate_couple` for kind "PC" (module docstring): patch 1 a `Point`, patch 2 a curve,
+    u = (s,). s' = -Ft / Fu (Eq. 47 with F = t2 . d); the frame and its rates from d' = v_rel -
+    t2 s' and t2' = w2 x t2 + k2 s' (`frame_rates_pc`: n' = sigma (d' - dh (dh . d')) / |d|,
+    dh = d / |d|; c = -(w2 x t2) s', Eq. 52)."""
+    (R1, p1o), (R2, p2o) = _pose(X1), _pose(X2)
+    w1, v1 = (float_vec(x) for x in V1)
+    w2, v2 = (float_vec(x) for x in V2)
+    r1 = _rot(R1, patch1.jet(())[0])
+    P1 = _add(r1, p1o)
+    u0 = [float(a) for a in u_state]
+
+    def at(s):
+        r2, (t2,), ((k2,),) = _geometry(patch2, R2, [s])
+        d = _sub(P1, _add(r2, p2o))
+        (F,), ((Fu,),) = _residual("PC", d, None, None, (t2,), ((k2,),))
+        return r2, t2, k2, d, F, Fu
+
+    s = u0[0]
+    r2, t2, k2, d, F, Fu = at(s)
+    residual = abs(F)
+    cond = _pc_conditioning([[Fu]], d, (t2,), ((k2,),))
+    ds = 0.0
+    if project and residual > 0.0 and cond > 1e-14:
+        ds = -F / Fu
+        s += ds
+        r2, t2, k2, d, F, Fu = at(s)
+        cond = _pc_conditioning([[Fu]], d, (t2,), ((k2,),))
+    dist = math.sqrt(_dot(d, d))
+    if not dist > 0.0:
+        raise SingularCoupleError("point-curve couple: the point lies on the curve (|d| = 0), "
+                                  "its normal is undefined")
+    P2 = _add(r2, p2o)
+    v_rel = _sub(_add(v1, _cr(w1, r1)), _add(v2, _cr(w2, r2)))
+    w2t2 = _cr(w2, t2)
+    Ft = _dot(w2t2, d) + _dot(t2, v_rel)
+    # Eq. (47); a singular Fu (p on a circle's axis) gives zero, reported by `conditioning`.
+    sdot = -Ft / Fu if cond > 1e-14 else 0.0
+    sig = float(sigma)
+    n, ndot, ta, tadot, conv = frame_rates_pc(d, t2, _axpy(-sdot, t2, v_rel),
+                                              _axpy(sdot, k2, w2t2), tuple(w2), sdot, sig)
+    tb = _cr(n, ta)
+    tbdot = _add(_cr(ndot, ta), _cr(n, tadot))
+    return CoupleEval(
+        u=np.array([s]), drift=np.array([ds]), residual=residual, udot=np.array([sdot]),
+        conditioning=cond, p1=np.array(P1), p2=np.array(P2), n=np.array(n), ta=np.array(ta),
+        tb=np.array(tb), gap=sig * dist - patch1.radius, v_rel=np.array(v_rel),
+        vn=_dot(n, v_rel), vt=np.array((_dot(ta, v_rel), _dot(tb, v_rel))),
+        bias_n=_dot(n, conv) + _dot(ndot, v_rel),
+        bias_t=np.array((_dot(ta, conv) + _dot(tadot, v_rel),
+                         _dot(tb, conv) + _dot(tbdot, v_rel))))

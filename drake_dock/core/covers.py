@@ -110,9 +110,14 @@ def cell_slabs(patch, U, half):
 
 def patch_cover(patch, n: int, block: int) -> Cover:
     """The cover of ``patch`` with n cells per parameter in blocks of ``block`` per parameter
-    (`block_layout`), with slabs for a surface; kept on the patch."""
+    (`block_layout`), with slabs for a surface (a point: its sphere); kept on the patch."""
     cache = patch.__dict__.setdefault("_covers", {})
     hit = cache.get((n, block))
+    if hit is None and patch.dim == 0:
+        # A `Point` (a sphere of radius ``radius``): one cell, the sphere itself.
+        hit = cache[(n, block)] = Cover.from_cells(patch.position(np.zeros((1, 0))),
+                                                   np.array([patch.radius]),
+                                                   np.zeros((1, 1), dtype=np.int64))
     if hit is None:
         U, half, blocks = block_layout(patch, n, block)
         slabs = cell_slabs(patch, U, half) if patch.dim == 2 else (None, None)

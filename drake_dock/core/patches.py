@@ -145,6 +145,37 @@ class Circle(Patch):
         return (R * c, R * s, self.height), ((-R * s, R * c, 0.0),), (((-R * c, -R * s, 0.0),),)
 
 
+class Point(Patch):
+    """A point ``p`` of its frame (a 0-D patch, u = ()), rounded to a sphere of radius
+    ``radius`` >= 0 (a petal corner, `drake_dock.core.couple`, kind "PC"): its couple with a
+    curve has the gap |p - c(s)| - radius."""
+
+    dim = 0
+    periodic = ()
+
+    def __init__(self, p, radius: float = 0.0):
+        self.p = np.asarray(p, dtype=float).reshape(3)
+        self.radius = float(radius)
+        self.lower = np.zeros(0)
+        self.upper = np.zeros(0)
+
+    def position(self, u):
+        u = np.asarray(u, dtype=float)
+        return np.broadcast_to(self.p, u.shape[:-1] + (3,)).copy()
+
+    def first(self, u):
+        return np.zeros(np.asarray(u).shape[:-1] + (3, 0))
+
+    def second(self, u):
+        return np.zeros(np.asarray(u).shape[:-1] + (3, 0, 0))
+
+    def jet(self, u):
+        return tuple(self.p.tolist()), (), ()
+
+    def grid(self, n):
+        return np.zeros((1, 0))
+
+
 class Arc(Circle):
     """Arc of the circle of radius ``radius`` in the plane z = ``height`` of its frame, centred
     on the z axis, for theta in ``theta_range`` (a petal's tip arc); u = (theta,), bounded."""

@@ -15,7 +15,8 @@ import math
 import numpy as np
 
 from drake_dock.core import vec3 as v3
-from drake_dock.core.couple import closest_point_conditions
+from drake_dock.core.couple import closest_point_conditions, point_curve_side
+from drake_dock.core.patches import Circle
 from drake_dock.errors import SeekingError
 
 
@@ -297,6 +298,8 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, **grid_options) 
     """The couple of minimal distance between posed patches P1 and P2 (Sect. 5.1); with
     ``distance_rtol`` the Newton finish ends once the distance has converged to that fraction,
     where it is beyond ``rtol_beyond`` (see `newton_closest`)."""
+    if P1.patch.dim == 0:
+        return seek_point_curve(P1, P2)
     best = None
     tol = 1e-9 * np.concatenate([P1.patch.span, P2.patch.span])
     started = []
@@ -316,6 +319,51 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, **grid_options) 
     if best is None or not math.isfinite(best.distance):
         raise SeekingError("no finite distance between the patches (a non-finite pose)")
     return best
+
+
+def seek_point_curve(P1, P2, *, n_grid=64, max_iter=30) -> Couple:
+    """The couple of a posed point P1 (`Point`, a sphere of radius r) and a posed curve P2:
+    the s of least |p - c(s)|; the distance is |p - c(s)| - r. For a full `Circle` in closed
+    form: s is the polar angle of p projected onto the circle's plane (in P2's frame), and with
+    p on the axis (every s is closest) s = 0, a couple that is not isolated (its conditioning is
+    0, `contact_couple` refuses it). Otherwise a grid of ``n_grid`` points over the domain,
+    finished by Newton on F = t2 . d (Eq. 37 for a point) clipped to the domain. The couple is
+    ``interior`` only inside the curve's domain and with p on its concave side (inside a
+    circle's passage, `point_curve_side`): elsewhere it is not a potential contact."""
+    pt, curve = P1.patch, P2.patch
+    p = P1.position(np.zeros(0))
+    q = P2.R.T @ (p - P2.p)                      # p in the curve's frame
+    if type(curve) is Circle:
+        rho = math.hypot(q[0], q[1])
+        s = curve.wrap(np.array([math.atan2(q[1], q[0]) if rho > 0.0 else 0.0]))
+        it = 0
+    else:
+        U = curve.grid(n_grid)
+        d2 = ((curve.position(U) - q) ** 2).sum(axis=-1)
+        s = U[int(np.argmin(d2))]
+        it = 0
+        for it in range(1, max_iter + 1):
+            r, t, k = curve.position(s), curve.first(s)[:, 0], curve.second(s)[:, 0, 0]
+            d = q - r
+            Fu = k @ d - t @ t
+            if not Fu < 0.0:                    # not a minimum of |d|: stop here
+                break
+            step = -(t @ d) / Fu
+            s_new = curve.clip(s + step)
+            done = abs(float(s_new[0] - s[0])) <= 1e-14 * (1.0 + float(curve.span[0]))
+            s = s_new
+            if done:
+                break
+        s = curve.wrap(s)
+    p2 = P2.position(s)
+    d = p - p2
+    dist = float(np.linalg.norm(d)) - pt.radius
+    if not math.isfinite(dist):
+        raise SeekingError("no finite distance between the point and the curve (a non-finite "
+                           "pose)")
+    # A potential contact only on the curve's concave side (`point_curve_side`).
+    concave = point_curve_side(curve, P2.R, s[0], d) > 0.0
+    return Couple(np.zeros(0), s, p, p2, dist, it, is_interior(curve, s) and concave)
 
 
 def is_interior(patch, u, rtol=1e-9) -> bool:
@@ -352,7 +400,8 @@ def contact_couple(kind, patch1, X1, patch2, X2, c: Couple, *, conditioning_min,
     u0 = c.u
     n1 = patch1.dim
     if not c.interior:
-        return ContactCouple(u0, False, "the closest couple lies on a domain end")
+        return ContactCouple(u0, False, "the closest couple lies on a domain end (a point-curve "
+                                        "couple: or on the curve's convex side)")
     _, _, cond = closest_point_conditions(kind, patch1, X1, patch2, X2, u0, conditioning=True)
     if not cond > 10 * conditioning_min:
         return ContactCouple(u0, False, f"the couple is not isolated (J conditioning "

@@ -29,7 +29,8 @@ import math
 import numpy as np
 
 from drake_dock.core.handover import SurfaceEdge
-from drake_dock.core.patches import Annulus, Arc, Circle, Cone, PolarCurve, Reparametrized
+from drake_dock.core.patches import (Annulus, Arc, Circle, Cone, Point, PolarCurve,
+                                     Reparametrized)
 from drake_dock.errors import InputError
 
 # The contact sets a docking scene names (`contact.pairs`; `drake_dock.docking.scene.apds_pairs`):
@@ -281,6 +282,31 @@ def ring_face(g: ApdsGeometry) -> Annulus:
     return Annulus(g.Rs, g.R, 0.0)
 
 
+# The petal corner's sphere (the paper gives no rounding): radius r through the corner, its
+# centre r outward of it along the APDS radius, so that a coaxial ring circle of radius
+# Rs = R - H cot alpha1, which passes exactly through the corners, has the centre on its convex
+# side (docs/model.md, "The petal corner").
+CORNER_RADIUS = 1e-3
+
+
+def corner_point(g: ApdsGeometry, i: int) -> np.ndarray:
+    """The corner at the top of guide side i (zeta = H), where it meets the tip arc of its
+    petal: the tip arc's lower end for odd i, its upper end for even i."""
+    if i not in range(1, 7):
+        raise InputError("petal corner", i, "1..6")
+    tip = tip_arc(g, (i + 1) // 2)
+    return tip.position(tip.lower if i % 2 else tip.upper)
+
+
+def petal_corner(g: ApdsGeometry, i: int) -> Point:
+    """The sphere of petal corner i (`corner_point`): radius `CORNER_RADIUS`, centred
+    `CORNER_RADIUS` outward of the corner along the APDS radius (the sphere passes through
+    the corner)."""
+    c = corner_point(g, i)
+    out = np.array([c[0], c[1], 0.0]) / math.hypot(c[0], c[1])
+    return Point(c + CORNER_RADIUS * out, CORNER_RADIUS)
+
+
 @dataclasses.dataclass
 class ApdsPatches:
     sides: dict      # i -> guide side n_i
@@ -289,12 +315,14 @@ class ApdsPatches:
     tips: dict       # k -> tip arc of petal k
     rim: Circle      # outside circle of the ring
     face: Annulus    # the ring's face
+    corners: dict = dataclasses.field(default_factory=dict)   # i -> corner at side i's top
 
 
 def apds_patches(g: ApdsGeometry) -> ApdsPatches:
     return ApdsPatches({i: guide_side(g, i) for i in range(1, 7)},
                        {k: guide_surface(g, k) for k in (1, 2, 3)}, ring_circle(g),
-                       {k: tip_arc(g, k) for k in (1, 2, 3)}, ring_rim(g), ring_face(g))
+                       {k: tip_arc(g, k) for k in (1, 2, 3)}, ring_rim(g), ring_face(g),
+                       {i: petal_corner(g, i) for i in range(1, 7)})
 
 
 # Visual mesh --------------------------------------------------------------------------------

@@ -29,11 +29,11 @@ CC_SIDE_PAIRS = ((1, 5), (2, 4), (3, 3), (4, 2), (5, 1), (6, 6))
 
 @dataclasses.dataclass(frozen=True)
 class PairSpec:
-    """A potential contact pair. Body 1 carries the curve (Sect. 4.3); the normal of its couple
-    points from Body 2 to Body 1 (Definition 2)."""
+    """A potential contact pair. Body 1 carries the curve (Sect. 4.3), or the point of a
+    point-curve pair; the normal of its couple points from Body 2 to Body 1 (Definition 2)."""
 
     name: str
-    kind: str            # "CC" or "CS"
+    kind: str            # "CC", "CS" or "PC" (a point on Body 1)
     body1: str
     patch1: Patch
     body2: str
@@ -45,8 +45,10 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     2.2 and 8.1, six guide side vs guide side (C-C, Body 1 = the chaser's side, as in Sect. 3.2),
     three chaser-ring vs target-surface and three target-ring vs chaser-surface (C-S, Body 1 =
     the ring). ``complete`` adds, for each APDS against the other (`edge_pairs`): the ring's
-    inside circle vs each guide side and each tip arc (C-C), and the ring's outside circle vs
-    the other ring's face (C-S)."""
+    inside circle vs each guide side and each tip arc (C-C), the ring's outside circle vs
+    the other ring's face (C-S), the tip arcs vs the guide surfaces they can face (C-S,
+    `tip_surface_pairs`) and the other APDS's petal corners vs the ring's inside circle
+    (point-curve, `corner_pairs`)."""
     if which not in PAIR_SETS:
         raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)
@@ -61,6 +63,8 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         pairs += edge_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
         pairs += tip_surface_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
         pairs += tip_surface_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
+        pairs += corner_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
+        pairs += corner_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
     return pairs
 
 
@@ -78,6 +82,15 @@ def edge_pairs(P, one, other) -> list[PairSpec]:
     out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
     out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
     return out
+
+
+def corner_pairs(P, one, other) -> list[PairSpec]:
+    """APDS ``other``'s six petal corners (Body 1, `petal_corner`) against APDS ``one``'s
+    ring inside circle (Body 2), pc_<Y>corner<i>_<X>ring (point-curve, kind "PC"; X the ring's
+    APDS, Y the corner's): corner i is where guide side i meets its tip arc."""
+    (x, b_ring), (y, b_corner) = one, other
+    return [PairSpec(f"pc_{y}corner{i}_{x}ring", "PC", b_corner, P.corners[i], b_ring, P.ring)
+            for i in range(1, 7)]
 
 
 def tip_surface_pairs(P, one, other, R) -> list[PairSpec]:
@@ -237,7 +250,7 @@ def travel_grid(g: ApdsGeometry, approach: Approach, step=None):
 
 
 # Covers of the search (`drake_dock.core.covers`): cells per parameter and per block.
-COVER_CELLS = {1: (256, 16), 2: (32, 8)}
+COVER_CELLS = {0: (1, 1), 1: (256, 16), 2: (32, 8)}
 
 
 def pair_covers(pr: PairSpec):

@@ -92,7 +92,7 @@ def check_pairs(plant, pairs, energy_scale):
     if len(set(names)) != len(names):
         raise ValueError(f"pairs: names must be unique, got {names}")
     for p in pairs:
-        want = (1, 1) if p.kind == "CC" else (1, 2) if p.kind == "CS" else None
+        want = {"CC": (1, 1), "CS": (1, 2), "PC": (0, 1)}.get(p.kind)
         if want is None or (p.patch1.dim, p.patch2.dim) != want:
             raise ValueError(f"pairs[{p.name}]: kind {p.kind!r} needs patch dims {want}, "
                              f"got ({p.patch1.dim}, {p.patch2.dim})")
@@ -251,7 +251,8 @@ class RigidContactSystem(LeafSystem):
     def DoGetWitnessFunctions(self, context):
         return [self._w_far if i is None else self._w[i][kind]
                 for i, kind in witnesses.armed(self.get_modes(context).pairs,
-                                               self.evaluator.links.of_edge)]
+                                               self.evaluator.links.of_edge,
+                                               self.evaluator.side_pairs)]
 
     def witness_values(self, context) -> dict:
         """The values of the witnesses `DoGetWitnessFunctions` returns now, by description
@@ -259,7 +260,8 @@ class RigidContactSystem(LeafSystem):
         return {FAR_WITNESS if i is None else f"{self.pairs[i].name} {kind}":
                 self._witness(context, i, kind)
                 for i, kind in witnesses.armed(self.get_modes(context).pairs,
-                                               self.evaluator.links.of_edge)}
+                                               self.evaluator.links.of_edge,
+                                               self.evaluator.side_pairs)}
 
     def witness_rates(self, context) -> dict:
         """Time derivatives of the gap witnesses of the tracked couples, by description:

@@ -30,8 +30,9 @@ COUPLE_OUTPUT_SIZE = _offset
 
 @dataclasses.dataclass
 class ContactPair:
-    """A declared pair: ``patch1`` (a curve) on ``frame1``, ``patch2`` (a curve for "CC", a
-    surface for "CS") on ``frame2``; the couple's normal points from body 2 to body 1.
+    """A declared pair: ``patch1`` (a curve, or a `Point` for "PC") on ``frame1``, ``patch2``
+    (a curve for "CC" and "PC", a surface for "CS") on ``frame2``; the couple's normal points
+    from body 2 to body 1.
     ``sigma`` (+-1) fixes the orientation of n (Definition 2) when the scene knows it (a body
     that starts resting on a plane); by default it is taken when the pair becomes potential,
     from the side the patches are on."""

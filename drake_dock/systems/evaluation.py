@@ -15,7 +15,8 @@ from drake_dock.core.constraints import (SLIDE, STICK, ContactRow, friction_powe
 from drake_dock.core.couple import evaluate_couple, float_pose, float_vec
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels.couples import DRIFT_REL as KERNEL_DRIFT_REL
-from drake_dock.errors import DriftError
+from drake_dock.core.kernels.couples import GAP as KERNEL_GAP
+from drake_dock.errors import DriftError, SingularCoupleError
 from drake_dock.systems.contact_types import Evaluation
 from drake_dock.systems.far_pairs import FarPairs
 from drake_dock.systems.handovers import HandoverLinks
@@ -75,6 +76,8 @@ class PlantEvaluator:
             from drake_dock.core.kernels import constraints as solver
             self.solver = solver
         self.far = FarPairs(pairs, self.fidx)
+        # The point-curve pairs: their side witness (`witnesses`).
+        self.side_pairs = frozenset(i for i, p in enumerate(self.pairs) if p.kind == "PC")
         self.links = HandoverLinks(self.pairs, handovers)
         self.evaluations = 0
         self._zero_v = np.zeros(self.nv)         # never written
@@ -106,8 +109,11 @@ class PlantEvaluator:
         ``drift_tol`` of the domain span."""
         p = self.pairs[i]
         a, b = self.fidx[i]
-        ev = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
-                             twists[b], u, sigma)
+        try:
+            ev = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
+                                 twists[b], u, sigma)
+        except SingularCoupleError as e:
+            raise SingularCoupleError(str(e), time=time, couples=[p.name]) from None
         rel = np.abs(ev.drift) / self.spans[i]
         if rel.max() > self.options.drift_tol:
             raise DriftError(f"couple drift {rel.max():.3e} of the domain span exceeds "
@@ -121,25 +127,35 @@ class PlantEvaluator:
         k, fb = len(self.pairs), self.options.drift_feedback
         evals = [None] * k
         udot = np.zeros(self.nu)
-        if self.kernel is None:
+        python = range(k) if self.kernel is None else self.kernel.python
+        if any(modes.pairs[i].mode != Mode.FAR for i in python):
             # The couples work in plain floats: the frames' poses and twists converted once.
             fposes = [float_pose(X) for X in poses]
             ftwists = [(float_vec(w), float_vec(v)) for w, v in twists]
-            for i, st in enumerate(modes.pairs):
+            for i in python:
+                st = modes.pairs[i]
                 if st.mode != Mode.FAR:
                     sl = self.couple_slice(i)
                     ev = evals[i] = self.couple(i, u[sl], fposes, ftwists, st.sigma, t)
                     udot[sl] = ev.udot + fb * ev.drift
+        if self.kernel is None:
             return evals, udot
         active = np.array([st.mode != Mode.FAR for st in modes.pairs], dtype=np.bool_)
+        active[self.kernel.python] = False
         if not active.any():
             return evals, udot
+        python_udot = udot
         sigma = np.array([st.sigma for st in modes.pairs], dtype=float)
         out, udot = self.kernel.evaluate(np.array([X[0] for X in poses]),
                                          np.array([X[1] for X in poses]),
                                          np.array([V[0] for V in twists]),
                                          np.array([V[1] for V in twists]), u, sigma, active,
                                          drift_feedback=fb)
+        for i in self.kernel.pc.tolist():
+            if active[i] and math.isnan(out[i, KERNEL_GAP]):
+                raise SingularCoupleError("point-curve couple: the point lies on the curve "
+                                          "(|d| = 0), its normal is undefined", time=t,
+                                          couples=[self.pairs[i].name])
         rel = out[:, KERNEL_DRIFT_REL]
         if (rel > self.options.drift_tol).any():
             i = int(np.argmax(rel > self.options.drift_tol))
@@ -148,6 +164,9 @@ class PlantEvaluator:
                              couples=[self.pairs[i].name])
         for i in np.flatnonzero(active).tolist():
             evals[i] = self.kernel.couple_eval(out, i)
+        for i in self.kernel.python:
+            sl = self.couple_slice(i)
+            udot[sl] = python_udot[sl]
         return evals, udot
 
     def row(self, i, ev, poses, ctx):

@@ -12,7 +12,7 @@ from drake_dock.core import covers
 from drake_dock.core.kernels import cover as compiled_cover
 
 # Covers of the broad phase: cells per parameter and per block, by patch dimension.
-BROAD_CELLS = {1: (256, 16), 2: (32, 8)}
+BROAD_CELLS = {0: (1, 1), 1: (256, 16), 2: (32, 8)}
 
 
 def bounding_sphere(patch, n=41):

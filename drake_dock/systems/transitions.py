@@ -8,7 +8,7 @@ import numpy as np
 
 from drake_dock.core import handover, hybrid
 from drake_dock.core.constraints import select_modes
-from drake_dock.core.couple import evaluate_couple
+from drake_dock.core.couple import evaluate_couple, point_curve_side
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import constraints as compiled_constraints
 from drake_dock.core.kernels import seek as compiled_seek
@@ -18,6 +18,13 @@ from drake_dock.errors import (InputError, PainleveInconsistency, SeekingError,
                                SingularCoupleError, ZenoError)
 from drake_dock.systems import handovers, impacts
 from drake_dock.systems.handovers import applied
+
+
+def _reseek(p, c, margin, R2, conditioning_min) -> bool:
+    """A couple c of pair p that is not far is sought again: at a domain end, with J singular,
+    or (a point-curve pair) on the curve's convex side, Body 2 turned by R2."""
+    return margin.min() <= 0.0 or c.conditioning <= conditioning_min or (
+        p.kind == "PC" and point_curve_side(p.patch2, R2, c.u[0], c.n) <= 0.0)
 
 
 class Transitions:
@@ -65,7 +72,7 @@ class Transitions:
                 raise SingularCoupleError(
                     f"the Jacobian of a couple in contact turned singular (Eq. 39 fails; "
                     f"conditioning {c.conditioning:.2e})", time=t, couples=[p.name])
-            if margin.min() <= 0.0 or c.conditioning <= opt.conditioning_min:
+            if _reseek(p, c, margin, poses[ev.fidx[i][1]][0], opt.conditioning_min):
                 sought.append((i, self.seek(i, poses, modes.pairs, u, t, st.mode.in_contact)))
         for i, after in sought:
             self.carry(i, after, modes.pairs)

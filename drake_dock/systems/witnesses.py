@@ -7,6 +7,7 @@ import math
 
 from pydrake.systems.framework import WitnessFunctionDirection
 
+from drake_dock.core.couple import point_curve_side
 from drake_dock.core.hybrid import Mode
 
 FAR_WITNESS = "far pairs clearance"   # the one witness of all far pairs ("clear")
@@ -67,6 +68,17 @@ def _handover(ev, E, st, i):
     return ev.links.guard(i, c.n, c.u, E.poses[ev.fidx[i][1]][0]) + GUARD_BAND
 
 
+def _side(ev, E, st, i):
+    """A point-curve pair's side (`drake_dock.core.couple.point_curve_side`): positive while the
+    point lies on the curve's concave side; at its zero the pair is sought again (a potential
+    contact only there)."""
+    c = E.evals[i]
+    if c is None:
+        return 1.0
+    p = ev.pairs[i]
+    return point_curve_side(p.patch2, E.poses[ev.fidx[i][1]][0], c.u[0], c.n)
+
+
 def _lambda(ev, E, st, i):
     """lambda_n of a couple in contact: it detaches at its zero (Eq. 50-51)."""
     return E.lam_n[i] if st.mode.in_contact else 1.0
@@ -101,7 +113,7 @@ def _clear(ev, E, st, i):
 WITNESSES = {"gap": ("gap", _gap), "end": ("domain end", _end), "cond": ("Eq. 39", _cond),
              "lambda": ("lambda_n", _lambda), "slip": ("slip", _slip),
              "cone": ("friction cone", _cone), "apex": ("gap rate", _apex),
-             "handover": ("hand-over", _handover)}
+             "handover": ("hand-over", _handover), "side": ("concave side", _side)}
 
 # The witnesses of a pair in each mode, in the order they are armed.
 BY_MODE = {Mode.FAR: (),
@@ -128,13 +140,16 @@ def declare(system, pairs, value_at, event):
     return per_pair, far
 
 
-def armed(states, edge_pairs=()) -> list:
+def armed(states, edge_pairs=(), side_pairs=()) -> list:
     """(pair index or None, kind) of every witness armed for the pairs' `PairState`s: the far
-    pairs' clearance when a pair is far, then each pair's witnesses of its mode, and the
-    hand-over guard of the pairs in ``edge_pairs`` that are not far."""
+    pairs' clearance when a pair is far, then each pair's witnesses of its mode, the
+    hand-over guard of the pairs in ``edge_pairs`` and the side of the point-curve pairs in
+    ``side_pairs`` that are not far."""
     out = [(None, "clear")] if any(st.mode == Mode.FAR for st in states) else []
     for i, st in enumerate(states):
         out += [(i, kind) for kind in BY_MODE[st.mode]]
         if st.mode != Mode.FAR and i in edge_pairs:
             out.append((i, "handover"))
+        if st.mode != Mode.FAR and i in side_pairs:
+            out.append((i, "side"))
     return out

@@ -14,7 +14,7 @@ from drake_dock.core.kernels.jets import jet, patch_spec
 from drake_dock.core.kernels.tracked import TrackedCouples
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
-from drake_dock.docking.apds import ApdsGeometry, apds_patches
+from drake_dock.docking.apds import ApdsGeometry, apds_patches, corner_point
 from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec
 from edge_scenes import (CORNER, arc_over_cone, rim_over_face, ring_over_arc, ring_over_segment,
                          tip_handover)
@@ -163,12 +163,31 @@ def test_kernels_equal_the_python_path(name):
 def test_complete_set_names_and_patches(geom):
     """`paper` is the 12 pairs; `complete` adds, per APDS, its ring's inside circle against the
     other's 6 sides and 3 tip arcs, its rim against the other's face and its tip arcs against
-    the other's guide surfaces they can face (32 pairs)."""
+    the other's guide surfaces they can face (32 pairs), and its ring's inside circle against
+    the other's 6 petal corners, each the top end of its guide side (12 point-curve pairs)."""
     paper, complete = apds_pairs(geom), apds_pairs(geom, "complete")
     assert [p.name for p in complete[:12]] == [p.name for p in paper] and len(paper) == 12
     new = {p.name: p for p in complete[12:]}
-    assert len(new) == 32
+    assert len(new) == 44
     P = apds_patches(geom)
+    for x, y, bx, by in (("C", "T", "chaser_apds", "target_apds"),
+                         ("T", "C", "target_apds", "chaser_apds")):
+        for i in range(1, 7):
+            pc = new[f"pc_{y}corner{i}_{x}ring"]
+            assert (pc.kind, pc.body1, pc.body2) == ("PC", by, bx)
+            assert (pc.patch2.radius, pc.patch2.height) == (geom.Rs, 0.0)
+            side = P.sides[i]
+            ends = side.position(np.array([side.lower, side.upper]))
+            corner = ends[np.argmax(ends[:, 2])]      # the side's top, on the tip arc
+            np.testing.assert_allclose(corner_point(geom, i), corner, atol=1e-15)
+            r = pc.patch1.radius
+            assert r > 0 and pc.patch1.p[2] == pytest.approx(geom.H, abs=1e-15)
+            # The sphere's centre r outward: the sphere passes through the corner, and a
+            # coaxial ring circle of radius R - H cot(alpha1) has its centre on the convex side.
+            rho = math.hypot(*pc.patch1.p[:2])
+            assert rho == pytest.approx(math.hypot(*corner[:2]) + r, abs=1e-15)
+            (a, b), (c, d) = pc.patch1.p[:2], corner[:2]
+            assert a * d - b * c == pytest.approx(0.0, abs=1e-15)
     side = new["cc_Cring_T3"]
     assert side.kind == "CC" and type(side.patch2) is type(P.sides[3])
     for patch, expected in ((side.patch2, P.sides[3]), (side.patch1, P.ring)):
@@ -191,13 +210,16 @@ def test_complete_set_names_and_patches(geom):
                                                             alpha1_deg=50.0, alpha2_deg=25.0)])
 @pytest.mark.parametrize("d", [0.12, 0.02, -0.05])
 def test_complete_pairs_compiled_seek_equals_python(g, d):
-    """The 20 new pairs, the chaser tilted, offset and at ring distance d: the compiled seek
+    """The 20 new C-C and C-S pairs, the chaser tilted, offset and at ring distance d: the compiled seek
     gives the Python seek's distance to 1e-12 and the same interior flag."""
     poses = {"target_apds": (np.eye(3), np.zeros(3)),
              "chaser_apds": (rot_vec((0.03, -0.02, 0.01)) @ R_MATCHED,
                              np.array([0.03, -0.02, d]))}
     for pr in apds_pairs(g, "complete")[12:]:
         P1, P2 = posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2])
+        if pr.kind == "PC":         # sought in Python (closed form), not compiled
+            assert not compiled_seek.supported(P1, P2)
+            continue
         assert compiled_seek.supported(P1, P2)
         ref, got = seek_couple(P1, P2), compiled_seek.seek_couple(P1, P2)
         assert got.distance == pytest.approx(ref.distance, rel=0, abs=1e-12), pr.name

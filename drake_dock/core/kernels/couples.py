@@ -8,7 +8,8 @@ operations are those of `evaluate_couple`, in the same order, except for the con
 norms (a plain square root of the sum of squares instead of `math.hypot`, which only moves the
 conditioning, a threshold test, in its last bits).
 
-Patch 1 of every pair is a curve; patch 2 a curve (CC) or a surface (CS). The output has one
+Patch 1 of every pair is a curve; patch 2 a curve (CC) or a surface (CS). The point-curve
+couples (kind "PC", a point against a curve) have their own loop, `evaluate_point_curves`. The output has one
 row per pair, its fields at the offsets below (`ROW`); the rows of pairs not asked for are
 left zero.
 """
@@ -19,7 +20,8 @@ import math
 from numba import njit
 
 from drake_dock.core.kernels.frames import (add as _add, axpy as _axpy, cross as _cr, dot as _dot,
-                                             frame_rates_cc, frame_rates_cs, sub as _sub)
+                                             frame_rates_cc, frame_rates_cs, frame_rates_pc,
+                                             sub as _sub)
 from drake_dock.core.kernels.jets import jet
 
 # Row layout: u (3), drift (3), udot (3), residual, conditioning, p1 (3), p2 (3), n (3),
@@ -228,3 +230,76 @@ def evaluate_couples(cc, kind1, prm1, kind2, prm2, fidx, uoff, spans, R, o, w, v
             row[RATE + j] = row[UDOT + j] + drift_feedback * row[DRIFT + j]
             rate[uoff[i] + j] = row[RATE + j]
         row[DRIFT_REL] = rel
+
+
+@njit(cache=True)
+def evaluate_pc_one(kind2, prm2, p, radius, R1, o1, w1, v1, R2, o2, w2, v2, s, sigma,
+                    project, out):
+    """One point-curve couple (kind "PC", `drake_dock.core.couple._evaluate_point_curve`):
+    the point p (its frame's coordinates; a sphere of ``radius``) against the curve
+    (kind2, prm2), u = (s,), into the row ``out``. A point on the curve (|d| = 0, no normal)
+    leaves the gap NaN for the caller to report."""
+    r1 = _rot(R1, p)
+    x1 = _add(r1, o1)
+    r2, T2, _, K2, _, _ = _geometry(kind2, prm2, R2, s, 0.0)
+    d = _sub(x1, _add(r2, o2))
+    F, Fu = _dot(T2, d), _dot(K2, d) - _dot(T2, T2)
+    residual = abs(F)
+    den = _dot(T2, T2) + math.sqrt(_dot(K2, K2) * _dot(d, d))
+    cond = abs(Fu) / den if den > 0 else 0.0
+    ds = 0.0
+    if project and residual > 0.0 and cond > 1e-14:
+        ds = -F / Fu
+        s = s + ds
+        r2, T2, _, K2, _, _ = _geometry(kind2, prm2, R2, s, 0.0)
+        d = _sub(x1, _add(r2, o2))
+        F, Fu = _dot(T2, d), _dot(K2, d) - _dot(T2, T2)
+        den = _dot(T2, T2) + math.sqrt(_dot(K2, K2) * _dot(d, d))
+        cond = abs(Fu) / den if den > 0 else 0.0
+    dist = math.sqrt(_dot(d, d))
+    out[U], out[DRIFT], out[RESIDUAL], out[COND] = s, ds, residual, cond
+    if not dist > 0.0:
+        out[GAP] = math.nan
+        return
+    x2 = _add(r2, o2)
+    v_rel = _sub(_add(v1, _cr(w1, r1)), _add(v2, _cr(w2, r2)))
+    w2t2 = _cr(w2, T2)
+    Ft = _dot(w2t2, d) + _dot(T2, v_rel)
+    sdot = -Ft / Fu if cond > 1e-14 else 0.0
+    nv, ndot, ta, tadot, conv = frame_rates_pc(d, T2, _axpy(-sdot, T2, v_rel),
+                                               _axpy(sdot, K2, w2t2), w2, sdot, sigma)
+    tb = _cr(nv, ta)
+    tbdot = _add(_cr(ndot, ta), _cr(nv, tadot))
+    out[UDOT] = sdot
+    _put(out, P1, x1)
+    _put(out, P2, x2)
+    _put(out, N, nv)
+    _put(out, TA, ta)
+    _put(out, TB, tb)
+    out[GAP] = sigma * dist - radius
+    _put(out, VREL, v_rel)
+    out[VN] = _dot(nv, v_rel)
+    out[VT], out[VT + 1] = _dot(ta, v_rel), _dot(tb, v_rel)
+    out[BIAS_N] = _dot(nv, conv) + _dot(ndot, v_rel)
+    out[BIAS_T] = _dot(ta, conv) + _dot(tadot, v_rel)
+    out[BIAS_T + 1] = _dot(tb, conv) + _dot(tbdot, v_rel)
+
+
+@njit(cache=True)
+def evaluate_point_curves(pc, kind2, prm1, prm2, fidx, uoff, spans, R, o, w, v, u, sigma,
+                          active, project, drift_feedback, out, rate):
+    """`evaluate_couples` for the point-curve pairs i listed in ``pc`` that are ``active``:
+    prm1[i] holds the point (3) and its radius."""
+    for i in pc:
+        if not active[i]:
+            continue
+        a, b = fidx[i, 0], fidx[i, 1]
+        row = out[i]
+        evaluate_pc_one(kind2[i], prm2[i], (prm1[i, 0], prm1[i, 1], prm1[i, 2]), prm1[i, 3],
+                        R[a], (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]),
+                        (v[a, 0], v[a, 1], v[a, 2]),
+                        R[b], (o[b, 0], o[b, 1], o[b, 2]), (w[b, 0], w[b, 1], w[b, 2]),
+                        (v[b, 0], v[b, 1], v[b, 2]), u[uoff[i]], sigma[i], project, row)
+        row[DRIFT_REL] = abs(row[DRIFT]) / spans[i, 0]
+        row[RATE] = row[UDOT] + drift_feedback * row[DRIFT]
+        rate[uoff[i]] = row[RATE]

@@ -78,3 +78,17 @@ def frame_rates_cs(t1, su, sv, sudot, svdot, N, w1, w2, u1dot, u2dot_a, u2dot_b,
     tadot = perp_rate(ta, sudot, su_norm)
     conv = sub(cross(w1, mul(t1, u1dot)), cross(w2, axpy(u2dot_b, sv, mul(su, u2dot_a))))
     return n, ndot, ta, tadot, conv
+
+
+@njit(cache=True)
+def frame_rates_pc(d, t2, ddot, t2dot, w2, u2dot, sigma):
+    """P-C (a point against a curve, d = p - c(s)): n = sigma d / |d|, ta = t2 / |t2| and their
+    rates from d' (= v_rel - t2 s') and t2'; conv = -w2 x t2 s' (the point has no parameter).
+    Returns (n, n', ta, ta', conv)."""
+    d_hat, d_norm = unit(d)
+    n = mul(d_hat, sigma)
+    ndot = mul(perp_rate(d_hat, ddot, d_norm), sigma)
+    ta, t2_norm = unit(t2)
+    tadot = perp_rate(ta, t2dot, t2_norm)
+    conv = mul(cross(w2, t2), -u2dot)
+    return n, ndot, ta, tadot, conv

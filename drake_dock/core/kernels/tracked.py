@@ -11,9 +11,11 @@ from drake_dock.core.kernels.jets import N_PARAMS, patch_spec
 
 
 class TrackedCouples:
-    """Pairs given as (kind "CC"/"CS", patch1, patch2, (frame index 1, frame index 2)).
-    `supported` is False when a patch has no kernel description (`patch_spec`); the caller
-    then evaluates the couples in Python."""
+    """Pairs given as (kind "CC"/"CS"/"PC", patch1, patch2, (frame index 1, frame index 2)).
+    `supported` is False when a patch has no kernel description (`patch_spec`; a "PC" pair's
+    point is described by its coordinates and radius); the caller then evaluates the couples
+    in Python. ``python`` lists the pairs the caller evaluates in Python even so (none: kept
+    for pair kinds without a kernel)."""
 
     def __init__(self, pairs):
         k = len(pairs)
@@ -24,7 +26,21 @@ class TrackedCouples:
         self.spans = np.ones((k, 3))
         self.dims = np.zeros(k, dtype=np.int64)
         self.supported = True
+        self.python = []
+        self.pc = np.array([i for i, (kind, *_) in enumerate(pairs) if kind == "PC"],
+                           dtype=np.int64)
         for i, (kind, p1, p2, (a, b)) in enumerate(pairs):
+            if kind == "PC":
+                s2 = patch_spec(p2)
+                if p1.dim != 0 or s2 is None or p2.dim != 1:
+                    self.supported = False
+                    continue
+                self.prm1[i, :4] = (*p1.p, p1.radius)
+                self.kind2[i], self.prm2[i] = s2
+                self.fidx[i] = a, b
+                self.spans[i, 0] = p2.span[0]
+                self.dims[i] = 1
+                continue
             s1, s2 = patch_spec(p1), patch_spec(p2)
             if s1 is None or s2 is None or p1.dim != 1 or p2.dim != (1 if kind == "CC" else 2):
                 self.supported = False
@@ -43,6 +59,12 @@ class TrackedCouples:
         twists w, v (F, 3) and the couples u (concatenated)."""
         out = np.zeros((len(self.cc), K.ROW))
         rate = np.zeros(len(u))
+        if len(self.pc):
+            K.evaluate_point_curves(self.pc, self.kind2, self.prm1, self.prm2, self.fidx,
+                                    self.uoff, self.spans, R, o, w, v, u, sigma, active,
+                                    project, drift_feedback, out, rate)
+            active = active.copy()
+            active[self.pc] = False
         K.evaluate_couples(self.cc, self.kind1, self.prm1, self.kind2, self.prm2, self.fidx,
                            self.uoff, self.spans, R, o, w, v, u, sigma, active, project,
                            drift_feedback, out, rate)
@@ -84,13 +106,14 @@ class CoupleRow:
 
 
 def warm():
-    """Compiles or loads the kernels: one CC and one CS couple of small patches."""
-    from drake_dock.core.patches import Circle, PlaneRect, Segment
+    """Compiles or loads the kernels: one CC, one CS and one PC couple of small patches."""
+    from drake_dock.core.patches import Circle, PlaneRect, Point, Segment
     seg = Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1))
     tc = TrackedCouples([("CC", seg, Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0)), (0, 1)),
                          ("CS", Circle(0.3, 0.1), PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)),
-                          (0, 1))])
+                          (0, 1)),
+                         ("PC", Point((0.1, 0.2, 0.3), 0.01), Circle(0.3), (0, 1))])
     R = np.array([np.eye(3), np.eye(3)])
     z = np.zeros((2, 3))
-    tc.evaluate(R, z, z, z, np.array([0.5, 0.5, 0.0, 0.5, 0.5]), np.ones(2),
-                np.ones(2, dtype=np.bool_))
+    tc.evaluate(R, z, z, z, np.array([0.5, 0.5, 0.0, 0.5, 0.5, 1.0]), np.ones(3),
+                np.ones(3, dtype=np.bool_))

@@ -1,0 +1,243 @@
+"""The point-curve couple (kind "PC", a petal corner against a ring's inside circle) against
+closed forms: the distance and normal of a point passing a circle, the tracking of s (Eq. 47
+for a point) along prescribed motions, finite differences of the rates and the Eq. (52) terms,
+and the degenerate point on the circle's axis."""
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from drake_dock.core.couple import closest_point_conditions, evaluate_couple, point_curve_side
+from drake_dock.core.patches import Arc, Circle, Point, posed
+from drake_dock.core.seeking import contact_couple, seek_couple
+from drake_dock.errors import SingularCoupleError
+from tests.motions import Motion
+
+R_C = 0.4
+
+
+def closed_form(p, R2, o2, radius=R_C, r_pt=0.0):
+    """(s, distance - r_pt, unit normal) of a world point p and the circle of radius ``radius``
+    at z = 0 of the frame (R2, o2)."""
+    q = R2.T @ (p - o2)
+    s = math.atan2(q[1], q[0]) % (2 * math.pi)
+    c = radius * np.array([math.cos(s), math.sin(s), 0.0])
+    dq = q - c
+    dist = math.sqrt((math.hypot(q[0], q[1]) - radius) ** 2 + q[2] ** 2)
+    return s, dist - r_pt, R2 @ dq / np.linalg.norm(dq)
+
+
+MOVING = [Motion(p0=(0.1, -0.3, 0.05), V=(0.02, 0.5, -0.1), a=(0.3, 1.3), b=(0.2, 0.7)),
+          Motion(p0=(0.45, 0.2, -0.02), A=(0.05, 0.1, 0.03), W=(2.0, 1.5, 3.0), b=(0.4, 1.1))]
+RING = Motion(p0=(0.0, 0.0, 0.0), V=(0.0, 0.0, 0.01), a=(0.5, 0.9), b=(0.3, 1.7))
+
+
+@pytest.mark.parametrize("r_pt", [0.0, 0.002])
+@pytest.mark.parametrize("m1", MOVING)
+def test_point_passing_circle_distance_and_normal(m1, r_pt):
+    point, ring = Point((0.02, 0.01, 0.03), r_pt), Circle(R_C)
+    for t in np.linspace(0.0, 1.0, 11):
+        X1, X2 = m1.pose(t), RING.pose(t)
+        p = X1[1] + X1[0] @ point.p
+        s, dist, n = closed_form(p, *X2, r_pt=r_pt)
+        c = seek_couple(posed(point, *X1), posed(ring, *X2))
+        assert c.u1.shape == (0,)
+        assert abs((c.u2[0] - s + math.pi) % (2 * math.pi) - math.pi) < 1e-12
+        assert c.distance == pytest.approx(dist, abs=1e-12)
+        ev = evaluate_couple("PC", point, X1, m1.twist(t), ring, X2, RING.twist(t), c.u, 1.0)
+        assert ev.gap == pytest.approx(dist, abs=1e-12)
+        np.testing.assert_allclose(ev.n, n, atol=1e-12)
+        np.testing.assert_allclose(ev.frame.T @ ev.frame, np.eye(3), atol=1e-12)
+        assert abs(ev.ta @ (X2[0] @ np.array([-math.sin(s), math.cos(s), 0.0]))) \
+            == pytest.approx(1.0, abs=1e-12)
+        assert ev.conditioning > 0.0
+        # The side: the cosine of n with the curvature direction -e_rho, (R - rho_p) / |d|;
+        # a potential contact (``interior``) only inside the passage, rho_p < R.
+        q = X2[0].T @ (p - X2[1])
+        rho_p = math.hypot(q[0], q[1])
+        side = (R_C - rho_p) / math.sqrt((rho_p - R_C) ** 2 + q[2] ** 2)
+        assert point_curve_side(ring, X2[0], c.u2[0], ev.n) == pytest.approx(side, abs=1e-12)
+        assert c.interior == (rho_p < R_C)
+
+
+@pytest.mark.parametrize("m1", MOVING)
+def test_tracking_follows_closed_form(m1):
+    """s integrated by Eq. (47) (u' = -Ft / Fu) equals the polar angle of the point in the
+    ring's frame."""
+    point, ring = Point((0.0, 0.05, 0.0)), Circle(R_C)
+
+    def rate(t, u):
+        return evaluate_couple("PC", point, m1.pose(t), m1.twist(t), ring, RING.pose(t),
+                               RING.twist(t), u, 1.0, project=False).udot
+
+    def s_exact(t):
+        X1 = m1.pose(t)
+        return closed_form(X1[1] + X1[0] @ point.p, *RING.pose(t))[0]
+
+    sol = solve_ivp(rate, (0.0, 1.0), [s_exact(0.0)], rtol=1e-12, atol=1e-13,
+                    dense_output=True, method="DOP853")
+    for t in np.linspace(0.0, 1.0, 9):
+        err = (sol.sol(t)[0] - s_exact(t) + math.pi) % (2 * math.pi) - math.pi
+        assert abs(err) < 1e-8
+
+
+@pytest.mark.parametrize("r_pt", [0.0, 0.003])
+@pytest.mark.parametrize("m1", MOVING)
+def test_rates_and_bias_by_finite_differences(m1, r_pt):
+    """vn = g', vt = the tangential velocity, and g'' = n . (a1 - a2) + bias_n,
+    (t . v_rel)' = t . (a1 - a2) + bias_t, by central differences along the couple."""
+    point, ring = Point((0.03, -0.02, 0.04), r_pt), Circle(R_C)
+
+    def ev_at(t):
+        X1 = m1.pose(t)
+        s = closed_form(X1[1] + X1[0] @ point.p, *RING.pose(t))[0]
+        return evaluate_couple("PC", point, X1, m1.twist(t), ring, RING.pose(t),
+                               RING.twist(t), [s], 1.0)
+
+    h = 1e-4
+    for t in (0.2, 0.55, 0.9):
+        e0, ep, em = ev_at(t), ev_at(t + h), ev_at(t - h)
+        fp, fm = ev_at(t + 1e-6), ev_at(t - 1e-6)
+        assert e0.vn == pytest.approx((fp.gap - fm.gap) / 2e-6, abs=1e-8)
+        assert e0.udot[0] == pytest.approx((fp.u[0] - fm.u[0]) / 2e-6, abs=1e-8)
+        gdd = (ep.gap - 2 * e0.gap + em.gap) / h ** 2
+        acc = m1.acceleration(t, e0.p1) - RING.acceleration(t, e0.p2)
+        assert e0.n @ acc + e0.bias_n == pytest.approx(gdd, abs=1e-5)
+        # The tangential velocity components of the material points, differentiated with the
+        # frame moving along the couple.
+        vt_dot = (ep.vt - em.vt) / (2 * h)
+        np.testing.assert_allclose(np.array([e0.ta @ acc, e0.tb @ acc]) + e0.bias_t, vt_dot,
+                                   atol=1e-6)
+        np.testing.assert_allclose(e0.vt, [e0.ta @ e0.v_rel, e0.tb @ e0.v_rel], atol=1e-15)
+
+
+def test_projection_corrects_drift():
+    point, ring = Point((0.1, 0.2, 0.3)), Circle(R_C)
+    X = (np.eye(3), np.zeros(3))
+    s = math.atan2(0.2, 0.1)
+    ev = evaluate_couple("PC", point, X, (np.zeros(3),) * 2, ring, X, (np.zeros(3),) * 2,
+                         [s + 1e-4], 1.0)
+    assert abs(ev.u[0] - s) < 1e-8           # one Newton step from 1e-4
+    assert ev.drift[0] == pytest.approx(s - (s + 1e-4), abs=1e-8)
+
+
+def test_point_on_axis_is_not_isolated_and_on_curve_raises():
+    ring, X = Circle(R_C), (np.eye(3), np.zeros(3))
+    on_axis = Point((0.0, 0.0, 0.2))
+    c = seek_couple(posed(on_axis, *X), posed(ring, *X))
+    assert c.distance == pytest.approx(math.hypot(R_C, 0.2), abs=1e-15)
+    _, _, cond = closest_point_conditions("PC", on_axis, X, ring, X, c.u, conditioning=True)
+    assert cond == 0.0
+    f = contact_couple("PC", on_axis, X, ring, X, c, conditioning_min=1e-6)
+    assert not f.usable and "not isolated" in f.reason
+    on_curve = Point((R_C, 0.0, 0.0))
+    with pytest.raises(SingularCoupleError):
+        evaluate_couple("PC", on_curve, X, (np.zeros(3),) * 2, ring, X, (np.zeros(3),) * 2,
+                        [0.0], 1.0)
+
+
+@pytest.mark.parametrize("q", [(0.3, 0.3, 0.1), (-0.2, 0.5, 0.0), (0.1, -0.4, -0.2)])
+def test_arc_seek_bounded(q):
+    """A bounded arc (generic 1-D seek): the polar angle where it lies on the arc, else the
+    nearer end (closed form)."""
+    arc, X = Arc(0.5, 0.1, (0.2, 1.4)), (np.eye(3), np.zeros(3))
+    point = Point(q)
+    c = seek_couple(posed(point, *X), posed(arc, *X))
+    ends = [np.linalg.norm(np.array(q) - arc.position(np.array([a]))) for a in (0.2, 1.4)]
+    th = math.atan2(q[1], q[0])
+    inside = 0.2 <= th <= 1.4
+    want = (math.sqrt((math.hypot(q[0], q[1]) - 0.5) ** 2 + (q[2] - 0.1) ** 2) if inside
+            else min(ends))
+    assert c.distance == pytest.approx(want, abs=1e-12)
+    assert c.interior == inside
+
+
+@pytest.mark.parametrize("r_pt", [0.0, 0.002])
+def test_compiled_kernel_equals_python(r_pt):
+    """The compiled point-curve couple (`TrackedCouples`, beside a C-C pair) gives the Python
+    evaluation's fields to 1e-12, on and off the couple (projection) and for both sigma; a
+    point on the curve is a NaN gap there (the caller's `SingularCoupleError`)."""
+    from drake_dock.core.kernels.tracked import TrackedCouples
+    from drake_dock.core.patches import Segment
+    point, ring = Point((0.03, -0.02, 0.04), r_pt), Circle(R_C)
+    seg = Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1))
+    tc = TrackedCouples([("CC", seg, Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0)), (1, 0)),
+                         ("PC", point, ring, (0, 1))])
+    assert tc.supported and tc.python == []
+    rng = np.random.default_rng(3)
+    for m1 in MOVING:
+        for t in (0.1, 0.45, 0.8):
+            X1, X2, V1, V2 = m1.pose(t), RING.pose(t), m1.twist(t), RING.twist(t)
+            s = closed_form(X1[1] + X1[0] @ point.p, *X2)[0]
+            for s0, sigma in ((s, 1.0), (s + 1e-3 * rng.normal(), -1.0)):
+                out, rate = tc.evaluate(np.array([X1[0], X2[0]]), np.array([X1[1], X2[1]]),
+                                        np.array([V1[0], V2[0]]), np.array([V1[1], V2[1]]),
+                                        np.array([0.5, 0.5, s0]), np.array([1.0, sigma]),
+                                        np.array([False, True]), drift_feedback=50.0)
+                ref = evaluate_couple("PC", point, X1, V1, ring, X2, V2, [s0], sigma)
+                got = tc.couple_eval(out, 1)
+                for f in ("u", "drift", "udot", "conditioning", "p1", "p2", "n", "ta", "tb",
+                          "gap", "vn", "vt", "bias_n", "bias_t"):
+                    want = np.asarray(getattr(ref, f), dtype=float)
+                    np.testing.assert_allclose(getattr(got, f), want, rtol=0,
+                                               atol=1e-12 * (1.0 + np.abs(want).max()),
+                                               err_msg=f)
+                assert rate[2] == pytest.approx(ref.udot[0] + 50.0 * ref.drift[0], abs=1e-12)
+                assert rate[:2].tolist() == [0.0, 0.0]
+    X = np.array([np.eye(3), np.eye(3)])
+    on = TrackedCouples([("PC", Point((R_C, 0.0, 0.0)), ring, (0, 1))])
+    out, _ = on.evaluate(X, np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)),
+                         np.array([0.0]), np.ones(1), np.ones(1, dtype=np.bool_))
+    assert math.isnan(on.couple_eval(out, 0).gap)
+
+
+def test_scene_corner_pairs_random_poses_raise_only_typed_errors():
+    """The 12 corner pairs of `contact.pairs: complete` at seeded random chaser poses (tilt to
+    20 deg, offsets to 0.3 m, ring distances -0.2 to 0.4 m, any roll) and with the corner
+    placed on the ring's axis and on the circle: the seek, the contact-form finish and the
+    evaluation give finite results in the domain or a typed error, never a Python or numpy
+    one."""
+    from drake_dock.docking.apds import ApdsGeometry
+    from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec, rot_z
+    from drake_dock.errors import DrakeDockError
+    pairs = [p for p in apds_pairs(ApdsGeometry(), "complete") if p.kind == "PC"]
+    assert len(pairs) == 12
+    rng = np.random.default_rng(18)
+    usable = 0
+    for pr in pairs:
+        for _ in range(20):
+            R = rot_vec(rng.uniform(-0.35, 0.35, 3) * (1, 1, 0)) @ rot_z(rng.uniform(-1, 1)) \
+                @ R_MATCHED
+            poses = {"target_apds": (np.eye(3), np.zeros(3)),
+                     "chaser_apds": (R, np.array([*rng.uniform(-0.3, 0.3, 2),
+                                                  rng.uniform(-0.2, 0.4)]))}
+            X1, X2 = poses[pr.body1], poses[pr.body2]
+            V = (rng.normal(size=3) * 0.1, rng.normal(size=3) * 0.1)
+            try:
+                c = seek_couple(posed(pr.patch1, *X1), posed(pr.patch2, *X2))
+                assert np.isfinite(c.distance) and 0.0 <= c.u2[0] < 2 * math.pi
+                f = contact_couple("PC", pr.patch1, X1, pr.patch2, X2, c, conditioning_min=1e-6)
+                if f.usable:
+                    usable += 1
+                    ev = evaluate_couple("PC", pr.patch1, X1, V, pr.patch2, X2, V, f.u, 1.0)
+                    assert np.all(np.isfinite(ev.udot)) and math.isfinite(ev.bias_n)
+                    assert ev.gap == pytest.approx(c.distance, abs=1e-12)
+            except DrakeDockError:
+                pass
+    assert usable > 100
+    # Degenerate: the corner on the other ring's axis, and on its circle.
+    pr = pairs[0]
+    p = pr.patch1.p
+    for o in (np.array([p[0], p[1], p[2] - 0.3]),
+              p - np.array([pr.patch2.radius, 0.0, 0.0])):
+        X2 = (np.eye(3), o)
+        c = seek_couple(posed(pr.patch1, np.eye(3), np.zeros(3)), posed(pr.patch2, *X2))
+        f = contact_couple("PC", pr.patch1, (np.eye(3), np.zeros(3)), pr.patch2, X2, c,
+                           conditioning_min=1e-6)
+        try:
+            evaluate_couple("PC", pr.patch1, (np.eye(3), np.zeros(3)), V, pr.patch2, X2, V,
+                            f.u, 1.0)
+        except SingularCoupleError:
+            pass
+
