@@ -14,8 +14,8 @@ from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import Patch, posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.apds import (PAIR_SETS, ApdsGeometry, apds_patches, petal_edges,
-                                      side_phi)
+from drake_dock.docking.apds import (PAIR_SETS, ApdsGeometry, apds_patches, azimuth_span,
+                                      petal_edges, side_phi, spans_within)
 from drake_dock.docking.penetration import deepest_penetration
 from drake_dock.docking.rotations import rot_vec, rot_x, rot_z  # noqa: F401 (re-exported)
 from drake_dock.errors import InputError, NumericalError
@@ -45,8 +45,9 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     2.2 and 8.1, six guide side vs guide side (C-C, Body 1 = the chaser's side, as in Sect. 3.2),
     three chaser-ring vs target-surface and three target-ring vs chaser-surface (C-S, Body 1 =
     the ring). ``complete`` adds, for each APDS against the other (`edge_pairs`): the ring's
-    inside circle vs each guide side and each tip arc (C-C), and the ring's outside circle vs
-    the other ring's face (C-S)."""
+    inside circle vs each guide side and each tip arc (C-C), the ring's outside circle vs
+    the other ring's face (C-S), the tip arcs vs the guide surfaces they face (C-S), and the
+    guide sides vs the non-partner sides and tip arcs they reach (C-C, `side_edge_pairs`)."""
     if which not in PAIR_SETS:
         raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)
@@ -61,6 +62,7 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         pairs += edge_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
         pairs += tip_surface_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
         pairs += tip_surface_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
+        pairs += side_edge_pairs(P, R_MATCHED)
     return pairs
 
 
@@ -96,6 +98,24 @@ def tip_surface_pairs(P, one, other, R) -> list[PairSpec]:
             if w[0] * math.cos(a) + w[1] * math.sin(a) > 0.0:
                 out.append(PairSpec(f"cs_{x}tip{j}_{y}{k}", "CS", b1, P.tips[j], b2,
                                     P.surfaces[k]))
+    return out
+
+
+def side_edge_pairs(P, R) -> list[PairSpec]:
+    """The guide sides against the other APDS's petal edges they can reach, other than their
+    paper partners (C-C, Body 1 the side): chaser side j vs target side i, cc_T<i>_C<j>, and
+    side j vs tip arc k, cc_<X><j>_<Y>tip<k>; those whose `azimuth_span`s at the matched
+    facing (R: chaser frame to target frame) are `spans_within` reach (docs/model.md)."""
+    turn = {"C": (CHASER_APDS, R), "T": (TARGET_APDS, np.eye(3))}
+    span = {(x, c): azimuth_span(c, turn[x][1]) for x in turn for c in (*P.sides.values(),
+                                                                         *P.tips.values())}
+    out = [PairSpec(f"cc_T{i}_C{j}", "CC", CHASER_APDS, P.sides[j], TARGET_APDS, P.sides[i])
+           for j in range(1, 7) for i in range(1, 7) if (i, j) not in CC_SIDE_PAIRS
+           and spans_within(span["C", P.sides[j]], span["T", P.sides[i]])]
+    for x, y in (("C", "T"), ("T", "C")):
+        out += [PairSpec(f"cc_{x}{j}_{y}tip{k}", "CC", turn[x][0], P.sides[j], turn[y][0],
+                         P.tips[k]) for j in range(1, 7) for k in (1, 2, 3)
+                if spans_within(span[x, P.sides[j]], span[y, P.tips[k]])]
     return out
 
 
