@@ -44,6 +44,14 @@ def side_candidates(g: ApdsGeometry) -> list[PairSpec]:
     return out
 
 
+def tip_candidates(g: ApdsGeometry) -> list[PairSpec]:
+    """Every chaser tip arc against every target tip arc, cc_Ctip<j>_Ttip<k> (C-C): not in
+    `complete` (docs/model.md); the sweep measures which the motion reaches."""
+    P = apds_patches(g)
+    return [PairSpec(f"cc_Ctip{j}_Ttip{k}", "CC", "chaser_apds", P.tips[j], "target_apds",
+                     P.tips[k]) for j in (1, 2, 3) for k in (1, 2, 3)]
+
+
 def random_pose(rng, box: ReachBox):
     """(R, p) of the chaser APDS in the target APDS frame, and the roll (rad)."""
     roll = math.radians(box.roll_deg) * rng.uniform(-1.0, 1.0)
