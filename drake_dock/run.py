@@ -18,7 +18,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from drake_dock.docking.replay import replay_html
-from drake_dock.docking.scene import scenario_pairs
+from drake_dock.docking.pairs import scenario_pairs
 from drake_dock.docking.results import (momenta, momentum_reference_point, relative_text, summary,
                                         timeseries)
 from drake_dock.docking.simulate import simulate

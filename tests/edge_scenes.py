@@ -1,6 +1,8 @@
 """Small scenes of the edge and face pairs with closed-form couples along prescribed motions: a
-ring's circle over a straight edge and over a circular arc (C-C), a tilted ring rim over a ring
-face (C-S), and an edge made of a straight side and a tip arc meeting at a corner.
+ring's circle over a straight edge and over a circular arc (C-C), a straight edge over a skew
+straight edge and over an arc (C-C, a guide side against another side or a tip arc), a tilted
+ring rim over a ring face (C-S), and an edge made of a straight side and a tip arc meeting at a
+corner.
 
 Body 2 (the edge or face) turns about its z axis by chi(t) and translates by p2(t); Body 1 (the
 ring) is posed relative to it by R_rel = Rz(beta) Rx(tau) Rz(psi) and its centre c (Body 2's
@@ -30,7 +32,8 @@ class Wave:
 
 
 class EdgeScene:
-    """A pair of Body 1 (a ring's circle, radius r) against Body 2 along a prescribed motion;
+    """A pair of Body 1 (a ring's circle, radius r, or an edge) against Body 2 along a
+    prescribed motion;
     ``exact(t)`` gives the couple, gap and points in closed form."""
 
     def __init__(self, kind, patch1, patch2, c, psi, tau=Wave(0.0), beta=Wave(0.0),
@@ -38,7 +41,7 @@ class EdgeScene:
                                              Wave(0.0, 0.005, 2.0))):
         self.kind, self.patch1, self.patch2 = kind, patch1, patch2
         self.c, self.psi, self.tau, self.beta, self.chi, self.p2 = c, psi, tau, beta, chi, p2
-        self.r = patch1.radius
+        self.r = getattr(patch1, "radius", None)
         self.branches = (1,)          # the closed-form couples at the least distance
 
     def relative(self, t):
@@ -125,6 +128,62 @@ def ring_over_arc():
     def exact(t, branch=+1):
         th, x2 = arc_crossing(s, t, arc.radius, branch)
         return exact_cc(s, t, th, x2)
+
+    s.exact = exact
+    return s
+
+
+def _segment_line(scene, t):
+    """Body 1's segment as the line a + s e in Body 2's frame (s its parameter)."""
+    R, _, c, _ = scene.relative(t)
+    return c + R @ scene.patch1.a, R @ (scene.patch1.b - scene.patch1.a)
+
+
+def segment_over_segment():
+    """A straight edge (half-length 0.6) tilted by tau ~ 0.1 rad out of Body 2's plane and
+    turned by psi ~ 0.8 rad across Body 2's straight edge x in [-1, 1], ~40 mm above it,
+    sliding along it: the couple is the common normal of the two skew lines, s = (b e - c d) /
+    (a c - b^2), t = (a e - b d) / (a c - b^2) with a = e1.e1, b = e1.e2, c = e2.e2, d = e1.w,
+    e = e2.w, w = a1 - a2; the gap is its length and the normal runs along it."""
+    seg = Segment((-1.0, 0.0, 0.0), (1.0, 0.0, 0.0))
+    s = EdgeScene("CC", Segment((-0.6, 0.0, 0.0), (0.6, 0.0, 0.0)), seg,
+                  (Wave(0.0, 0.15, 0.9, v=0.1), Wave(0.02, 0.03, 1.2), Wave(0.04, 0.01, 1.3)),
+                  Wave(0.8, 0.3, 0.7), tau=Wave(0.1, 0.03, 1.1), beta=Wave(0.0, 0.1, 0.8))
+
+    def exact(t, branch=+1):
+        a1, e1 = _segment_line(s, t)
+        e2, w = seg.b - seg.a, a1 - seg.a
+        a, b, c, d, e = e1 @ e1, e1 @ e2, e2 @ e2, e1 @ w, e2 @ w
+        u = np.array([b * e - c * d, a * e - b * d]) / (a * c - b * b)
+        x1, x2 = a1 + u[0] * e1, seg.a + u[1] * e2
+        gap = float(np.linalg.norm(x1 - x2))
+        p1, p2 = s.world(t, x1, x2)
+        return u, gap, p1, p2, (p1 - p2) / gap
+
+    s.exact = exact
+    return s
+
+
+def segment_over_arc():
+    """A level straight edge (half-length 0.3) ~30 mm above a tip-like arc (radius 0.45, theta
+    in [0.2, 1.4]), crossing it near theta = 0.8 at an angle psi ~ 1.1 rad while moving along
+    it: the couple is where the edge's projection crosses the circle (the root s of
+    |a + s e|^2 = r^2 near the edge's middle), at the gap c_z, normal +z."""
+    arc = Arc(0.45, 0.0, (0.2, 1.4))
+    s = EdgeScene("CC", Segment((-0.3, 0.0, 0.0), (0.3, 0.0, 0.0)), arc,
+                  (Wave(0.32, 0.03, 0.8), Wave(0.31, 0.02, 1.1, v=-0.05),
+                   Wave(0.03, 0.01, 1.7)), Wave(1.1, 0.2, 0.6))
+
+    def exact(t, branch=+1):
+        a1, e1 = _segment_line(s, t)
+        A, B, C = e1[:2] @ e1[:2], 2 * a1[:2] @ e1[:2], a1[:2] @ a1[:2] - arc.radius ** 2
+        roots = [(-B + k * math.sqrt(B * B - 4 * A * C)) / (2 * A) for k in (-1, 1)]
+        u1 = min(roots, key=lambda r: abs(r - 0.5))
+        x2 = a1 + u1 * e1
+        x2[2] = 0.0
+        p1, p2 = s.world(t, x2 + a1[2] * EZ, x2)
+        return (np.array([u1, math.atan2(x2[1], x2[0])]), a1[2], p1, p2,
+                rot_z(s.chi(t)) @ EZ)
 
     s.exact = exact
     return s

@@ -307,6 +307,27 @@ def petal_corner(g: ApdsGeometry, i: int) -> Point:
     return Point(c + CORNER_RADIUS * out, CORNER_RADIUS)
 
 
+# Reach of a guide side against the other APDS's petal edges (`scene.side_edge_pairs`): the
+# roll range of the scenario (60 deg) and a margin for tilt and offset, which the seeded sweep
+# of `drake_dock.docking.reach` bounds (docs/model.md).
+SIDE_REACH = math.radians(60.0 + 10.0)
+
+
+def azimuth_span(curve, R=np.eye(3)):
+    """(mid-direction, half-width) about the axis, rad, of a guide side or tip arc (both
+    parametrized by their azimuth, Eq. 14-15) turned by R: the directions of its two ends."""
+    a, b = (math.atan2(x[1], x[0]) for x in (R @ curve.position(curve.lower),
+                                            R @ curve.position(curve.upper)))
+    half = 0.5 * ((b - a + math.pi) % (2 * math.pi) - math.pi)
+    return a + half, abs(half)
+
+
+def spans_within(one, other, reach=SIDE_REACH) -> bool:
+    """True when two `azimuth_span`s come within ``reach`` of each other about the axis."""
+    gap = abs((one[0] - other[0] + math.pi) % (2 * math.pi) - math.pi) - one[1] - other[1]
+    return gap < reach
+
+
 @dataclasses.dataclass
 class ApdsPatches:
     sides: dict      # i -> guide side n_i

@@ -27,7 +27,7 @@ from drake_dock.systems.contact_system import (ContactOptions, ContactPair, Hand
 from drake_dock.systems.simulator import tolerances
 from drake_dock.docking.outcome import CaptureRule, misalignment
 from drake_dock.docking.plant import DockingPlant, StewartDamperPower, make_docking_plant
-from drake_dock.docking.scene import pair_handovers, scenario_pairs
+from drake_dock.docking.pairs import pair_handovers, scenario_pairs
 
 
 @dataclasses.dataclass

@@ -19,7 +19,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from drake_dock.docking.plant import add_docking_plant
 from drake_dock.docking.replay_marks import add_marks, overlay_html
-from drake_dock.docking.scene import scenario_pairs
+from drake_dock.docking.pairs import scenario_pairs
 
 CAMERA_DISTANCE = 2.8     # m from the rings' midpoint, outside the hulls (radius 1.2 m)
 CAMERA_FOV = 26.0         # deg, vertical

@@ -25,7 +25,7 @@ from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.outcome import misalignment
 from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
                                       stewart_force, stewart_potential)
-from drake_dock.docking.scene import CHASER_APDS, scenario_pairs
+from drake_dock.docking.pairs import CHASER_APDS, scenario_pairs
 
 IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or sticking)
 

@@ -12,126 +12,14 @@ from scipy.optimize import brentq
 from drake_dock.core import covers
 from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.kernels import seek as compiled_seek
-from drake_dock.core.patches import Patch, posed
+from drake_dock.core.patches import posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.apds import (PAIR_SETS, ApdsGeometry, apds_patches, petal_edges,
-                                      side_phi)
+from drake_dock.docking.apds import ApdsGeometry
+from drake_dock.docking.pairs import (CHASER_APDS, R_MATCHED, TARGET_APDS, PairSpec,
+                                      apds_pairs)
 from drake_dock.docking.penetration import deepest_penetration
 from drake_dock.docking.rotations import rot_vec, rot_x, rot_z  # noqa: F401 (re-exported)
 from drake_dock.errors import InputError, NumericalError
-
-TARGET_APDS = "target_apds"
-CHASER_APDS = "chaser_apds"
-
-# Sect. 2.2: guide side n_i of the target faces n_j of the chaser.
-CC_SIDE_PAIRS = ((1, 5), (2, 4), (3, 3), (4, 2), (5, 1), (6, 6))
-
-
-@dataclasses.dataclass(frozen=True)
-class PairSpec:
-    """A potential contact pair. Body 1 carries the curve (Sect. 4.3), or the point of a
-    point-curve pair; the normal of its couple points from Body 2 to Body 1 (Definition 2)."""
-
-    name: str
-    kind: str            # "CC", "CS" or "PC" (a point on Body 1)
-    body1: str
-    patch1: Patch
-    body2: str
-    patch2: Patch
-
-
-def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
-    """The contact pairs of the set ``which`` (`PAIR_SETS`). ``paper``: the 12 pairs of Sect.
-    2.2 and 8.1, six guide side vs guide side (C-C, Body 1 = the chaser's side, as in Sect. 3.2),
-    three chaser-ring vs target-surface and three target-ring vs chaser-surface (C-S, Body 1 =
-    the ring). ``complete`` adds, for each APDS against the other (`edge_pairs`): the ring's
-    inside circle vs each guide side and each tip arc (C-C), the ring's outside circle vs
-    the other ring's face (C-S), the tip arcs vs the guide surfaces they can face (C-S,
-    `tip_surface_pairs`) and the other APDS's petal corners vs the ring's inside circle
-    (point-curve, `corner_pairs`)."""
-    if which not in PAIR_SETS:
-        raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
-    P = apds_patches(g)
-    pairs = [PairSpec(f"cc_T{i}_C{j}", "CC", CHASER_APDS, P.sides[j], TARGET_APDS, P.sides[i])
-             for i, j in CC_SIDE_PAIRS]
-    pairs += [PairSpec(f"cs_Cring_T{k}", "CS", CHASER_APDS, P.ring, TARGET_APDS, P.surfaces[k])
-              for k in (1, 2, 3)]
-    pairs += [PairSpec(f"cs_Tring_C{k}", "CS", TARGET_APDS, P.ring, CHASER_APDS, P.surfaces[k])
-              for k in (1, 2, 3)]
-    if which == "complete":
-        pairs += edge_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
-        pairs += edge_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
-        pairs += tip_surface_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
-        pairs += tip_surface_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
-        pairs += corner_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
-        pairs += corner_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
-    return pairs
-
-
-def scenario_pairs(scenario) -> list[PairSpec]:
-    """The pairs of the scenario's contact set (`contact.pairs`)."""
-    return apds_pairs(scenario.geometry, scenario.contact.pairs)
-
-
-def edge_pairs(P, one, other) -> list[PairSpec]:
-    """The pairs of APDS ``one``'s ring (Body 1) against APDS ``other``'s petal edges and face;
-    ``one`` and ``other`` are (letter, body). Names: cc_<X>ring_<Y><i> (inside circle vs guide
-    side i), cc_<X>ring_<Y>tip<k> (vs tip arc k), cs_<X>rim_<Y>face (outside circle vs face)."""
-    (x, b1), (y, b2) = one, other
-    out = [PairSpec(f"cc_{x}ring_{y}{i}", "CC", b1, P.ring, b2, P.sides[i]) for i in range(1, 7)]
-    out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
-    out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
-    return out
-
-
-def corner_pairs(P, one, other) -> list[PairSpec]:
-    """APDS ``other``'s six petal corners (Body 1, `petal_corner`) against APDS ``one``'s
-    ring inside circle (Body 2), pc_<Y>corner<i>_<X>ring (point-curve, kind "PC"; X the ring's
-    APDS, Y the corner's): corner i is where guide side i meets its tip arc."""
-    (x, b_ring), (y, b_corner) = one, other
-    return [PairSpec(f"pc_{y}corner{i}_{x}ring", "PC", b_corner, P.corners[i], b_ring, P.ring)
-            for i in range(1, 7)]
-
-
-def tip_surface_pairs(P, one, other, R) -> list[PairSpec]:
-    """APDS ``one``'s tip arcs (Body 1) against the guide surfaces of APDS ``other`` they can
-    face, cs_<X>tip<j>_<Y><k> (C-S); R turns ``other``'s frame into ``one``'s at the matched
-    facing. Tip arc j faces surface k when their mid-directions are less than 90 deg apart
-    about the axis at the matched facing: the two petals next to the gap it enters, reached at
-    a relative roll near +-60 deg; the third petal is 180 deg away (docs/model.md)."""
-    (x, b1), (y, b2) = one, other
-    out = []
-    for j in (1, 2, 3):
-        a = side_phi(2 * j - 1) + math.pi / 6
-        for k in (1, 2, 3):
-            b = side_phi(2 * k - 1) + math.pi / 6
-            w = R @ np.array([math.cos(b), math.sin(b), 0.0])
-            if w[0] * math.cos(a) + w[1] * math.sin(a) > 0.0:
-                out.append(PairSpec(f"cs_{x}tip{j}_{y}{k}", "CS", b1, P.tips[j], b2,
-                                    P.surfaces[k]))
-    return out
-
-
-def pair_handovers(g: ApdsGeometry, pairs) -> list:
-    """(edge pair, surface pair, `SurfaceEdge`) of each hand-over among ``pairs``
-    (`drake_dock.core.handover`): a ring's inside circle passes between guide surface k
-    (cs_<X>ring_<Y>k) and its sides 2k - 1, 2k (cc_<X>ring_<Y><i>) and its tip arc
-    (cc_<X>ring_<Y>tip<k>), `petal_edges`."""
-    names = {p.name for p in pairs}
-    out = []
-    for x, y in (("C", "T"), ("T", "C")):
-        for k in (1, 2, 3):
-            for key, edge in petal_edges(g, k).items():
-                e = f"cc_{x}ring_{y}{'tip' + str(k) if key == 'tip' else key}"
-                if {e, f"cs_{x}ring_{y}{k}"} <= names:
-                    out.append((e, f"cs_{x}ring_{y}{k}", edge))
-    return out
-
-
-# Matched facing (docs/model.md): the chaser's APDS frame is the target's turned by pi about a
-# transverse axis and by 240 deg about the docking axis, so that the pairs of Sect. 2.2 face.
-R_MATCHED = rot_z(math.radians(240.0)) @ rot_x(math.pi)
-
 
 def relative_pose(yaw_rad: float, d: float):
     """Pose (R, p) of the chaser APDS in the target APDS frame: coaxial, ring faces d apart,

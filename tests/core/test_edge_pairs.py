@@ -1,5 +1,7 @@
 """The edge and face pairs (`contact.pairs: complete`) in closed form (tests/edge_scenes.py): a
-ring's circle over a straight edge and over a tip arc (C-C), a tilted rim over a ring face (C-S),
+ring's circle over a straight edge and over a tip arc, a straight edge over a skew straight edge
+and over an arc (C-C: a guide side against another side or a tip arc), a tilted rim over a ring
+face (C-S),
 a tip arc over a guide-surface cone (C-S) and the hand-over at a petal-like tip, tracked by Eq. (47) through prescribed motions to 1e-8;
 the compiled kernels against the Python reference to 1e-12."""
 import math
@@ -17,9 +19,10 @@ from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.docking.apds import ApdsGeometry, apds_patches, corner_point
 from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec
 from edge_scenes import (CORNER, arc_over_cone, rim_over_face, ring_over_arc, ring_over_segment,
-                         tip_handover)
+                         segment_over_arc, segment_over_segment, tip_handover)
 
 SCENES = {"ring_over_segment": ring_over_segment, "ring_over_arc": ring_over_arc,
+          "segment_over_segment": segment_over_segment, "segment_over_arc": segment_over_arc,
           "rim_over_face": rim_over_face, "arc_over_cone": arc_over_cone}
 TIMES = np.linspace(0.0, 1.0, 11)
 
@@ -163,12 +166,14 @@ def test_kernels_equal_the_python_path(name):
 def test_complete_set_names_and_patches(geom):
     """`paper` is the 12 pairs; `complete` adds, per APDS, its ring's inside circle against the
     other's 6 sides and 3 tip arcs, its rim against the other's face and its tip arcs against
-    the other's guide surfaces they can face (32 pairs), and its ring's inside circle against
-    the other's 6 petal corners, each the top end of its guide side (12 point-curve pairs)."""
+    the other's guide surfaces they can face (32 pairs), its ring's inside circle against
+    the other's 6 petal corners, each the top end of its guide side (12 point-curve pairs),
+    and the guide sides against the non-partner sides and the tip arcs they can reach (36
+    pairs)."""
     paper, complete = apds_pairs(geom), apds_pairs(geom, "complete")
     assert [p.name for p in complete[:12]] == [p.name for p in paper] and len(paper) == 12
     new = {p.name: p for p in complete[12:]}
-    assert len(new) == 44
+    assert len(new) == len(complete) - 12 == 80
     P = apds_patches(geom)
     for x, y, bx, by in (("C", "T", "chaser_apds", "target_apds"),
                          ("T", "C", "target_apds", "chaser_apds")):
@@ -195,6 +200,16 @@ def test_complete_set_names_and_patches(geom):
             assert np.array_equal(patch.position(u), expected.position(u))
     assert new["cc_Tring_Ctip2"].body1 == "target_apds"
     assert new["cs_Crim_Tface"].kind == "CS" and new["cs_Crim_Tface"].body2 == "target_apds"
+    for name, b1, c1, b2, c2 in (("cc_T4_C1", "chaser_apds", P.sides[1], "target_apds",
+                                  P.sides[4]),
+                                 ("cc_T2_Ctip3", "target_apds", P.sides[2], "chaser_apds",
+                                  P.tips[3])):
+        pr = new[name]
+        assert (pr.kind, pr.body1, pr.body2) == ("CC", b1, b2)
+        for patch, expected in ((pr.patch1, c1), (pr.patch2, c2)):
+            u = np.linspace(expected.lower, expected.upper, 5)
+            assert np.array_equal(patch.lower, expected.lower)
+            assert np.array_equal(patch.position(u), expected.position(u))
     # The tip arc is where the guide surface meets zeta = H, between its two sides' ends.
     for k in (1, 2, 3):
         tip, surf = P.tips[k], P.surfaces[k]
@@ -247,3 +262,67 @@ def test_tip_arcs_face_the_surfaces_their_pairs_name(geom):
                     if (((az - lo) % (2 * math.pi)) <= math.pi / 3).any():
                         reach.add(f"cs_{x}tip{j}_{y}{k}")
     assert names == reach and len(names) == 12
+
+
+def _azimuths(curve, R, n=40):
+    """The directions about the axis (rad) of n points along a guide side or tip arc turned by
+    R."""
+    pts = curve.position(np.linspace(curve.lower, curve.upper, n)) @ R.T
+    return np.arctan2(pts[:, 1], pts[:, 0])
+
+
+def test_sides_reach_the_edges_their_pairs_name(geom):
+    """A guide side has a pair with a non-partner guide side or a tip arc of the other APDS
+    exactly when, at some relative roll in the scenario's range (-60 to 60 deg), a point of the
+    one comes within 10 deg of a point of the other about the axis (the margin for tilt and
+    offset): sampled rolls and curve points. These are the sides 60 deg from the partner and
+    the tip arcs 30 and 90 deg from the side's root."""
+    from drake_dock.docking.pairs import CC_SIDE_PAIRS
+    from drake_dock.docking.scene import relative_pose
+    P = apds_patches(geom)
+    names = {p.name for p in apds_pairs(geom, "complete")[12:]
+             if p.name.startswith("cc_") and "ring" not in p.name}
+    margin = math.radians(10.0)
+    rolls = np.radians(np.linspace(-60.0, 60.0, 241))
+    R = {roll: relative_pose(roll, 0.0)[0] for roll in rolls}    # the chaser's frame
+    near = lambda a, b: bool((np.abs((a[:, None] - b[None, :] + math.pi) % (2 * math.pi)
+                                     - math.pi) < margin).any())
+    reach = set()
+    for roll in rolls:
+        az = {("C", "side", j): _azimuths(P.sides[j], R[roll]) for j in range(1, 7)}
+        az |= {("T", "side", i): _azimuths(P.sides[i], np.eye(3)) for i in range(1, 7)}
+        az |= {("C", "tip", k): _azimuths(P.tips[k], R[roll]) for k in (1, 2, 3)}
+        az |= {("T", "tip", k): _azimuths(P.tips[k], np.eye(3)) for k in (1, 2, 3)}
+        for i in range(1, 7):
+            for j in range(1, 7):
+                if (i, j) not in CC_SIDE_PAIRS and near(az["C", "side", j], az["T", "side", i]):
+                    reach.add(f"cc_T{i}_C{j}")
+        for x, y in (("C", "T"), ("T", "C")):
+            for j in range(1, 7):
+                for k in (1, 2, 3):
+                    if near(az[x, "side", j], az[y, "tip", k]):
+                        reach.add(f"cc_{x}{j}_{y}tip{k}")
+    assert names == reach and len(names) == 36
+
+
+def test_the_reach_sweep_finds_no_undeclared_side_pair(geom):
+    """Over 2000 seeded random poses (roll -60..60 deg, tilt up to 10 deg, offset up to 0.15 m,
+    ring faces -0.2..0.45 m apart; `drake_dock.docking.reach`), every candidate side pair whose
+    closest couple comes interior within 2 cm is declared by `complete`; the declared pairs
+    whose azimuth spans come within 50 deg (the sides 60 deg from the partner, the tip arcs 30
+    deg from the side's root) are all reached. bench/edge_reach.py runs the sweep at 20000."""
+    from drake_dock.docking.reach import reach_sweep, side_candidates
+    from drake_dock.docking.apds import azimuth_span, spans_within
+    from drake_dock.docking.scene import R_MATCHED
+    declared = {p.name: p for p in apds_pairs(geom, "complete")}
+    rows = reach_sweep(geom, side_candidates(geom), 2000)
+    reached = {k for k, (hits, _, _) in rows.items() if hits}
+    assert reached <= set(declared), sorted(reached - set(declared))
+    close = set()
+    for k in set(rows) & set(declared):
+        pr = declared[k]
+        turn = {"chaser_apds": R_MATCHED, "target_apds": np.eye(3)}
+        if spans_within(azimuth_span(pr.patch1, turn[pr.body1]),
+                        azimuth_span(pr.patch2, turn[pr.body2]), math.radians(50.0)):
+            close.add(k)
+    assert len(close) == 24 and close <= reached, sorted(close - reached)
