@@ -54,7 +54,7 @@ import numpy as np
 # compiled code the couple kernels share (`drake_dock.core.kernels.frames`).
 from drake_dock.core.kernels.frames import frame_rates_cc, frame_rates_cs, frame_rates_pc
 from drake_dock.core.vec3 import add as _add, axpy as _axpy, cross as _cr, dot as _dot, \
-    rot as _rot, sub as _sub
+    mul as _mul, rot as _rot, sub as _sub
 from drake_dock.errors import SingularCoupleError
 
 
@@ -323,6 +323,14 @@ def _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, projec
     sig = float(sigma)
     n, ndot, ta, tadot, conv = frame_rates_pc(d, t2, _axpy(-sdot, t2, v_rel),
                                               _axpy(sdot, k2, w2t2), tuple(w2), sdot, sig)
+    # The contact point is the sphere's point towards the curve, q = -r d/|d| from its centre:
+    # v_rel there, and its motion over the sphere, w1 x (q' - w1 x q), in the Eq. (52) term
+    # (the normal row's terms equal the centre's).
+    q = _mul(n, -patch1.radius * sig)
+    qdot = _mul(ndot, -patch1.radius * sig)
+    P1 = _add(P1, q)
+    v_rel = _add(v_rel, _cr(w1, q))
+    conv = _add(conv, _cr(w1, _sub(qdot, _cr(w1, q))))
     tb = _cr(n, ta)
     tbdot = _add(_cr(ndot, ta), _cr(n, tadot))
     return CoupleEval(

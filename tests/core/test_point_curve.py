@@ -241,3 +241,21 @@ def test_scene_corner_pairs_random_poses_raise_only_typed_errors():
         except SingularCoupleError:
             pass
 
+
+
+@pytest.mark.parametrize("r_pt", [0.0, 0.003])
+@pytest.mark.parametrize("m1", MOVING)
+def test_contact_points_lie_on_the_line_of_action(m1, r_pt):
+    """The couple's points are the sphere's point nearest the curve and the curve's point:
+    p1 - p2 = g n (closed form: the sphere's centre lies |d| from the curve along n, its
+    surface r nearer), so forces +-F at them have no moment when the couple touches (g = 0),
+    whatever their direction (friction included): momentum and angular momentum conserved."""
+    point, ring = Point((0.03, -0.02, 0.04), r_pt), Circle(R_C)
+    for t in (0.2, 0.55, 0.9):
+        X1 = m1.pose(t)
+        centre = X1[1] + X1[0] @ point.p
+        s = closed_form(centre, *RING.pose(t))[0]
+        e = evaluate_couple("PC", point, X1, m1.twist(t), ring, RING.pose(t), RING.twist(t),
+                            [s], 1.0)
+        np.testing.assert_allclose(e.p1 - e.p2, e.gap * e.n, atol=1e-15)
+        np.testing.assert_allclose(np.linalg.norm(centre - e.p1), r_pt, atol=1e-15)

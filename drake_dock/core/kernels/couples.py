@@ -21,7 +21,7 @@ from numba import njit
 
 from drake_dock.core.kernels.frames import (add as _add, axpy as _axpy, cross as _cr, dot as _dot,
                                              frame_rates_cc, frame_rates_cs, frame_rates_pc,
-                                             sub as _sub)
+                                             mul as _mul, sub as _sub)
 from drake_dock.core.kernels.jets import jet
 
 # Row layout: u (3), drift (3), udot (3), residual, conditioning, p1 (3), p2 (3), n (3),
@@ -268,6 +268,14 @@ def evaluate_pc_one(kind2, prm2, p, radius, R1, o1, w1, v1, R2, o2, w2, v2, s, s
     sdot = -Ft / Fu if cond > 1e-14 else 0.0
     nv, ndot, ta, tadot, conv = frame_rates_pc(d, T2, _axpy(-sdot, T2, v_rel),
                                                _axpy(sdot, K2, w2t2), w2, sdot, sigma)
+    # The contact point is the sphere's point towards the curve, q = -radius d/|d| from its
+    # centre: v_rel there, and its motion over the sphere, w1 x (q' - w1 x q), in the Eq. (52)
+    # term (the normal row's terms equal the centre's).
+    q = _mul(nv, -radius * sigma)
+    qdot = _mul(ndot, -radius * sigma)
+    x1 = _add(x1, q)
+    v_rel = _add(v_rel, _cr(w1, q))
+    conv = _add(conv, _cr(w1, _sub(qdot, _cr(w1, q))))
     tb = _cr(nv, ta)
     tbdot = _add(_cr(ndot, ta), _cr(nv, tadot))
     out[UDOT] = sdot
