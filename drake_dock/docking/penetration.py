@@ -15,7 +15,11 @@ and its face, the six guide sides (Eq. 14) and the three petal tip arcs (zeta = 
 A thin plate has no inside, so a point *crosses* a petal when its s changes sign at a place
 over the plate (its foot, interpolated to s = 0 between two sub-steps, inside the petal): a
 point passing round a side or over the tip changes side without crossing. A point that has
-crossed (an odd number of times) lies at depth |s| while it is over the plate. A point inside
+crossed (an odd number of times) is inside while it is over the plate, at the depth of the
+least motion that ends that: back through the plate (|s|) or off the plate past its nearest
+free edge (the distance of its foot to the guide sides and the tip arc; the root is fixed to
+the ring). Near an edge the second is the smaller: a guide side sliding on its partner's edge
+that rides up over the edge by 30 um lies 30 um deep, however far it is above the plate. A point inside
 the other ring's solid lies at its distance to the nearest face. Checked: guide sides, tip arcs
 and the ring's inside circle against the other APDS's petals; the ring's circles and face
 against the other ring. A petal passing through the other ring's annulus (so also the ring's
@@ -108,6 +112,36 @@ def _over(g, frac, zeta_f, tol=1e-9):
     return (frac >= -tol) & (frac <= 1 + tol) & (zeta_f >= -tol) & (zeta_f <= g.H + tol)
 
 
+def free_edges(g, n=4001) -> dict:
+    """{petal k: (M, 3) polyline} of petal k's free edges in the APDS frame, fine enough that
+    a chord lies within 1e-9 m of the curve: guide side 2k - 1, the tip arc, guide side 2k
+    (Eq. 14 and zeta = H; the root is fixed to the ring)."""
+    f = feature_points(g, n_side=n, n_arc=n)
+    return {k: np.concatenate([f[f"guide side {2 * k - 1}"][::-1], f[f"petal {k} tip arc"],
+                               f[f"guide side {2 * k}"]]) for k in (1, 2, 3)}
+
+
+def foot_on_cone(g, X, s):
+    """The feet of points X (M, 3) at signed distances s (M,) from the cone (Eq. 12)."""
+    e = X[:, :2] / np.maximum(np.hypot(X[:, 0], X[:, 1]), 1e-300)[:, None]
+    n = np.column_stack([math.sin(g.alpha1) * e, np.full(len(X), math.cos(g.alpha1))])
+    return X - s[:, None] * n
+
+
+def distance_to_polyline(F, P):
+    """Distance of points F (M, 3) to the polyline P (N, 3): to the two segments beside each
+    point's nearest vertex."""
+    if len(F) == 0:
+        return np.zeros(0)
+    j = np.argmin(((F[:, None, :] - P[None, :, :]) ** 2).sum(-1), axis=1)
+    best = np.full(len(F), np.inf)
+    for a, b in ((np.maximum(j - 1, 0), j), (j, np.minimum(j + 1, len(P) - 1))):
+        A, d = P[a], P[b] - P[a]
+        u = np.clip(((F - A) * d).sum(-1) / np.maximum((d * d).sum(-1), 1e-300), 0.0, 1.0)
+        best = np.minimum(best, np.linalg.norm(F - A - u[:, None] * d, axis=1))
+    return best
+
+
 def ring_depth_of(g, X, ring_depth):
     """Depth of points X (M, 3) inside the ring's solid (<= 0: outside)."""
     rho = np.hypot(X[:, 0], X[:, 1])
@@ -149,51 +183,69 @@ def sub_steps(t, R, p, reach, max_travel):
 
 @dataclasses.dataclass
 class _PetalWatch:
-    """One feature against one petal: each point's last s and foot, and whether it has crossed."""
+    """One feature against one petal: each point's last s, foot and place on the petal, and
+    whether it has crossed."""
 
     name: str
     solid: str
-    edge: float = 1e-9         # m: the plate's edges widened by this (narrowed if negative)
+    edges: np.ndarray          # the petal's free edges (`free_edges`)
+    graze: float = 1e-6        # m: a crossing this close to a free edge passes round it
     s: np.ndarray = None
+    foot: np.ndarray = None
     frac: np.ndarray = None
     zeta: np.ndarray = None
     crossed: np.ndarray = None
 
-    def step(self, g, s, frac, zeta):
-        """Updates with the sub-step's coordinates; returns the depth of each point."""
+    def step(self, g, X, s, frac, zeta):
+        """Updates with the sub-step's points X and their coordinates; returns the depth of
+        each point."""
+        foot = foot_on_cone(g, X, s)
         if self.s is None:
             self.crossed = np.zeros(len(s), dtype=bool)
         else:
-            flip = np.sign(s) * np.sign(self.s) < 0
-            if flip.any():
-                w = self.s[flip] / (self.s[flip] - s[flip])      # where s = 0, linearly
-                through = _over(g, self.frac[flip] + w * (frac[flip] - self.frac[flip]),
-                                self.zeta[flip] + w * (zeta[flip] - self.zeta[flip]),
-                                self.edge)
-                idx = np.flatnonzero(flip)[through]
+            flip = np.flatnonzero(np.sign(s) * np.sign(self.s) < 0)
+            if len(flip):
+                w = (self.s[flip] / (self.s[flip] - s[flip]))[:, None]     # s = 0, linearly
+                mid = [a + w[:, 0] * (b - a) for a, b in ((self.frac[flip], frac[flip]),
+                                                          (self.zeta[flip], zeta[flip]))]
+                idx = flip[_over(g, *mid)]
+                if len(idx) and self.graze > 0.0:
+                    w = (self.s[idx] / (self.s[idx] - s[idx]))[:, None]
+                    at = self.foot[idx] + w * (foot[idx] - self.foot[idx])
+                    idx = idx[distance_to_polyline(at, self.edges) > self.graze]
                 self.crossed[idx] = ~self.crossed[idx]
-        self.s, self.frac, self.zeta = s, frac, zeta
-        return np.where(self.crossed & _over(g, frac, zeta), np.abs(s), 0.0)
+        self.s, self.foot, self.frac, self.zeta = s, foot, frac, zeta
+        depth = np.zeros(len(s))
+        inside = np.flatnonzero(self.crossed & _over(g, frac, zeta))
+        if len(inside):
+            off = distance_to_polyline(foot[inside], self.edges)
+            depth[inside] = np.minimum(np.abs(s[inside]), off)
+        return depth
 
 
 def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=1e-3,
-                        features=None, edge=1e-9) -> Penetration:
+                        features=None, graze=1e-6) -> Penetration:
     """The deepest interpenetration of the two APDS over the samples t (N,) with their frames'
     poses R_WA (N, 2, 3, 3), p_WA (N, 2, 3) (the timeseries fields), names the two APDS names;
     ``features`` replaces `feature_points` (a subset, for tests). A point crosses a petal where
-    its foot lies within ``edge`` (m) outside the plate's edges or further in; a negative edge
-    takes a crossing that close to an edge (a grazing of the edge) as passing round it."""
+    its foot lies on the plate and more than ``graze`` (m) from its free edges; closer, it grazes
+    an edge and passes round it: an edge in contact with a petal's edge holds the two at
+    distance 0, so each of its points that the contact slides past passes exactly through
+    the other edge (the default, 1 um, is above the sub-steps' interpolation error, 0.1 um at
+    1 mm travel; a real slicing of the plate is seen by the feature's points further in)."""
     feats = feature_points(g) if features is None else features
     reach = max(float(np.linalg.norm(X, axis=1).max()) for X in feats.values())
     best = Penetration()
+    edges = free_edges(g)
     for a, b in ((0, 1), (1, 0)):
         R, p = relative_poses(R_WA, p_WA, a, b)
-        watches = {(f, k): _PetalWatch(f"{names[a]} {f}", f"{names[b]} petal {k}", edge)
+        watches = {(f, k): _PetalWatch(f"{names[a]} {f}", f"{names[b]} petal {k}", edges[k],
+                                       graze)
                    for f in feats if f.startswith(PETAL_FEATURES) for k in (1, 2, 3)}
         for tt, Rab, pab in sub_steps(t, R, p, reach, max_travel):
             for fname, X in feats.items():
                 Y = X @ Rab.T + pab
-                found = [(w.solid, w.step(g, *petal_coordinates(g, Y, k)))
+                found = [(w.solid, w.step(g, Y, *petal_coordinates(g, Y, k)))
                          for (f, k), w in watches.items() if f == fname]
                 if fname.startswith(RING_FEATURES):
                     found.append((f"{names[b]} ring", ring_depth_of(g, Y, ring_depth)))

@@ -365,7 +365,7 @@ def _check_free_approach(g: ApdsGeometry, approach: Approach, which: str):
     eye, zero = np.eye(3), np.zeros(3)
     found = deepest_penetration(g, np.array([0.0, 1.0]), np.array([[eye, R0], [eye, R1]]),
                                 np.array([[zero, p0], [zero, p1]]), ("target", "chaser"),
-                                edge=-FREE_APPROACH_TOL)
+                                graze=FREE_APPROACH_TOL)
     if found.depth > FREE_APPROACH_TOL:
         height = approach.height(lam0) * (1.0 - found.time)
         raise NoPairCloses(

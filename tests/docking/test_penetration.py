@@ -110,3 +110,42 @@ def test_a_ring_passing_through_a_petal_and_out_between_samples_is_seen(geom):
     leaving = 0.1 / (0.2 * math.sin(geom.alpha1))     # path fraction where the foot is at 0
     assert found.depth == pytest.approx(0.06 * leaving - 0.01, abs=1e-3)
     assert 0.0 < found.time < 1e-3
+
+
+def _near_side(g, delta, zeta=0.1):
+    """The point of petal 1's guide surface delta (m) in from guide side 1 at height zeta, and
+    the cone's outward normal there: guide side 1 (Eq. 14) at zeta, moved delta along the
+    surface at right angles to the side (the side's tangent from two points of Eq. 14) and
+    back onto the cone."""
+    A, tan1 = g.R * math.sin(g.alpha2), math.tan(g.alpha1)
+
+    def side(rho):                                 # Eq. (14), i = 1, at radius rho
+        th = math.asin(A / rho) - g.alpha2
+        return np.array([rho * math.cos(th), rho * math.sin(th), (g.R - rho) * tan1])
+
+    rho = g.R - zeta / tan1
+    x = side(rho)
+    tangent = side(rho - 1e-6) - side(rho + 1e-6)
+    n = math.sin(g.alpha1) * np.array([x[0], x[1], 0.0]) / rho + [0.0, 0.0, math.cos(g.alpha1)]
+    inward = np.cross(n, tangent)
+    inward /= np.linalg.norm(inward)
+    if petal_coordinates(g, (x + 1e-3 * inward)[None], 1)[1][0] < 0.0:
+        inward = -inward
+    y = x + delta * inward
+    e = np.array([y[0], y[1], 0.0]) / math.hypot(y[0], y[1])
+    n = math.sin(g.alpha1) * e + [0.0, 0.0, math.cos(g.alpha1)]
+    off = (math.hypot(y[0], y[1]) - g.R) * math.sin(g.alpha1) + y[2] * math.cos(g.alpha1)
+    return y - off * n, n                          # back onto the cone (Eq. 12)
+
+
+@pytest.mark.parametrize("delta,s,depth", [(50e-6, 2e-3, 50e-6), (3e-3, 2e-3, 2e-3),
+                                           (0.5e-6, 2e-3, 0.0)])
+def test_depth_near_a_free_edge_is_the_least_motion_out(geom, delta, s, depth):
+    """A point pushed s through petal 1 at delta from guide side 1 lies min(s, delta) deep:
+    back through the plate, or sideways off it past the side. Within the 1 um graze of the
+    side it passes round the edge (an edge in contact with the side passes exactly through it)."""
+    x, n = _near_side(geom, delta)
+    found = _depth_along(geom, [x + 0.01 * n, x - s * n])
+    assert found.depth == pytest.approx(depth, abs=1e-9)      # the edges as chords
+    if depth:
+        assert found.solid == "target_apds petal 1"
