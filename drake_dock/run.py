@@ -133,7 +133,15 @@ def format_summary(s) -> str:
         f"{relative_text(led['closure_error_relative'])}",
         f"wall time {s['wall_time_s']:.2f} s for {s['end_time_s']:.4f} s simulated "
         f"({s['derivative_evaluations']} derivative evaluations)",
-        time_shares_line(s["time_shares"])])
+        time_shares_line(s["time_shares"]), *pair_type_lines(s["cost_by_pair_type"])])
+
+
+def pair_type_lines(cost) -> list:
+    """A line per pair type tracked or sought: its seeks and their wall time, and the
+    evaluations in which a pair of it was tracked."""
+    return [f"  {t}: {c['pairs']} pairs, {c['seeks']} seeks ({c['seek_time_s']:.3g} s), "
+            f"{c['screens']} screened, tracked in {c['tracked_evaluations']} evaluations"
+            for t, c in cost.items() if c["seeks"] or c["tracked_evaluations"]]
 
 
 def time_shares_line(ts) -> str:

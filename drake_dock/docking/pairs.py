@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import numpy as np
 
@@ -123,6 +124,38 @@ def side_edge_pairs(P, R) -> list[PairSpec]:
         out += [PairSpec(f"cc_{x}{j}_{y}tip{k}", "CC", turn[x][0], P.sides[j], turn[y][0],
                          P.tips[k]) for j in range(1, 7) for k in (1, 2, 3)
                 if spans_within(span[x, P.sides[j]], span[y, P.tips[k]])]
+    return out
+
+
+# The pair types of the names above, for the cost of each type in a run's time shares.
+PAIR_TYPES = (
+    (re.compile(r"cc_T\d_C\d$"), "guide side / guide side"),
+    (re.compile(r"cs_[CT]ring_[CT]\d$"), "ring inside circle / guide surface"),
+    (re.compile(r"cc_[CT]ring_[CT]\d$"), "ring inside circle / guide side"),
+    (re.compile(r"cc_[CT]ring_[CT]tip\d$"), "ring inside circle / tip arc"),
+    (re.compile(r"cs_[CT]rim_[CT]face$"), "ring outside circle / ring face"),
+    (re.compile(r"cs_[CT]tip\d_[CT]\d$"), "tip arc / guide surface"),
+    (re.compile(r"pc_[CT]corner\d_[CT]ring$"), "petal corner / ring inside circle"),
+    (re.compile(r"cc_[CT]\d_[CT]tip\d$"), "guide side / tip arc"))
+
+
+def pair_type(name: str) -> str:
+    """The type of the pair named ``name`` (`PAIR_TYPES`), or the name itself."""
+    return next((t for rx, t in PAIR_TYPES if rx.match(name)), name)
+
+
+def cost_by_pair_type(time_shares: dict) -> dict:
+    """{pair type: pairs declared, seeks, screenings, wall time of both (s), evaluations with
+    a pair tracked} from a run's time shares (`drake_dock.systems.profiling.Timing.shares`)."""
+    out = {}
+    for name, seeks in time_shares["seeks_per_pair"].items():
+        row = out.setdefault(pair_type(name), {"pairs": 0, "seeks": 0, "screens": 0,
+                                               "seek_time_s": 0.0, "tracked_evaluations": 0})
+        row["pairs"] += 1
+        row["seeks"] += seeks
+        row["screens"] += time_shares["screens_per_pair"][name]
+        row["seek_time_s"] += time_shares["seek_time_per_pair"][name]
+        row["tracked_evaluations"] += time_shares["tracked_evaluations_per_pair"][name]
     return out
 
 

@@ -25,7 +25,7 @@ from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.outcome import misalignment
 from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
                                       stewart_force, stewart_potential)
-from drake_dock.docking.pairs import CHASER_APDS, scenario_pairs
+from drake_dock.docking.pairs import CHASER_APDS, cost_by_pair_type, scenario_pairs
 
 IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or sticking)
 
@@ -200,5 +200,6 @@ def summary(result, ts: dict) -> dict:
         "derivative_evaluations": result.evaluations,
         "wall_time_s": result.wall_time,
         "time_shares": result.timing,
+        "cost_by_pair_type": cost_by_pair_type(result.timing),
     }
 

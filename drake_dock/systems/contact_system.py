@@ -202,8 +202,13 @@ class RigidContactSystem(LeafSystem):
             x = context.get_continuous_state_vector().CopyToVector()
             key = self.evaluator.key(t, x, modes, inputs)
             value.set_value(self._evaluations.get(
-                key, lambda: self.evaluator.evaluate(t, x, modes, inputs),
+                key, lambda: self._evaluate(t, x, modes, inputs),
                 refresh=lambda E: E if E.modes is modes else E.under(modes)))
+
+    def _evaluate(self, t, x, modes, inputs) -> Evaluation:
+        self.timing.count_tracked([p.name for p, st in zip(self.pairs, modes.pairs)
+                                   if st.mode != Mode.FAR])
+        return self.evaluator.evaluate(t, x, modes, inputs)
 
     def DoCalcTimeDerivatives(self, context, derivatives):
         derivatives.get_mutable_vector().SetFromVector(self._cache.Eval(context).xdot)

@@ -22,19 +22,30 @@ class Timing:
     impacts: float = 0.0
     seeks: dict = dataclasses.field(default_factory=dict)
     screens: dict = dataclasses.field(default_factory=dict)   # far pairs the broad phase kept
+    seek_time: dict = dataclasses.field(default_factory=dict)  # s per pair: seeks, screens
+    tracked: dict = dataclasses.field(default_factory=dict)    # evaluations with the pair tracked
 
     def reset(self):
         self.seeking = self.contact_dynamics = self.impacts = 0.0
-        self.seeks, self.screens = {}, {}
+        self.seeks, self.screens, self.seek_time, self.tracked = {}, {}, {}, {}
 
     @contextlib.contextmanager
-    def measure(self, part: str):
-        """Adds the wall time of the ``with`` block to ``part`` (one of `PARTS`)."""
+    def measure(self, part: str, pair: str | None = None):
+        """Adds the wall time of the ``with`` block to ``part`` (one of `PARTS`), and to the
+        pair's seeking time when ``pair`` names one."""
         t0 = perf_counter()
         try:
             yield
         finally:
-            setattr(self, part, getattr(self, part) + perf_counter() - t0)
+            dt = perf_counter() - t0
+            setattr(self, part, getattr(self, part) + dt)
+            if pair is not None:
+                self.seek_time[pair] = self.seek_time.get(pair, 0.0) + dt
+
+    def count_tracked(self, names):
+        """One evaluation with the pairs ``names`` tracked (their couples evaluated, Eq. 47)."""
+        for n in names:
+            self.tracked[n] = self.tracked.get(n, 0) + 1
 
     def count_seek(self, pair: str):
         self.seeks[pair] = self.seeks.get(pair, 0) + 1
@@ -44,10 +55,13 @@ class Timing:
 
     def shares(self, wall_time: float) -> dict:
         """The three parts and the rest (Drake's integrator, witnesses, logging) as fractions of
-        ``wall_time``, with the pairs declared, the seeks per pair and the broad phase's
-        screenings per pair (far pairs not sought: their covers were apart)."""
+        ``wall_time``, with the pairs declared, the seeks per pair, the broad phase's
+        screenings per pair (far pairs not sought: their covers were apart), the wall time of
+        each pair's seeks and screenings, and the evaluations in which it was tracked."""
         out = {k: getattr(self, k) / wall_time for k in PARTS}
         out["other"] = max(0.0, 1.0 - sum(out.values()))
         return {"wall_time": wall_time, "shares": out, "pairs_declared": len(self.pairs),
                 "seeks_per_pair": {n: self.seeks.get(n, 0) for n in self.pairs},
-                "screens_per_pair": {n: self.screens.get(n, 0) for n in self.pairs}}
+                "screens_per_pair": {n: self.screens.get(n, 0) for n in self.pairs},
+                "seek_time_per_pair": {n: self.seek_time.get(n, 0.0) for n in self.pairs},
+                "tracked_evaluations_per_pair": {n: self.tracked.get(n, 0) for n in self.pairs}}

@@ -121,7 +121,7 @@ class Transitions:
         st, opt = states[i], self.options
         if not opt.broad_phase:
             return False
-        with self.timing.measure("seeking"):
+        with self.timing.measure("seeking", self.pairs[i].name):
             gap = self.ev.far.cover_gap(i, poses)
             if not gap >= opt.track_distance:
                 return False
@@ -158,7 +158,7 @@ class Transitions:
         pair far; whether that pair carries it is for `carry`, once the pass has set every
         pair's state: returns ``carry``'s argument."""
         name = self.pairs[i].name
-        with self.timing.measure("seeking"):
+        with self.timing.measure("seeking", name):
             try:
                 return self._seek(i, poses, states, u, time, was_contact, initial)
             finally:
