@@ -12,7 +12,7 @@ medians follow, against the sweep's target of 0.1 s per run.
 Two floors. The plant alone over the same simulated time and settings: no run of a contact
 model built on it costs less. And the floor of drake_dock's architecture at its own number of
 evaluations: each costs at least the plant's own evaluation (its wall time per derivative
-evaluation without contact) plus an empty Python LeafSystem's (`target_floor.empty_leaf_cost`);
+evaluation without contact) plus an empty Python LeafSystem's (`floors.empty_leaf_cost`);
 no implementation with a Python LeafSystem that needs as many evaluations runs below it.
 
     python bench/offnominal_floor.py [--runs 8] [SCENARIO.yaml]

@@ -23,8 +23,9 @@ fixed when the pair becomes potential so that n points from Body 2 to Body 1 (do
 tangents ta = s_u/|s_u| (CS) or t2/|t2| (CC), tb = n x ta. Signed gap g = n . d.
 
 Point-curve ("PC", a petal corner against a ring's inside circle): patch 1 is a point p (a
-sphere of radius r, `drake_dock.core.patches.Point`), d = p - c(s); n = sigma d/|d| (sigma = +1:
-the corner lies outside its sphere's tube about the curve), g = sigma |d| - r, ta = t2/|t2|.
+sphere of radius r, `drake_dock.core.patches.Point`), d = p - c(s); n = sigma d/|d|,
+g = sigma |d| - r, ta = t2/|t2|; the contact system takes sigma = +1 (`hybrid.couple_sigma`:
+n along d, also while the sphere overlaps the curve, g < 0).
 Its Jacobian is the scalar Fu = k2 . d - t2 . t2 (for a circle of radius R, -R rho_p with
 rho_p the distance of p from the axis: singular on the axis, where every s is closest); its
 conditioning is |Fu| / (t2 . t2 + |k2| |d|). d = 0 (the corner on the curve, r deeper than a

@@ -36,9 +36,12 @@ class Mode(enum.IntEnum):
 
 
 # ---------------------------------------------------------------------------- seeking
-def couple_sigma(declared: float | None, gap: float) -> float:
+def couple_sigma(kind: str, declared: float | None, gap: float) -> float:
     """The orientation sigma of n (Definition 2): the declared one, else the side the patches
-    are on."""
+    are on. A point-curve couple's n is always along d = p - c(s) (sigma = +1): its gap
+    |d| - r is negative while the sphere overlaps the curve, and d does not change side."""
+    if kind == "PC":
+        return 1.0
     if declared is not None:
         return declared
     return 1.0 if gap >= 0.0 else -1.0

@@ -33,7 +33,7 @@ from drake_dock.core.patches import (Annulus, Arc, Circle, Cone, Point, PolarCur
                                      Reparametrized)
 from drake_dock.errors import InputError
 
-# The contact sets a docking scene names (`contact.pairs`; `drake_dock.docking.scene.apds_pairs`):
+# The contact sets a docking scene names (`contact.pairs`; `drake_dock.docking.pairs.apds_pairs`):
 # the paper's 12 pairs, or those and the edge and face pairs they leave out.
 PAIR_SETS = ("paper", "complete")
 
@@ -307,7 +307,7 @@ def petal_corner(g: ApdsGeometry, i: int) -> Point:
     return Point(c + CORNER_RADIUS * out, CORNER_RADIUS)
 
 
-# Reach of a guide side against the other APDS's petal edges (`scene.side_edge_pairs`): the
+# Reach of a guide side against the other APDS's petal edges (`pairs.side_edge_pairs`): the
 # roll range of the scenario (60 deg) and a margin for tilt and offset, which the seeded sweep
 # of `drake_dock.docking.reach` bounds (docs/model.md).
 SIDE_REACH = math.radians(60.0 + 10.0)

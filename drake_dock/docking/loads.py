@@ -24,7 +24,7 @@ def couple_forces_W(ts: dict) -> np.ndarray:
 def interface_loads(ts: dict, pairs) -> dict:
     """Force F_A[N,3] (N) and moment M_A[N,3] (N m, about the ring centre) of the contact on
     the target APDS, in the target APDS frame; ``pairs``: the pair specs
-    (`drake_dock.docking.scene.apds_pairs`), matched to the couples by name."""
+    (`drake_dock.docking.pairs.apds_pairs`), matched to the couples by name."""
     by_name = {p.name: p for p in pairs}
     names = ts["couple_names"].tolist()
     sign = np.array([1.0 if by_name[c].body1 == TARGET else

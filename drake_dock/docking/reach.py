@@ -1,5 +1,6 @@
-"""The seeded geometric sweep behind `scene.side_edge_pairs`: which guide sides reach which
-edges (guide sides, tip arcs) of the other APDS's petals over random relative poses.
+"""The seeded geometric sweep behind `drake_dock.docking.pairs.side_edge_pairs`: which guide
+sides reach which edges (guide sides, tip arcs) of the other APDS's petals over random relative
+poses.
 
 A pose is the matched facing turned by a relative roll, tilted through the chaser's ring centre
 and offset sideways, with the ring faces a distance d apart (`Approach`'s convention). A
@@ -33,7 +34,7 @@ class ReachBox:
 
 def side_candidates(g: ApdsGeometry) -> list[PairSpec]:
     """Every guide side against every non-partner guide side (Body 1 the chaser's) and every
-    tip arc of the other APDS (Body 1 the side), named as `scene.side_edge_pairs` names them."""
+    tip arc of the other APDS (Body 1 the side), named as `pairs.side_edge_pairs` names them."""
     P = apds_patches(g)
     B = {"C": "chaser_apds", "T": "target_apds"}
     out = [PairSpec(f"cc_T{i}_C{j}", "CC", B["C"], P.sides[j], B["T"], P.sides[i])

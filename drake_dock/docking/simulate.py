@@ -2,8 +2,10 @@
 
 The record holds one sample at the end of every integration step (so the step that ends at an
 impact's witness gives the state just before it) and, for each impact, one sample of the state
-just after it at the same time (from the impact log; no step end sees that state). The
-simulation ends at ``simulation.duration`` or at capture (`CaptureMonitor`'s witness).
+just after it at the same time (from the impact log; no step end sees that state). An event
+with two impulses (an LZB impact, then an impact without collision) gives two samples after
+it, the first also the state just before the second. The simulation ends at
+``simulation.duration`` or at capture (`CaptureMonitor`'s witness).
 
 Integration: the scenario's ``simulator_config`` (Drake's `SimulatorConfig`), applied by
 `drake_dock.systems.simulator.make_simulator`; the witness isolation window and LZB's accuracy
@@ -100,7 +102,8 @@ class _Recorder:
         modes = contact.get_modes(contact.GetMyContextFromRoot(root))
         new = modes.impacts[self.n_impacts:]
         for imp in new:
-            if self.record.t and self.record.t[-1] == imp["t"]:
+            if self.record.t and self.record.t[-1] == imp["t"] \
+                    and self.record.kind[-1] == STEP:
                 self.record.kind[-1] = PRE_IMPACT
             self._post_impact(root, imp, modes)
         self.n_impacts = len(modes.impacts)

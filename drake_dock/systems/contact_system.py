@@ -63,7 +63,7 @@ from pydrake.systems.framework import (EventStatus, LeafSystem, UnrestrictedUpda
 
 from drake_dock.core.contact_law import ContactLaw
 from drake_dock.core.hybrid import Mode
-from drake_dock.errors import DriftError, ZenoError
+from drake_dock.errors import DriftError, InputError, ZenoError
 from drake_dock.systems import witnesses
 from drake_dock.systems.contact_types import (COUPLE_FIELDS, COUPLE_OUTPUT_SIZE, COUPLE_SLICES,
                                               ContactModes, ContactOptions, ContactPair,
@@ -96,6 +96,9 @@ def check_pairs(plant, pairs, energy_scale):
         if want is None or (p.patch1.dim, p.patch2.dim) != want:
             raise ValueError(f"pairs[{p.name}]: kind {p.kind!r} needs patch dims {want}, "
                              f"got ({p.patch1.dim}, {p.patch2.dim})")
+        if p.kind == "PC" and p.sigma not in (None, 1.0):
+            raise InputError(f"pairs[{p.name}].sigma", p.sigma,
+                             "None or +1 (a point-curve couple's n is along d = p - c(s))")
 
 
 class RigidContactSystem(LeafSystem):

@@ -11,6 +11,7 @@ import numpy as np
 from drake_dock.core.contact_law import ContactLaw
 from drake_dock.core.handover import SurfaceEdge
 from drake_dock.core.hybrid import Mode
+from drake_dock.errors import InputError
 
 __all__ = ["COUPLE_FIELDS", "COUPLE_OUTPUT_SIZE", "COUPLE_SLICES", "ContactLaw", "ContactModes",
            "ContactOptions", "ContactPair", "Evaluation", "Handover", "PairState",
@@ -26,6 +27,7 @@ for _name, _size in COUPLE_FIELDS:
     COUPLE_SLICES[_name] = slice(_offset, _offset + _size)
     _offset += _size
 COUPLE_OUTPUT_SIZE = _offset
+PAINLEVE = ("impact", "error")   # `ContactOptions.painleve`
 
 
 @dataclasses.dataclass
@@ -90,6 +92,11 @@ class ContactOptions:
                                      # scene's policy (`docking.diagram.contact_options`: on
                                      # for every pair set but paper); off where no scene
                                      # resolves it (a contact system built directly)
+
+    def __post_init__(self):
+        if self.painleve not in PAINLEVE:
+            raise InputError("ContactOptions.painleve", self.painleve,
+                             f"one of {', '.join(map(repr, PAINLEVE))}")
 
 
 @dataclasses.dataclass

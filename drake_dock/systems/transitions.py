@@ -15,7 +15,7 @@ from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import (InputError, PainleveInconsistency, SeekingError,
-                               SingularCoupleError, ZenoError)
+                               SingularCoupleError)
 from drake_dock.systems import handovers, impacts
 from drake_dock.systems.handovers import applied
 
@@ -83,12 +83,7 @@ class Transitions:
         x_new = x.copy()
         x_new[ev.nq:ev.nq + ev.nv] = v
         x_new[ev.nq + ev.nv:ev.ie] = u
-        if len(modes.impacts) > n_impacts:
-            # The states just before and just after the impact (for loggers: a step-end
-            # sample is the state before; this event's result is not seen by any step end).
-            modes.impacts[-1].update(x_minus=x.copy(), x_plus=x_new.copy(),
-                                     pairs_plus=copy.deepcopy(modes.pairs),
-                                     impact_loss_plus=modes.impact_loss)
+        impacts.states_around(ev, modes, n_impacts, x, x_new)
         return x_new, modes
 
     def _handovers(self, states, poses, twists, u) -> tuple[dict, dict]:
@@ -197,7 +192,7 @@ class Transitions:
             raw = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
                                   poses[b], (np.zeros(3),) * 2, uc, 1.0, project=False)
             gap = raw.gap
-            sigma = hybrid.couple_sigma(p.sigma, gap)
+            sigma = hybrid.couple_sigma(p.kind, p.sigma, gap)
             crossing = hybrid.patches_cross(gap, c.distance, sigma, opt.impact_gap_tol)
         if initial and p.sigma is not None and (
                 (usable and sigma * gap < -opt.impact_gap_tol)
@@ -257,9 +252,6 @@ class Transitions:
         hit = hybrid.impact_hits([st.mode for st in states], gap, vn, opt.impact_gap_tol)
         closed = []
         if hit:
-            if len(modes.impacts) >= opt.max_impacts:
-                raise ZenoError(f"more than max_impacts = {opt.max_impacts} impacts",
-                                time=t, couples=[self.pairs[i].name for i in hit])
             S = hybrid.impact_set(hit, [st.mode for st in states], vn)
             v, vn_plus, approach = impacts.lzb_impact(ev, t, modes, ctx, poses, evs, S, v)
             for i, c in zip(S, hybrid.closed_after_impact(vn_plus, approach)):
@@ -267,6 +259,7 @@ class Transitions:
                     closed.append(i)       # closed at the end of the impact: in contact
                 else:
                     states[i].track()      # separating
+            modes.impacts[-1]["pairs_plus"] = copy.deepcopy(states)
             poses = evaluate_all(v)
             gap, vn = gaps_and_rates()
         new, cand = hybrid.contact_candidates([st.mode for st in states], gap, vn, bool(hit),

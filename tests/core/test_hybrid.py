@@ -22,8 +22,10 @@ def test_mode_is_the_port_status_code():
 
 
 def test_sigma_and_crossing_by_hand():
-    assert hybrid.couple_sigma(-1.0, 0.3) == -1.0          # declared
-    assert hybrid.couple_sigma(None, -0.2) == -1.0 and hybrid.couple_sigma(None, 0.0) == 1.0
+    assert hybrid.couple_sigma("CS", -1.0, 0.3) == -1.0          # declared
+    assert hybrid.couple_sigma("CC", None, -0.2) == -1.0
+    assert hybrid.couple_sigma("CC", None, 0.0) == 1.0
+    assert hybrid.couple_sigma("PC", None, -0.2) == 1.0       # a point-curve n is along d
     tol = 1e-8
     # A couple 1 cm apart on the side of n: the closest couple, not crossing.
     assert not hybrid.patches_cross(0.01, 0.01, 1.0, tol)

@@ -248,6 +248,17 @@ def test_painleve_inconsistency_is_reported():
     assert err.value.time == 0.0
 
 
+@pytest.mark.parametrize("value", ["Impact", "warn", None])
+def test_painleve_option_is_checked(value):
+    """`ContactOptions.painleve` is "impact" or "error"; anything else is refused, naming the
+    field, the value and the allowed ones (it would otherwise act as "error")."""
+    from drake_dock.errors import InputError
+    with pytest.raises(InputError, match=r"ContactOptions\.painleve = .*'impact', 'error'") as e:
+        ContactOptions(painleve=value)
+    assert e.value.field == "ContactOptions.painleve" and e.value.value == value
+    assert ContactOptions(painleve="error").painleve == "error"
+
+
 def _tip_impulse(p, v_tip):
     """The planar sticking impulse (P_x, P_z) at the rod's tip that stops the tip's velocity
     v_tip = (v_x, v_z), and the kinetic energy it takes: for a planar body, a point impulse P
