@@ -86,11 +86,11 @@ def main():
     def solve():
         solve_given_modes(Minv, a0, R, [STICK] * 3, [None] * 3, omega=20.0)
 
-    W, bias, gap, vn, _, mu, _ = compiled.pack_rows(R)
+    W, bias, gap, vn, _, mu, mu_s = compiled.pack_rows(R)
     codes, dirs = np.full(3, compiled.STICK), np.zeros((3, 2))
 
     def solve_compiled():
-        compiled.solve_packed(Minv, a0, W, bias, gap, vn, mu, codes, dirs, 20.0)
+        compiled.solve_packed(Minv, a0, W, bias, gap, vn, mu, mu_s, codes, dirs, 20.0)
 
     n = a.repeats
     t_full = per_call(full, n)

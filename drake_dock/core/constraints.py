@@ -33,6 +33,11 @@ their normal modes, is the Painleve paradox of a rigid model: it raises `Painlev
 time and the couples. Several consistent choices that differ only in stick against
 start-of-sliding (possible when mu_s > mu) are resolved by preferring stick: a couple at rest
 stays at rest.
+
+A start of sliding takes the direction along which the couple's tangential acceleration lies:
+a fixed point, then, where it does not converge, a scan of one couple's direction or a grid
+and Newton's method for two (`_slide_start`). Two couples sticking between the same two bodies
+are fixed up to a squeeze, chosen to keep them in their cones (`drake_dock.core.squeeze`).
 """
 from __future__ import annotations
 
@@ -43,6 +48,7 @@ import math
 
 import numpy as np
 
+from drake_dock.core.squeeze import squeezed
 from drake_dock.errors import (NumericalError, PainleveError, PainleveInconsistency,
                                SingularContactError)
 
@@ -50,6 +56,8 @@ STICK, SLIDE, DETACH = "stick", "slide", "detach"
 MAX_ENUMERATED = 8
 TIE_RTOL = 1e-6     # consistency accepted at a transition when none holds at rtol
 SLIDE_START_ITER = 200   # fixed-point iterations for the direction of a start of sliding
+SLIDE_START_SCAN = 72    # directions scanned when the fixed point fails for one couple
+SLIDE_START_GRID = 24    # per couple, when it fails for two: a grid, then Newton
 
 
 @dataclasses.dataclass
@@ -145,6 +153,15 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None) -> C
                     f"contact constraint equations singular and inconsistent (cond = "
                     f"{cond:.3e}) for modes {modes}", time=time,
                     couples=[r.name for r, m in zip(rows, modes) if m != DETACH])
+            # Two couples sticking between two bodies: the squeeze that keeps them in their
+            # cones (Eq. 51; `drake_dock.core.squeeze`).
+            offsets, mus, j = [], [], 0
+            for r, m in zip(rows, modes):
+                if m == STICK:
+                    offsets.append(j)
+                    mus.append(r.mu_s)
+                j += 3 if m == STICK else (1 if m == SLIDE else 0)
+            lam = squeezed(lam, A, C, np.array(offsets, dtype=np.int64), np.array(mus))
         vdot = a0 + MinvC @ lam
         Cf = C @ lam
     k = len(rows)
@@ -183,7 +200,111 @@ def _slide_start(Minv, a0, rows, modes, dirs, i_start, omega, time,
             break
     sol = solve_given_modes(Minv, a0, rows, modes, dirs, omega=omega, time=time)
     ok = all(sol.at[i] @ dirs[i] > 0 for i in i_start)
+    if not ok and len(i_start) == 1:
+        return _slide_start_scan(Minv, a0, rows, modes, dirs, i_start[0], omega, time)
+    if not ok and len(i_start) == 2:
+        return _slide_start_grid(Minv, a0, rows, modes, dirs, i_start, omega, time)
     return sol, ok
+
+
+def slip_angle(s, a):
+    """The angle from the unit direction s to the vector a (0 where a lies along s)."""
+    return math.atan2(s[0] * a[1] - s[1] * a[0], s[0] * a[0] + s[1] * a[1])
+
+
+def _slide_start_scan(Minv, a0, rows, modes, dirs, i, omega, time):
+    """The direction of couple i starting to slide where the fixed point does not converge:
+    a direction s(theta) along which its tangential acceleration lies, bracketed on
+    `SLIDE_START_SCAN` angles around the fixed point's last direction theta0 and bisected
+    (the bracket nearest theta0); (sol, True), or (sol, False) if there is none."""
+    dirs = list(dirs)
+    th0 = math.atan2(dirs[i][1], dirs[i][0])
+
+    def residual(th):
+        dirs[i] = np.array([math.cos(th), math.sin(th)])
+        sol = solve_given_modes(Minv, a0, rows, modes, dirs, omega=omega, time=time)
+        return slip_angle(dirs[i], sol.at[i]), sol
+
+    n = SLIDE_START_SCAN
+    ths = [th0 + 2.0 * math.pi * (k / n - 0.5) for k in range(n + 1)]
+    rs = [residual(t)[0] for t in ths]
+    best = None
+    for k in range(n):
+        if rs[k] * rs[k + 1] <= 0 and max(abs(rs[k]), abs(rs[k + 1])) < 0.5 * math.pi:
+            dist = abs(0.5 * (ths[k] + ths[k + 1]) - th0)
+            if best is None or dist < best[0]:
+                best = (dist, k)
+    if best is None:
+        return residual(th0)[1], False
+    lo, hi, flo = ths[best[1]], ths[best[1] + 1], rs[best[1]]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        fm = residual(mid)[0]
+        if fm * flo > 0:
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    sol = residual(0.5 * (lo + hi))[1]
+    return sol, bool(sol.at[i] @ dirs[i] > 0)
+
+
+def _slide_start_grid(Minv, a0, rows, modes, dirs, i_start, omega, time):
+    """The directions of two couples starting to slide where the fixed point does not converge:
+    where each couple's tangential acceleration lies along its direction. The point of a
+    `SLIDE_START_GRID`^2 grid of the two angles around the fixed point's last directions with
+    the least angles between directions and accelerations starts Newton's method on s x a_t
+    (smooth where a_t vanishes, unlike the angle; forward-difference Jacobian, steps halved
+    while it does not fall). (sol, True) at a root with a_t along s, or with a_t below 1e-6 of
+    the acceleration scale (both couples at the stick-slip transition: forces on the cones'
+    edges), else (sol, False)."""
+    dirs = list(dirs)
+    th0 = np.array([math.atan2(dirs[i][1], dirs[i][0]) for i in i_start])
+
+    def solve(th):
+        for i, t in zip(i_start, th):
+            dirs[i] = np.array([math.cos(t), math.sin(t)])
+        return solve_given_modes(Minv, a0, rows, modes, dirs, omega=omega, time=time)
+
+    def cross(th):
+        sol = solve(th)
+        return np.array([dirs[i][0] * sol.at[i][1] - dirs[i][1] * sol.at[i][0]
+                         for i in i_start]), sol
+
+    n = SLIDE_START_GRID
+    steps = 2.0 * math.pi * (np.arange(n) / n - 0.5)
+    best, th = np.inf, th0
+    for d0 in steps:
+        for d1 in steps:
+            t = th0 + np.array([d0, d1])
+            sol = solve(t)
+            r = sum(abs(slip_angle(dirs[i], sol.at[i])) for i in i_start)
+            if r < best:
+                best, th = r, t
+    r, sol = cross(th)
+    for _ in range(40):
+        J = np.empty((2, 2))
+        for c in range(2):
+            e = np.zeros(2)
+            e[c] = 1e-7
+            J[:, c] = (cross(th + e)[0] - r) / 1e-7
+        det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+        if not (math.isfinite(det) and det != 0.0):
+            break
+        step = np.array([J[0, 1] * r[1] - J[1, 1] * r[0], J[1, 0] * r[0] - J[0, 0] * r[1]]) / det
+        for _ in range(30):
+            r_new, sol_new = cross(th + step)
+            if np.abs(r_new).sum() < np.abs(r).sum():
+                th, r, sol = th + step, r_new, sol_new
+                break
+            step = 0.5 * step
+        else:
+            break
+    r, sol = cross(th)
+    small = 1e-6 * (1.0 + float(np.abs(sol.vdot).max()))
+    ok = all(math.hypot(*sol.at[i]) <= small
+             or (abs(ri) <= 1e-9 * math.hypot(*sol.at[i]) and sol.at[i] @ dirs[i] > 0)
+             for i, ri in zip(i_start, r))
+    return sol, bool(ok)
 
 
 def stabilised_gddot(sol, rows, omega) -> np.ndarray:

@@ -216,7 +216,8 @@ class PlantEvaluator:
             codes[j] = S.CODE[smodes[j]]
             if dirs[j] is not None:
                 sdirs[j] = dirs[j]
-        return S.solve_packed(Minv, a0, W, bias, gap, vn, np.full(kc, self.law.mu), codes,
+        return S.solve_packed(Minv, a0, W, bias, gap, vn, np.full(kc, self.law.mu),
+                              np.full(kc, self.mu_s), codes,
                               sdirs, omega, time=t, names=[self.pairs[i].name for i in row_pairs])
 
     def free_acceleration(self, ctx, v, inputs):

@@ -2,7 +2,8 @@
 plain arrays: the patches' jets by kind code and parameters (`jets`), and every tracked couple
 of a contact system in one call (`couples`: Eq. 47, the projection, the contact frame, gap,
 normal velocity and the Eq. 52 bias terms), the seek of Sect. 5.1 (`seek`), and the constraint
-solve and mode selection of Eq. 48-52 (`constraints`). `compile_cache` chooses the directory
+solve and mode selection of Eq. 48-52 (`constraints`, with the solve in `solve` and the start
+of sliding in `slide_start`). `compile_cache` chooses the directory
 the compiled code is cached in; importing this package applies it before numba is imported.
 
 The pure-Python modules (`drake_dock.core.patches`, `drake_dock.core.couple`,

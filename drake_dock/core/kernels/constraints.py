@@ -19,123 +19,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, types
-from numba.extending import intrinsic
+from numba import njit
 
 from drake_dock.core import constraints as ref
+from drake_dock.core.kernels.slide_start import slide_start
+from drake_dock.core.kernels.solve import (CODE, DETACH, INDETERMINATE, NAME, NONE_CONSISTENT,
+                                           NONFINITE, OK, SLIDE, STICK, accelerations,
+                                           solve_modes, stabilised)
 from drake_dock.errors import (NumericalError, PainleveError, PainleveInconsistency,
                                SingularContactError)
-
-STICK, SLIDE, DETACH = 0, 1, 2
-CODE = {ref.STICK: STICK, ref.SLIDE: SLIDE, ref.DETACH: DETACH}
-NAME = (ref.STICK, ref.SLIDE, ref.DETACH)
-OK, SINGULAR, NONFINITE, NONE_CONSISTENT, INDETERMINATE = 0, 1, 2, 3, 4
-SLIDE_START_ITER = ref.SLIDE_START_ITER
-
-
-@intrinsic
-def _fma(typingctx, a, b, c):
-    """a b + c rounded once (LLVM's fma)."""
-    def codegen(context, builder, signature, args):
-        return builder.fma(*args)
-    return types.float64(types.float64, types.float64, types.float64), codegen
-
-
-@njit(cache=True)
-def stabilised(x, vn, gap, omega):
-    """x + 2 omega g' + omega^2 g: the Baumgarte-stabilised normal row (Eq. 52), x = g'' or its
-    velocity-product term bn."""
-    return x + 2 * omega * vn + omega ** 2 * gap
-
-
-@njit(cache=True)
-def _solve(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, vdot, lam_n, lam_t, gf):
-    """`constraints.solve_given_modes` into vdot (nv,), lam_n (k,), lam_t (k, 2) and the
-    generalized force gf (nv,); returns (status, cond(A)): SINGULAR when the constraint matrix
-    is singular and the equations inconsistent, NONFINITE when they hold an inf or a nan."""
-    k, nv = W.shape[0], W.shape[1]
-    m = 0
-    for i in range(k):
-        m += 3 if modes[i] == STICK else (1 if modes[i] == SLIDE else 0)
-    lam_n[:] = 0.0
-    lam_t[:] = 0.0
-    if m == 0:
-        vdot[:] = a0
-        gf[:] = 0.0
-        return OK, 0.0
-    Ct = np.empty((m, nv))         # C^T and D^T, C-ordered: C = Ct.T as the reference's
-    Dt = np.empty((m, nv))
-    rhs = np.empty(m)
-    j = 0
-    for i in range(k):
-        if modes[i] == STICK:
-            for c in range(3):
-                for a in range(nv):
-                    Ct[j + c, a] = W[i, a, c]
-                    Dt[j + c, a] = W[i, a, c]
-            rhs[j] = stabilised(bias[i, 0], vn[i], gap[i], omega)
-            rhs[j + 1] = bias[i, 1]
-            rhs[j + 2] = bias[i, 2]
-            j += 3
-        elif modes[i] == SLIDE:
-            s0, s1 = dirs[i, 0], dirs[i, 1]
-            for a in range(nv):
-                # Wt s as numpy's product of the (nv, 2) by the 2-vector rounds it
-                Ct[j, a] = W[i, a, 0] - mu[i] * _fma(W[i, a, 1], s0, W[i, a, 2] * s1)
-                Dt[j, a] = W[i, a, 0]
-            rhs[j] = stabilised(bias[i, 0], vn[i], gap[i], omega)
-            j += 1
-    C = Ct.T
-    MinvC = np.dot(Minv, C)
-    A = np.dot(Dt, MinvC)
-    b = -(rhs + np.dot(Dt, a0))
-    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
-        return NONFINITE, np.nan        # LAPACK is not called on them
-    # The reference's singularity test: the Hadamard ratio |det A| / prod of its row norms.
-    prod, positive = 1.0, True
-    for r in range(m):
-        s = 0.0
-        for c in range(m):
-            s += A[r, c] * A[r, c]
-        rn = math.sqrt(s)
-        positive = positive and rn > 0
-        prod *= rn
-    ratio = abs(np.linalg.det(A)) / prod if positive and prod > 0 else 0.0
-    cond = 0.0
-    if np.isfinite(ratio) and ratio > 1e-12:
-        lam = np.linalg.solve(A, b)
-    else:
-        cond = np.linalg.cond(A)
-        lam = np.linalg.lstsq(A, b, rcond=1e-10)[0]
-        if np.linalg.norm(np.dot(A, lam) - b) > 1e-8 * (1.0 + np.linalg.norm(b)):
-            return SINGULAR, cond
-    vdot[:] = a0 + np.dot(MinvC, lam)
-    gf[:] = np.dot(C, lam)
-    j = 0
-    for i in range(k):
-        if modes[i] == STICK:
-            lam_n[i], lam_t[i, 0], lam_t[i, 1] = lam[j], lam[j + 1], lam[j + 2]
-            j += 3
-        elif modes[i] == SLIDE:
-            lam_n[i] = lam[j]
-            f = -mu[i] * lam[j]
-            lam_t[i, 0], lam_t[i, 1] = f * dirs[i, 0], f * dirs[i, 1]
-            j += 1
-    return OK, cond
-
-
-@njit(cache=True)
-def _accelerations(W, bias, vdot, gdd, at):
-    """g'' (k,) and the tangential relative accelerations at (k, 2) at vdot."""
-    for i in range(W.shape[0]):
-        for c in range(3):
-            s = 0.0
-            for a in range(W.shape[1]):
-                s += W[i, a, c] * vdot[a]
-            if c == 0:
-                gdd[i] = s + bias[i, 0]
-            else:
-                at[i, c - 1] = s + bias[i, c]
 
 
 @njit(cache=True)
@@ -153,37 +45,6 @@ def _consistent(modes, lam_n, lam_t, gdd, vn, gap, mu_s, omega, tol_f, tol_a):
                     and math.hypot(lam_t[i, 0], lam_t[i, 1]) > mu_s[i] * lam_n[i] + tol_f):
                 return False
     return True
-
-
-@njit(cache=True)
-def _slide_start(Minv, a0, W, bias, gap, vn, mu, modes, dirs, starting, omega, vdot, lam_n,
-                 lam_t, gf, gdd, at):
-    """`constraints._slide_start`: the sliding directions (in dirs) of the couples starting to
-    slide, s = a_t/|a_t|, the solution in the outputs; returns (status, directions found)."""
-    for _ in range(SLIDE_START_ITER):
-        st, _c = _solve(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, vdot, lam_n,
-                        lam_t, gf)
-        if st != OK:
-            return st, False
-        _accelerations(W, bias, vdot, gdd, at)
-        change = 0.0
-        for i in starting:
-            na = math.hypot(at[i, 0], at[i, 1])
-            if na == 0.0:
-                return OK, False
-            n0, n1 = at[i, 0] / na, at[i, 1] / na
-            change = max(change, max(abs(n0 - dirs[i, 0]), abs(n1 - dirs[i, 1])))
-            dirs[i, 0], dirs[i, 1] = n0, n1
-        if change < 1e-13:
-            break
-    st, _c = _solve(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, vdot, lam_n, lam_t, gf)
-    if st != OK:
-        return st, False
-    _accelerations(W, bias, vdot, gdd, at)
-    for i in starting:
-        if not at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0:
-            return OK, False
-    return OK, True
 
 
 @njit(cache=True)
@@ -208,7 +69,7 @@ def _select(Minv, a0, W, bias, gap, vn, vt, mu, mu_s, avoid, v_slip, omega, rtol
         n *= nopt[i]
     # Force and acceleration scales (the free motion: every couple detached).
     gdd, at = np.empty(k), np.empty((k, 2))
-    _accelerations(W, bias, a0, gdd, at)
+    accelerations(W, bias, a0, gdd, at)
     free_at = at.copy()
     a_scale = 1.0 + np.abs(gdd).max() + np.abs(free_at).max()
     M_ = np.empty((n, k), np.int64)
@@ -250,8 +111,8 @@ def _select(Minv, a0, W, bias, gap, vn, vt, mu, mu_s, avoid, v_slip, omega, rtol
             # tangential acceleration).
             for i in range(k):
                 gmodes[i] = STICK if modes[i] == SLIDE and not has_dir[i] else modes[i]
-            st, _c = _solve(Minv, a0, W, bias, gap, vn, mu, gmodes, dirs, omega, vdot, lam_n,
-                            lam_t, gf)
+            st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, gmodes, dirs, omega, vdot,
+                                 lam_n, lam_t, gf)
             if st != OK:
                 continue
             for i in starting:
@@ -263,16 +124,16 @@ def _select(Minv, a0, W, bias, gap, vn, vt, mu, mu_s, avoid, v_slip, omega, rtol
                     dirs[i, 0], dirs[i, 1] = g0 / ng, g1 / ng
                 else:
                     dirs[i, 0], dirs[i, 1] = 1.0, 0.0
-            st, ok = _slide_start(Minv, a0, W, bias, gap, vn, mu, modes, dirs, starting, omega,
-                                  vdot, lam_n, lam_t, gf, gdd, at)
+            st, ok = slide_start(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting,
+                                  omega, vdot, lam_n, lam_t, gf, gdd, at)
             if st != OK or not ok:
                 continue
         else:
-            st, _c = _solve(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, vdot, lam_n,
-                            lam_t, gf)
+            st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot,
+                                 lam_n, lam_t, gf)
             if st != OK:
                 continue
-            _accelerations(W, bias, vdot, gdd, at)
+            accelerations(W, bias, vdot, gdd, at)
         f_scale = 1.0 + np.abs(lam_n).max()
         if _consistent(modes, lam_n, lam_t, gdd, vn, gap, mu_s, omega, rtol * f_scale,
                        rtol * a_scale):
@@ -327,15 +188,15 @@ def _dirs_array(modes, dirs):
     return out
 
 
-def solve_packed(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, *, time=None,
+def solve_packed(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, *, time=None,
                  names=()):
     """(vdot, lam_n (k,), lam_t (k, 2), generalized force) for the packed rows and the mode
     codes ``modes`` (int array), ``dirs`` (k, 2) the sliding directions; `SingularContactError`
     (naming ``names``) as the reference."""
     k, nv = W.shape[0], len(a0)
     vdot, lam_n, lam_t, gf = np.empty(nv), np.empty(k), np.empty((k, 2)), np.empty(nv)
-    st, cond = _solve(Minv, a0, W, bias, gap, vn, mu, modes, dirs, omega, vdot, lam_n, lam_t,
-                      gf)
+    st, cond = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
+                           lam_t, gf)
     if st == NONFINITE:
         raise NumericalError(f"contact constraint equations not finite for modes "
                              f"{tuple(NAME[m] for m in modes)}", time=time,
@@ -354,7 +215,8 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None):
     codes = np.array([CODE[m] for m in modes], dtype=np.int64)
     vdot, lam_n, lam_t, gf = solve_packed(np.ascontiguousarray(Minv, dtype=float),
                                           np.asarray(a0, dtype=float), W, bias, gap, vn, mu,
-                                          codes, _dirs_array(modes, dirs), omega, time=time,
+                                          mu_s, codes, _dirs_array(modes, dirs), omega,
+                                          time=time,
                                           names=[r.name for r in rows])
     return ref.ContactSolution(tuple(modes), list(dirs), vdot, lam_n, lam_t, gf, list(rows))
 
@@ -404,5 +266,5 @@ def warm():
     one = np.ones(2)
     _select(np.eye(nv), -np.ones(nv), W, bias, z, z, vt, 0.1 * one, 0.1 * one,
             np.zeros((2, 3), np.int64), 1e-6, 20.0, 1e-9, ref.TIE_RTOL)
-    solve_packed(np.eye(nv), -np.ones(nv), W, bias, z, z, 0.1 * one,
+    solve_packed(np.eye(nv), -np.ones(nv), W, bias, z, z, 0.1 * one, 0.1 * one,
                  np.array([STICK, SLIDE], np.int64), np.array([[0.0, 0.0], [1.0, 0.0]]), 20.0)

@@ -1,0 +1,194 @@
+"""The direction of a start of sliding (`drake_dock.core.constraints._slide_start` and its scan
+and grid) compiled: the fixed point s = a_t/|a_t|, then, where it does not converge, the scan
+of one couple's direction or the grid and Newton's method for two."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from drake_dock.core import constraints as ref
+from drake_dock.core.kernels.solve import OK, SLIDE_START_ITER, accelerations, solve_modes
+
+
+@njit(cache=True)
+def slide_start(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, omega, vdot,
+                 lam_n, lam_t, gf, gdd, at):
+    """`constraints._slide_start`: the sliding directions (in dirs) of the couples starting to
+    slide, s = a_t/|a_t|, the solution in the outputs; returns (status, directions found)."""
+    for _ in range(SLIDE_START_ITER):
+        st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
+                             lam_t, gf)
+        if st != OK:
+            return st, False
+        accelerations(W, bias, vdot, gdd, at)
+        change = 0.0
+        for i in starting:
+            na = math.hypot(at[i, 0], at[i, 1])
+            if na == 0.0:
+                return OK, False
+            n0, n1 = at[i, 0] / na, at[i, 1] / na
+            change = max(change, max(abs(n0 - dirs[i, 0]), abs(n1 - dirs[i, 1])))
+            dirs[i, 0], dirs[i, 1] = n0, n1
+        if change < 1e-13:
+            break
+    st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
+                         lam_t, gf)
+    if st != OK:
+        return st, False
+    accelerations(W, bias, vdot, gdd, at)
+    for i in starting:
+        if not at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0:
+            if len(starting) == 1:
+                return _slide_start_scan(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i,
+                                         omega, vdot, lam_n, lam_t, gf, gdd, at)
+            if len(starting) == 2:
+                return _slide_start_grid(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs,
+                                         starting, omega, vdot, lam_n, lam_t, gf, gdd, at)
+            return OK, False
+    return OK, True
+
+
+@njit(cache=True)
+def _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, th, omega, vdot,
+                   lam_n, lam_t, gf, gdd, at):
+    """`constraints._slide_start_scan`'s residual: couple i sliding along theta; returns
+    (status, the angle from its direction to its tangential acceleration)."""
+    dirs[i, 0], dirs[i, 1] = math.cos(th), math.sin(th)
+    st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
+                         lam_t, gf)
+    if st != OK:
+        return st, 0.0
+    accelerations(W, bias, vdot, gdd, at)
+    s0, s1, a0_, a1 = dirs[i, 0], dirs[i, 1], at[i, 0], at[i, 1]
+    return OK, math.atan2(s0 * a1 - s1 * a0_, s0 * a0_ + s1 * a1)
+
+
+@njit(cache=True)
+def _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, th, omega,
+                    vdot, lam_n, lam_t, gf, gdd, at, r, angle):
+    """`constraints._slide_start_grid`'s residual into r (2,): the starting couples sliding
+    along th (2,); the angles between their directions and accelerations if ``angle``, else
+    s x a_t. Returns the status."""
+    for c in range(2):
+        dirs[starting[c], 0], dirs[starting[c], 1] = math.cos(th[c]), math.sin(th[c])
+    st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
+                         lam_t, gf)
+    if st != OK:
+        return st
+    accelerations(W, bias, vdot, gdd, at)
+    for c in range(2):
+        i = starting[c]
+        s0, s1, a0_, a1 = dirs[i, 0], dirs[i, 1], at[i, 0], at[i, 1]
+        r[c] = (math.atan2(s0 * a1 - s1 * a0_, s0 * a0_ + s1 * a1) if angle
+                else s0 * a1 - s1 * a0_)
+    return OK
+
+
+@njit(cache=True)
+def _slide_start_grid(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, omega,
+                      vdot, lam_n, lam_t, gf, gdd, at):
+    """`constraints._slide_start_grid` (the same grid, Newton steps and test)."""
+    n = ref.SLIDE_START_GRID
+    th0 = np.empty(2)
+    for c in range(2):
+        th0[c] = math.atan2(dirs[starting[c], 1], dirs[starting[c], 0])
+    r, rn, t = np.empty(2), np.empty(2), np.empty(2)
+    best, th = np.inf, th0.copy()
+    for g0 in range(n):
+        for g1 in range(n):
+            t[0] = th0[0] + 2.0 * math.pi * (g0 / n - 0.5)
+            t[1] = th0[1] + 2.0 * math.pi * (g1 / n - 0.5)
+            st = _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting,
+                                 t, omega, vdot, lam_n, lam_t, gf, gdd, at, r, True)
+            if st != OK:
+                return st, False
+            if abs(r[0]) + abs(r[1]) < best:
+                best, th[0], th[1] = abs(r[0]) + abs(r[1]), t[0], t[1]
+    st = _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, th,
+                         omega, vdot, lam_n, lam_t, gf, gdd, at, r, False)
+    if st != OK:
+        return st, False
+    J = np.empty((2, 2))
+    for _ in range(40):
+        for c in range(2):
+            t[0], t[1] = th[0], th[1]
+            t[c] += 1e-7
+            st = _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting,
+                                 t, omega, vdot, lam_n, lam_t, gf, gdd, at, rn, False)
+            if st != OK:
+                return st, False
+            J[0, c], J[1, c] = (rn[0] - r[0]) / 1e-7, (rn[1] - r[1]) / 1e-7
+        det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+        if not (math.isfinite(det) and det != 0.0):
+            break
+        s0 = (J[0, 1] * r[1] - J[1, 1] * r[0]) / det
+        s1 = (J[1, 0] * r[0] - J[0, 0] * r[1]) / det
+        moved = False
+        for _h in range(30):
+            t[0], t[1] = th[0] + s0, th[1] + s1
+            st = _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting,
+                                 t, omega, vdot, lam_n, lam_t, gf, gdd, at, rn, False)
+            if st != OK:
+                return st, False
+            if abs(rn[0]) + abs(rn[1]) < abs(r[0]) + abs(r[1]):
+                th[0], th[1], r[0], r[1], moved = t[0], t[1], rn[0], rn[1], True
+                break
+            s0, s1 = 0.5 * s0, 0.5 * s1
+        if not moved:
+            break
+    st = _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, th,
+                         omega, vdot, lam_n, lam_t, gf, gdd, at, r, False)
+    if st != OK:
+        return st, False
+    small = 1e-6 * (1.0 + np.abs(vdot).max())
+    ok = True
+    for c in range(2):
+        i = starting[c]
+        na = math.hypot(at[i, 0], at[i, 1])
+        ok = ok and (na <= small or (abs(r[c]) <= 1e-9 * na
+                                     and at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0))
+    return OK, ok
+
+
+@njit(cache=True)
+def _slide_start_scan(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, omega, vdot,
+                      lam_n, lam_t, gf, gdd, at):
+    """`constraints._slide_start_scan` (the same scan, bracket and bisection)."""
+    th0 = math.atan2(dirs[i, 1], dirs[i, 0])
+    n = ref.SLIDE_START_SCAN
+    ths, rs = np.empty(n + 1), np.empty(n + 1)
+    for k in range(n + 1):
+        ths[k] = th0 + 2.0 * math.pi * (k / n - 0.5)
+        st, rs[k] = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i,
+                                   ths[k], omega, vdot, lam_n, lam_t, gf, gdd, at)
+        if st != OK:
+            return st, False
+    best, best_k = np.inf, -1
+    for k in range(n):
+        if rs[k] * rs[k + 1] <= 0 and max(abs(rs[k]), abs(rs[k + 1])) < 0.5 * math.pi:
+            dist = abs(0.5 * (ths[k] + ths[k + 1]) - th0)
+            if dist < best:
+                best, best_k = dist, k
+    if best_k < 0:
+        st, _r = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, th0,
+                                omega, vdot, lam_n, lam_t, gf, gdd, at)
+        return st, False
+    lo, hi, flo = ths[best_k], ths[best_k + 1], rs[best_k]
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        st, fm = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, mid,
+                                omega, vdot, lam_n, lam_t, gf, gdd, at)
+        if st != OK:
+            return st, False
+        if fm * flo > 0:
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    st, _r = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i,
+                            0.5 * (lo + hi), omega, vdot, lam_n, lam_t, gf, gdd, at)
+    if st != OK:
+        return st, False
+    return OK, at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0
+

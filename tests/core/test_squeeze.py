@@ -1,0 +1,191 @@
+"""Two couples sticking between two rigid bodies leave one internal squeeze undetermined
+(`drake_dock.core.squeeze`): a ball resting in a V-groove, whose minimum-norm forces are
+vertical and so outside a small friction cone, sticks with forces inside it (statics: they
+carry the weight), and a block standing on two points of an incline steeper than its friction
+angle slides with the closed-form acceleration. The reference and the compiled kernels alike;
+runs without Drake."""
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drake_dock.core import constraints
+from drake_dock.core.constraints import SLIDE, STICK, ContactRow
+from drake_dock.core.kernels import constraints as compiled
+from drake_dock.core.squeeze import SHRINK, cone_interval
+
+G, OMEGA = 9.81, 20.0
+
+
+@pytest.fixture(params=["python", "compiled"])
+def select_modes(request):
+    return {"python": constraints.select_modes, "compiled": compiled.select_modes}[request.param]
+
+
+def point_row(name, r, n, mu):
+    """A body point at r from the mass centre on a fixed plane of unit normal n, at rest (v =
+    (v_com, w), world frame): W = [e; r x e] for e = n, t1, t2 (Eq. 11)."""
+    t1 = np.cross(n, [0.0, 1.0, 0.0] if abs(n[1]) < 0.9 else [1.0, 0.0, 0.0])
+    t1 /= np.linalg.norm(t1)
+    t2 = np.cross(n, t1)
+    W = [np.concatenate([e, np.cross(r, e)]) for e in (n, t1, t2)]
+    return ContactRow(name, W[0], np.column_stack(W[1:]), 0.0, np.zeros(2), 0.0, 0.0,
+                      np.zeros(2), mu, mu)
+
+
+def test_cone_interval_equals_a_dense_sampling():
+    """The closed form against the cone tested on 200001 points of s in [-50, 50]."""
+    rng = np.random.default_rng(4)
+    s = np.linspace(-50.0, 50.0, 200001)
+    for _ in range(300):
+        a, b, c0, c1, d0, d1 = rng.normal(size=6) * [5, 1, 2, 2, 1, 1]
+        mu = rng.uniform(0.05, 1.0)
+        lo, hi = cone_interval(a, b, c0, c1, d0, d1, mu)
+        ok = (a + b * s >= 0) & (np.hypot(c0 + d0 * s, c1 + d1 * s) <= mu * (a + b * s))
+        if not ok.any():
+            assert lo > hi or min(hi, 50) - max(lo, -50) < 1e-3
+            continue
+        assert np.all(ok[(s > lo + 1e-3) & (s < hi - 1e-3)])         # one interval
+        assert s[ok].min() == pytest.approx(max(lo, -50.0), abs=1e-3)
+        assert s[ok].max() == pytest.approx(min(hi, 50.0), abs=1e-3)
+
+
+@pytest.mark.parametrize("theta_deg", [20.0, 35.0, 50.0])
+@pytest.mark.parametrize("mu", [0.05, 0.1, 0.3, 0.5])
+def test_a_ball_in_a_v_groove_sticks_with_forces_in_the_cone(select_modes, theta_deg, mu):
+    """A ball of radius R at rest in a groove whose faces' normals lean theta from the vertical.
+    The minimum-norm forces are vertical (mg/2 each: tangential/normal = tan theta, outside the
+    cone for mu < tan theta); forces along the normals (mg / (2 cos theta)) hold it. Sticking is
+    consistent: the ball stays at rest, the forces carry the weight and lie in the cones."""
+    m, R, th = 2.0, 0.1, math.radians(theta_deg)
+    I = 0.4 * m * R * R
+    M = np.diag([m, m, m, I, I, I])
+    nA, nB = np.array([math.sin(th), 0.0, math.cos(th)]), np.array([-math.sin(th), 0.0,
+                                                                     math.cos(th)])
+    rows = [point_row("A", -R * nA, nA, mu), point_row("B", -R * nB, nB, mu)]
+    a0 = np.array([0.0, 0.0, -G, 0.0, 0.0, 0.0])
+    sol = select_modes(np.linalg.inv(M), a0, rows, omega=OMEGA)
+    assert sol.modes == (STICK, STICK)
+    assert np.abs(sol.vdot).max() < 1e-9
+    force = sum(r.Wn * ln + r.Wt @ lt for r, ln, lt in zip(rows, sol.lam_n, sol.lam_t))
+    assert force == pytest.approx([0.0, 0.0, m * G, 0.0, 0.0, 0.0], abs=1e-9)
+    for ln, lt in zip(sol.lam_n, sol.lam_t):
+        assert math.hypot(*lt) <= SHRINK * mu * ln * (1 + 1e-12)
+    if mu >= math.tan(th):                      # the minimum-norm forces already hold
+        assert sol.lam_n == pytest.approx([0.5 * m * G * math.cos(th)] * 2, rel=1e-9)
+
+
+def test_a_block_on_two_points_of_a_steep_incline_slides_at_the_closed_form_rate(select_modes):
+    """A body on two points of an incline of angle alpha > atan(mu), its mass centre on the
+    line through them (no moment about it): no squeeze makes sticking consistent, and it
+    slides down at g (sin alpha - mu cos alpha) without turning."""
+    m, alpha, mu = 3.0, math.radians(25.0), 0.2
+    M = np.diag([m, m, m, 0.1, 0.2, 0.15])
+    n = np.array([-math.sin(alpha), 0.0, math.cos(alpha)])
+    down = np.array([-math.cos(alpha), 0.0, -math.sin(alpha)])
+    rows = [point_row(k, y * np.array([0.0, 1.0, 0.0]), n, mu)
+            for k, y in (("A", -0.1), ("B", 0.1))]
+    a0 = np.array([0.0, 0.0, -G, 0.0, 0.0, 0.0])
+    sol = select_modes(np.linalg.inv(M), a0, rows, omega=OMEGA)
+    assert sol.modes == (SLIDE, SLIDE)
+    a = sol.vdot[:3]
+    assert a == pytest.approx(G * (math.sin(alpha) - mu * math.cos(alpha)) * down, abs=1e-9)
+    assert np.abs(sol.vdot[3:]).max() < 1e-9
+
+
+def _docking_selection():
+    d = json.loads((Path(__file__).parent / "slide_start_docking.json").read_text())
+    rows = [ContactRow(r["name"], np.array(r["Wn"]), np.array(r["Wt"]), r["bn"],
+                       np.array(r["bt"]), r["gap"], r["vn"], np.array(r["vt"]), r["mu"],
+                       r["mu_s"]) for r in d["rows"]]
+    return np.array(d["Minv"]), np.array(d["a0"]), rows, d
+
+
+def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_modes, monkeypatch):
+    """A docking selection (tests/core/slide_start_docking.json): couple 0 at rest, couple 1
+    sliding. Couple 0 sticking needs more than its cone; the fixed point s = a_t/|a_t| for its
+    start of sliding does not converge. A dense sampling of its direction (3600 angles, no
+    bisection) finds where a_t lies along s; the selection slides along that direction."""
+    Minv, a0, rows, d = _docking_selection()
+    sol = select_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
+                       avoid=[tuple(a) for a in d["avoid"]])
+    assert sol.modes == (SLIDE, SLIDE)
+    s = sol.dirs[0]
+    assert abs(constraints.slip_angle(s, sol.at[0])) < 1e-9 and sol.at[0] @ s > 0
+    assert (sol.lam_n > 0).all()
+    v1 = rows[1].vt / np.hypot(*rows[1].vt)
+    th = np.linspace(-math.pi, math.pi, 3601)
+    res = []
+    for t in th:
+        e = np.array([math.cos(t), math.sin(t)])
+        at = constraints.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), [e, v1],
+                                           omega=d["omega"]).at[0]
+        res.append(abs(constraints.slip_angle(e, at)))
+    t_best = th[int(np.argmin(res))]
+    assert min(res) < 2 * math.pi / 3600
+    assert math.atan2(s[1], s[0]) == pytest.approx(t_best, abs=2 * math.pi / 3600)
+    # The fixed point alone (no scan) misses it from the selection's own start.
+    monkeypatch.setattr(constraints, "_slide_start_scan", lambda *args: (None, False))
+    stick = constraints.solve_given_modes(Minv, a0, rows, (STICK, SLIDE), [None, v1],
+                                          omega=d["omega"])
+    start = -stick.lam_t[0] / np.hypot(*stick.lam_t[0])
+    assert not constraints._slide_start(Minv, a0, rows, (SLIDE, SLIDE), [start, v1], [0],
+                                        d["omega"], None)[1]
+
+
+def test_two_couples_starting_to_slide_are_found(select_modes):
+    """A docking selection (tests/core/slide_start_two.json): both couples at rest and leaving
+    stick. Least squares from each point of a 36 x 36 grid of their two directions (scipy, an
+    independent solver) finds where both tangential accelerations lie along their directions;
+    the selection slides along those directions."""
+    from scipy.optimize import least_squares
+    d = json.loads((Path(__file__).parent / "slide_start_two.json").read_text())
+    rows = [ContactRow(r["name"], np.array(r["Wn"]), np.array(r["Wt"]), r["bn"],
+                       np.array(r["bt"]), r["gap"], r["vn"], np.array(r["vt"]), r["mu"],
+                       r["mu_s"]) for r in d["rows"]]
+    Minv, a0 = np.array(d["Minv"]), np.array(d["a0"])
+    sol = select_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
+                       avoid=[tuple(a) for a in d["avoid"]])
+    assert sol.modes == (SLIDE, SLIDE) and (sol.lam_n > 0).all()
+
+    def residual(th):
+        dirs = [np.array([math.cos(t), math.sin(t)]) for t in th]
+        at = constraints.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), dirs,
+                                           omega=d["omega"]).at
+        return [constraints.slip_angle(e, a) for e, a in zip(dirs, at)]
+
+    g = np.linspace(-math.pi, math.pi, 36, endpoint=False)
+    start = min(((a, b) for a in g for b in g), key=lambda t: np.abs(residual(t)).sum())
+    root = least_squares(residual, start, xtol=1e-15, ftol=1e-15, gtol=1e-15).x
+    assert np.abs(residual(root)).max() < 1e-8
+    for s, t in zip(sol.dirs, root):
+        assert s == pytest.approx([math.cos(t), math.sin(t)], abs=1e-6)
+
+
+def test_two_couples_at_the_stick_slip_transition_start_to_slide(select_modes):
+    """A docking selection (tests/core/slide_start_transition.json): both couples at rest and
+    leaving stick at once. No squeeze puts the sticking forces in both cones (the intervals of
+    `cone_interval`, checked on a dense sampling of the squeeze), and the sliding directions
+    where both tangential accelerations vanish to 1e-6 of the acceleration scale are taken:
+    the forces on the cones' edges, in equilibrium with no tangential acceleration."""
+    d = json.loads((Path(__file__).parent / "slide_start_transition.json").read_text())
+    rows = [ContactRow(r["name"], np.array(r["Wn"]), np.array(r["Wt"]), r["bn"],
+                       np.array(r["bt"]), r["gap"], r["vn"], np.array(r["vt"]), r["mu"],
+                       r["mu_s"]) for r in d["rows"]]
+    Minv, a0 = np.array(d["Minv"]), np.array(d["a0"])
+    stick = constraints.solve_given_modes(Minv, a0, rows, (STICK, STICK), [None, None],
+                                          omega=d["omega"])
+    C = np.column_stack([c for r in rows for c in (r.Wn, r.Wt[:, 0], r.Wt[:, 1])])
+    z = np.linalg.svd(C.T @ Minv @ C)[2][-1]
+    lam = np.concatenate([[stick.lam_n[i], *stick.lam_t[i]] for i in range(2)])
+    s = np.linspace(-1e3, 1e3, 400001)
+    L = lam + s[:, None] * z
+    inside = ((np.hypot(L[:, 1], L[:, 2]) <= 0.1 * L[:, 0])
+              & (np.hypot(L[:, 4], L[:, 5]) <= 0.1 * L[:, 3]))
+    assert not inside.any()
+    sol = select_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
+                       avoid=[tuple(a) for a in d["avoid"]])
+    assert sol.modes == (SLIDE, SLIDE) and (sol.lam_n > 0).all()
+    assert np.abs(sol.at).max() <= 1e-6 * (1.0 + np.abs(sol.vdot).max())
