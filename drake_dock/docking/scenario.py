@@ -80,14 +80,14 @@ class InitialCondition:
 @dataclasses.dataclass
 class DockingContact(ContactLaw):
     """The contact law (`ContactLaw`) and the scene's contact set ``pairs``: ``paper``, the 12
-    pairs of Sect. 2.2 and 8.1, or ``complete``, those and, for each APDS against the other, the
+    pairs of Sect. 2.2 and 8.1, or ``complete`` (the default), those and, for each APDS against the other, the
     ring's inside circle against the guide sides and tip arcs, its outside circle against the
     other ring's face, the tip arcs against the guide surfaces they can face, the petal
     corners against the ring's inside circle, and the guide sides against the non-partner
     sides and tip arcs they reach (`drake_dock.docking.pairs.apds_pairs`; docs/model.md,
     "Facing and the contact pairs")."""
 
-    pairs: str = "paper"
+    pairs: str = "complete"
 
     def validate(self, where: str = "contact") -> "DockingContact":
         super().validate(where)

@@ -8,7 +8,8 @@ misalignment |offset| <= 0.10 m; lateral rate |v| <= 0.04 m/s; pitch and yaw (th
 components) within 4 deg each; roll (the relative yaw about the axis) within 4 deg; angular
 rates within 0.2 deg/s about each axis. Random conditions are uniform over the box (the disks
 uniform by area); a corner puts every parameter at an extreme, with seeded signs and
-directions. The base scenario gives everything else.
+directions. Every run has the plan's contact set (`complete` by default: the edges, faces and
+corners off-axis approaches reach); the base scenario gives everything else.
 
 One row per run: the inputs, the outcome (captured, rebound, jammed, timeout, or `error` with
 the typed error's class and message), capture time, impacts, peak contact force, momentum drift,
@@ -44,6 +45,7 @@ class ConditionsPlan:
     random: int = 60
     corners: int = 16
     seed: int = 2026
+    pairs: str = "complete"      # the contact set of every run (contact.pairs)
 
     @classmethod
     def quick(cls):
@@ -134,6 +136,8 @@ def run_condition(scenario, name: str, condition: dict) -> dict:
 
 
 def run_conditions(scenario, plan: ConditionsPlan, log=print) -> dict:
+    scenario = copy.deepcopy(scenario)
+    scenario.contact.pairs = plan.pairs
     rows = []
     todo = conditions(plan)
     for k, (name, cond) in enumerate(todo, 1):

@@ -23,9 +23,16 @@ def _misaligned():
     return s
 
 
+def _box_corner_paper_pairs():
+    """models/idss_box_corner.yaml with the paper's 12 pairs (where the seek crashed)."""
+    s = load_scenario(MODELS / "idss_box_corner.yaml")
+    s.contact.pairs = "paper"
+    return s
+
+
 @pytest.mark.parametrize("make, crashed_at", [
     (_misaligned, 0.206),
-    (lambda: load_scenario(MODELS / "idss_box_corner.yaml"), 0.167)],
+    (_box_corner_paper_pairs, 0.167)],
     ids=["misaligned", "idss_box_corner"])
 def test_runs_past_the_former_seek_crash(make, crashed_at):
     duration = crashed_at + 0.02

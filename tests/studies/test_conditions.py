@@ -79,3 +79,20 @@ def test_the_summary_prints_the_median_wall_time_per_run():
              "reason": "NumericalError: x", "wall_time_s": w} for k, w in enumerate(walls)]
     line, = [ln for ln in summary_lines({"rows": rows}) if ln.startswith("median wall")]
     assert float(line.split()[5]) == pytest.approx(np.median(walls), rel=1e-3)
+
+
+def test_every_run_has_the_plans_contact_set(paper_scenario, monkeypatch):
+    """The sweep runs the plan's contact set (complete by default) whatever the base states,
+    and leaves the base as it was."""
+    import drake_dock.studies.conditions as study
+    seen = []
+
+    def fake(scenario, name, condition):
+        seen.append(scenario.contact.pairs)
+        return {"name": name, "outcome": "timeout", "penetration_m": 0.0}
+
+    monkeypatch.setattr(study, "run_condition", fake)
+    study.run_conditions(paper_scenario, ConditionsPlan(random=2, corners=1), log=lambda s: None)
+    study.run_conditions(paper_scenario, ConditionsPlan(1, 0, pairs="paper"), log=lambda s: None)
+    assert seen == ["complete"] * 3 + ["paper"]
+    assert paper_scenario.contact.pairs == "paper"
