@@ -9,6 +9,7 @@ import re
 
 import numpy as np
 
+from drake_dock.core.handover import SurfaceEdge
 from drake_dock.core.patches import Patch
 from drake_dock.docking.apds import (PAIR_SETS, ApdsGeometry, apds_patches, azimuth_span,
                                       petal_edges, side_phi, spans_within)
@@ -43,8 +44,9 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     inside circle vs each guide side and each tip arc (C-C), the ring's outside circle vs
     the other ring's face (C-S), the tip arcs vs the guide surfaces they can face (C-S,
     `tip_surface_pairs`), the other APDS's petal corners vs the ring's inside circle
-    (point-curve, `corner_pairs`), and the guide sides vs the non-partner sides and tip arcs
-    they reach (C-C, `side_edge_pairs`)."""
+    (point-curve, `corner_pairs`), the guide sides vs the non-partner sides and tip arcs
+    they reach (C-C, `side_edge_pairs`), and the two rings' outside circles (C-C,
+    cc_Crim_Trim, Body 1 the chaser's)."""
     if which not in PAIR_SETS:
         raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)
@@ -62,6 +64,7 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         pairs += corner_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
         pairs += corner_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
         pairs += side_edge_pairs(P, R_MATCHED)
+        pairs.append(PairSpec("cc_Crim_Trim", "CC", CHASER_APDS, P.rim, TARGET_APDS, P.rim))
     return pairs
 
 
@@ -136,7 +139,8 @@ PAIR_TYPES = (
     (re.compile(r"cs_[CT]rim_[CT]face$"), "ring outside circle / ring face"),
     (re.compile(r"cs_[CT]tip\d_[CT]\d$"), "tip arc / guide surface"),
     (re.compile(r"pc_[CT]corner\d_[CT]ring$"), "petal corner / ring inside circle"),
-    (re.compile(r"cc_[CT]\d_[CT]tip\d$"), "guide side / tip arc"))
+    (re.compile(r"cc_[CT]\d_[CT]tip\d$"), "guide side / tip arc"),
+    (re.compile(r"cc_[CT]rim_[CT]rim$"), "ring outside circle / ring outside circle"))
 
 
 def pair_type(name: str) -> str:
@@ -163,9 +167,15 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
     """(edge pair, surface pair, `SurfaceEdge`) of each hand-over among ``pairs``
     (`drake_dock.core.handover`): a ring's inside circle passes between guide surface k
     (cs_<X>ring_<Y>k) and its sides 2k - 1, 2k (cc_<X>ring_<Y><i>) and its tip arc
-    (cc_<X>ring_<Y>tip<k>), `petal_edges`."""
+    (cc_<X>ring_<Y>tip<k>), `petal_edges`; the chaser's rim between the target's face
+    (cs_Crim_Tface) and the target's rim (cc_Crim_Trim)."""
     names = {p.name for p in pairs}
     out = []
+    if {"cc_Crim_Trim", "cs_Crim_Tface"} <= names:
+        # The chaser's rim leaves the target's face over its outer edge (rho = R, u = (rho,
+        # theta)): the target's rim, its parameter theta.
+        out.append(("cc_Crim_Trim", "cs_Crim_Tface",
+                    SurfaceEdge(0, True, lambda th: th, lambda th: th)))
     for x, y in (("C", "T"), ("T", "C")):
         for k in (1, 2, 3):
             for key, edge in petal_edges(g, k).items():

@@ -168,12 +168,12 @@ def test_complete_set_names_and_patches(geom):
     other's 6 sides and 3 tip arcs, its rim against the other's face and its tip arcs against
     the other's guide surfaces they can face (32 pairs), its ring's inside circle against
     the other's 6 petal corners, each the top end of its guide side (12 point-curve pairs),
-    and the guide sides against the non-partner sides and the tip arcs they can reach (36
-    pairs)."""
+    the guide sides against the non-partner sides and the tip arcs they can reach (36
+    pairs), and the two rims (1 pair, the chaser's Body 1)."""
     paper, complete = apds_pairs(geom), apds_pairs(geom, "complete")
     assert [p.name for p in complete[:12]] == [p.name for p in paper] and len(paper) == 12
     new = {p.name: p for p in complete[12:]}
-    assert len(new) == len(complete) - 12 == 80
+    assert len(new) == len(complete) - 12 == 81
     P = apds_patches(geom)
     for x, y, bx, by in (("C", "T", "chaser_apds", "target_apds"),
                          ("T", "C", "target_apds", "chaser_apds")):
@@ -200,6 +200,10 @@ def test_complete_set_names_and_patches(geom):
             assert np.array_equal(patch.position(u), expected.position(u))
     assert new["cc_Tring_Ctip2"].body1 == "target_apds"
     assert new["cs_Crim_Tface"].kind == "CS" and new["cs_Crim_Tface"].body2 == "target_apds"
+    rims = new["cc_Crim_Trim"]
+    assert (rims.kind, rims.body1, rims.body2) == ("CC", "chaser_apds", "target_apds")
+    for patch in (rims.patch1, rims.patch2):
+        assert (patch.radius, patch.height) == (geom.R, 0.0)
     for name, b1, c1, b2, c2 in (("cc_T4_C1", "chaser_apds", P.sides[1], "target_apds",
                                   P.sides[4]),
                                  ("cc_T2_Ctip3", "target_apds", P.sides[2], "chaser_apds",
@@ -281,7 +285,7 @@ def test_sides_reach_the_edges_their_pairs_name(geom):
     from drake_dock.docking.scene import relative_pose
     P = apds_patches(geom)
     names = {p.name for p in apds_pairs(geom, "complete")[12:]
-             if p.name.startswith("cc_") and "ring" not in p.name}
+             if p.name.startswith("cc_") and "ring" not in p.name and "rim" not in p.name}
     margin = math.radians(10.0)
     rolls = np.radians(np.linspace(-60.0, 60.0, 241))
     R = {roll: relative_pose(roll, 0.0)[0] for roll in rolls}    # the chaser's frame
