@@ -51,7 +51,7 @@ def test_bad_input_exits_2_and_leaves_previous_output(tmp_path):
 BAD = {
     "interpenetration": ("initial: {approach_travel: -0.01}\n", "initial.approach_travel"),
     "zero closing speed": ("initial: {chaser_speed: 0}\n", "initial.chaser_speed"),
-    "capture beyond the start": ("simulation: {capture_distance: 0.2}\n",
+    "capture beyond the start": ("simulation: {capture_distance: 0.5}\n",
                                  "simulation.capture_distance"),
     "nan": ("initial: {chaser_speed: .nan}\n", "initial.chaser_speed"),
     "negative mass": ("bodies: {target: {mass: -5.0}}\n", "bodies.target.mass"),

@@ -19,8 +19,8 @@ DOOMED = 2          # the sample whose worker process dies (the test hook below)
 
 
 def write_plan(tmp_path, samples, batch, sampler="sobol"):
-    (tmp_path / "short.yaml").write_text(
-        "simulation:\n  duration: 0.05\n  jam_time: 1.0\n")
+    (tmp_path / "short.yaml").write_text(     # the paper's example: its 12 pairs
+        "contact:\n  pairs: paper\nsimulation:\n  duration: 0.05\n  jam_time: 1.0\n")
     plan = tmp_path / "plan.yaml"
     plan.write_text(f"""scenario: short.yaml
 samples: {samples}

@@ -239,7 +239,7 @@ def test_unexpected_exception_is_one_paragraph_exit_3(tmp_path, capsys, monkeypa
 def test_numerical_failure_names_time_and_couples(tmp_path, capsys):
     """A real one: an accuracy no step can meet (Drake's minimum step is violated)."""
     scenario = tmp_path / "s.yaml"
-    scenario.write_text("simulator_config: {accuracy: 1.0e-300}\n")
+    scenario.write_text("contact: {pairs: paper}\nsimulator_config: {accuracy: 1.0e-300}\n")
     out = tmp_path / "results"
     rc = main(["run", str(scenario), "--out", str(out), "--no-progress"])
     msg = _one_paragraph_exit_3(capsys, rc, out)
