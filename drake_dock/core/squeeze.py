@@ -57,7 +57,9 @@ def cone_interval(a, b, c0, c1, d0, d1, mu):
     lo, hi = np.inf, -np.inf
     for j in range(len(cuts) - 1):
         x0, x1 = cuts[j], cuts[j + 1]
-        if x0 == -np.inf:
+        if x0 == -np.inf and x1 == np.inf:
+            t = 0.0
+        elif x0 == -np.inf:
             t = x1 - 1.0 - abs(x1)
         elif x1 == np.inf:
             t = x0 + 1.0 + abs(x0)

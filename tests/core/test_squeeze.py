@@ -52,6 +52,13 @@ def test_cone_interval_equals_a_dense_sampling():
         assert s[ok].max() == pytest.approx(min(hi, 50.0), abs=1e-3)
 
 
+def test_a_couple_the_squeeze_does_not_move_is_inside_for_every_s_or_none():
+    """b = 0 and d = 0: the couple's force does not change with s."""
+    assert cone_interval(2.0, 0.0, 0.1, 0.0, 0.0, 0.0, 0.1) == (-np.inf, np.inf)
+    lo, hi = cone_interval(2.0, 0.0, 0.3, 0.0, 0.0, 0.0, 0.1)
+    assert lo > hi
+
+
 @pytest.mark.parametrize("theta_deg", [20.0, 35.0, 50.0])
 @pytest.mark.parametrize("mu", [0.05, 0.1, 0.3, 0.5])
 def test_a_ball_in_a_v_groove_sticks_with_forces_in_the_cone(select_modes, theta_deg, mu):
