@@ -144,10 +144,11 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None) -> C
         if np.isfinite(ratio) and ratio > 1e-12:
             lam = np.linalg.solve(A, b)
         else:
-            cond = np.linalg.cond(A)
+            finite = bool(np.all(np.isfinite(A)))
+            cond = np.linalg.cond(A) if finite else np.nan
             # Redundant constraints (a body resting on several sticking couples is statically
             # indeterminate): the minimum-norm forces, if the equations are consistent.
-            lam = np.linalg.lstsq(A, b, rcond=1e-10)[0] if np.all(np.isfinite(A)) else None
+            lam = np.linalg.lstsq(A, b, rcond=1e-10)[0] if finite else None
             if lam is None or np.linalg.norm(A @ lam - b) > 1e-8 * (1.0 + np.linalg.norm(b)):
                 raise SingularContactError(
                     f"contact constraint equations singular and inconsistent (cond = "

@@ -114,11 +114,12 @@ def _over(g, frac, zeta_f, tol=1e-9):
 
 def free_edges(g, n=4001) -> dict:
     """{petal k: (M, 3) polyline} of petal k's free edges in the APDS frame, fine enough that
-    a chord lies within 1e-9 m of the curve: guide side 2k - 1, the tip arc, guide side 2k
-    (Eq. 14 and zeta = H; the root is fixed to the ring)."""
+    a chord lies within 1e-9 m of the curve: guide side 2k - 1 from its root to the tip, the
+    tip arc, guide side 2k from the tip to its root (Eq. 14 and zeta = H; the root is fixed
+    to the ring)."""
     f = feature_points(g, n_side=n, n_arc=n)
-    return {k: np.concatenate([f[f"guide side {2 * k - 1}"][::-1], f[f"petal {k} tip arc"],
-                               f[f"guide side {2 * k}"]]) for k in (1, 2, 3)}
+    return {k: np.concatenate([f[f"guide side {2 * k - 1}"], f[f"petal {k} tip arc"],
+                               f[f"guide side {2 * k}"][::-1]]) for k in (1, 2, 3)}
 
 
 def foot_on_cone(g, X, s):
@@ -131,6 +132,9 @@ def foot_on_cone(g, X, s):
 def distance_to_polyline(F, P):
     """Distance of points F (M, 3) to the polyline P (N, 3): to the two segments beside each
     point's nearest vertex."""
+    if len(F) > 64:                               # in blocks: M x N x 3 floats at once
+        return np.concatenate([distance_to_polyline(F[i:i + 64], P)
+                               for i in range(0, len(F), 64)])
     if len(F) == 0:
         return np.zeros(0)
     j = np.argmin(((F[:, None, :] - P[None, :, :]) ** 2).sum(-1), axis=1)
