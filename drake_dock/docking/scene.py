@@ -19,7 +19,7 @@ from drake_dock.docking.pairs import (CHASER_APDS, R_MATCHED, TARGET_APDS, PairS
                                       apds_pairs)
 from drake_dock.docking.penetration import deepest_penetration
 from drake_dock.docking.rotations import rot_vec, rot_x, rot_z  # noqa: F401 (re-exported)
-from drake_dock.errors import InputError, NumericalError
+from drake_dock.errors import InputError, NumericalError, SeekingError
 
 def relative_pose(yaw_rad: float, d: float):
     """Pose (R, p) of the chaser APDS in the target APDS frame: coaxial, ring faces d apart,
@@ -69,10 +69,18 @@ def signed_gaps(pairs, approach, d, refs):
     while its couple is interior (see `is_interior`); otherwise its gap is +inf and its side
     reference is dropped. The sign is fixed by the side the couple lies on when the pair becomes
     potential (docs/model.md) and continued from ``refs`` (the previous unit directions)."""
+    gaps, dirs, _ = seek_gaps(pairs, approach, d, refs)
+    return gaps, dirs
+
+
+def seek_gaps(pairs, approach, d, refs):
+    """`signed_gaps` and the distance of each pair's couple, interior or not (the least
+    distance of the two bounded features)."""
     R, p = approach.pose(d)
     poses = {TARGET_APDS: (np.eye(3), np.zeros(3)), CHASER_APDS: (R, p)}
-    out, dirs = [], []
+    out, dirs, dist = [], [], []
     for cp, ref in zip(pair_couples(pairs, poses), refs):
+        dist.append(cp.distance)
         if not cp.interior:
             out.append(np.inf)
             dirs.append(None)
@@ -81,7 +89,7 @@ def signed_gaps(pairs, approach, d, refs):
         s = 1.0 if ref is None or v @ ref >= 0 else -1.0
         out.append(s * cp.distance)
         dirs.append(s * v / max(cp.distance, 1e-300))
-    return np.array(out), dirs
+    return np.array(out), dirs, np.array(dist)
 
 
 def first_contact_distance(g: ApdsGeometry, yaw_deg: float, *, step=None, xtol=1e-13):
@@ -166,24 +174,30 @@ def touch_steps(pairs, approach: Approach, grid):
 
 
 class _Gaps:
-    """The signed gaps (`signed_gaps`) of the pairs at the travel grid's points, sought on demand
-    and counted. A pair's side is continued from the grid point before when it was sought
-    there; otherwise the pair was apart since its last seek and keeps the side it lies on."""
+    """The signed gaps and distances (`seek_gaps`) of the pairs at the travel grid's points,
+    sought on demand and counted. A pair's side is continued from the grid point before when
+    it was sought there; otherwise the pair was apart since its last seek and keeps the side
+    it lies on."""
 
     def __init__(self, pairs, approach, grid):
         self.pairs, self.approach, self.grid = pairs, approach, grid
-        self.at = {}                                   # (j, k) -> (gap, direction)
+        self.at = {}                                   # (j, k) -> (gap, direction, distance)
         self.seeks = 0
 
-    def gap(self, j, k):
+    def _hit(self, j, k):
         hit = self.at.get((j, k))
         if hit is None:
             before = self.at.get((j, k - 1))
             ref = None if before is None else before[1]
-            gaps, dirs = signed_gaps([self.pairs[j]], self.approach, self.grid[k], [ref])
+            hit = self.at[(j, k)] = _seek(self.pairs[j], self.approach, self.grid[k], ref)
             self.seeks += 1
-            hit = self.at[(j, k)] = (gaps[0], dirs[0])
-        return hit[0]
+        return hit
+
+    def gap(self, j, k):
+        return self._hit(j, k)[0]
+
+    def distance(self, j, k):
+        return self._hit(j, k)[2]
 
     def root(self, j, k, xtol):
         """brentq on the step from grid[k] down to grid[k + 1] for pair j, its side from
@@ -198,6 +212,77 @@ class _Gaps:
             return signed_gaps([self.pairs[j]], self.approach, dd, [ref])[0][0]
 
         return brentq(f, self.grid[k + 1], self.grid[k], xtol=xtol, rtol=1e-15)
+
+    def march(self, j, k, xtol):
+        """`march_root` over the step from grid[k]; the side at grid[k + 1] is the march's."""
+        hi, lo = self.grid[k], self.grid[k + 1]
+        lam, end, seeks = march_root(self.pairs[j], self.approach, hi, self._hit(j, k), lo,
+                                     (hi - lo) / MARCH_SUBSTEPS, xtol)
+        self.seeks += seeks
+        if end is not None:
+            self.at[(j, k + 1)] = end
+        return lam
+
+
+# The march of `march_root` takes at most this many sub-steps per step of the grid.
+MARCH_SUBSTEPS = 256
+# Two features touch below this distance, their couple interior or not (m, `march_root`).
+TOUCH_GAP = 1e-9
+
+
+def march_root(pair, approach, hi, start, lo, floor, xtol):
+    """The first closing of the pair on the travel from hi down to lo, where the grid's two
+    ends cannot see it: a couple that enters or leaves its domain inside the step (a ring
+    crossing a tip arc next to a petal corner and handed over to the guide surface; a circle
+    meeting a guide surface next to its edge leaves the domain as its gap reaches 0, since past
+    it the circle cuts the surface). ``start`` = (gap, direction, distance) at hi. The chaser
+    translates along the approach, so features a distance D apart cannot touch within a travel
+    of D: each sub-step is max(D, ``floor``), the side continued. From an interior gap above
+    `TOUCH_GAP`, the pair closes where the gap turns below -`TOUCH_GAP` (brentq) or where
+    it falls into +-`TOUCH_GAP` (the circle cutting the surface; the first touch bisected to
+    1e-12 of the travel). A couple that becomes interior already cutting the surface (its
+    distance within `TOUCH_GAP`: a circle that came in over an edge, which the set's edge
+    pairs, or none, model) does not close it. Returns (lam of the closing or None; (gap,
+    direction, distance) at lo; seeks taken)."""
+    lam, (g, ref, dist), seeks = hi, start, 0
+    while lam > lo:
+        nxt = max(lam - max(dist, floor), lo)
+        g2, ref2, d2 = _seek(pair, approach, nxt, ref)
+        seeks += 1
+        if np.isfinite(g) and g > TOUCH_GAP and g2 <= 0 and d2 > TOUCH_GAP:
+            def f(x, ref=ref):
+                return _seek(pair, approach, x, ref)[0]
+            return brentq(f, nxt, lam, xtol=xtol, rtol=1e-15), None, seeks
+        if np.isfinite(g) and g > TOUCH_GAP and np.isfinite(g2) and d2 <= TOUCH_GAP:
+            root, more = _touch(pair, approach, lam, nxt, ref)
+            return root, None, seeks + more
+        lam, g, ref, dist = nxt, g2, ref2, d2
+    return None, (g, ref, dist), seeks
+
+
+def _touch(pair, approach, hi, lo, ref):
+    """The features are apart at hi and touch at lo < hi (`march_root`): the first touch,
+    bisected to 1e-12 of the travel. Next to the touch the circle is tangent to the surface and
+    the closest couple degenerate: where its Newton does not converge the features are taken
+    to touch (the root moves up by at most the bracket). Returns (its lam, seeks)."""
+    seeks = 0
+    while hi - lo > 1e-12:
+        mid = 0.5 * (hi + lo)
+        try:
+            g = _seek(pair, approach, mid, ref)[0]
+        except SeekingError:
+            g = 0.0
+        seeks += 1
+        if g <= TOUCH_GAP:
+            lo = mid
+        else:
+            hi = mid
+    return hi, seeks
+
+
+def _seek(pair, approach, lam, ref):
+    gaps, dirs, dist = seek_gaps([pair], approach, lam, [ref])
+    return gaps[0], dirs[0], dist[0]
 
 
 @functools.lru_cache(maxsize=16)
@@ -216,11 +301,18 @@ def _first_contact(geometry: tuple, approach: Approach, step, xtol, which):
     touch = touch_steps(pairs, approach, grid)
     gaps = _Gaps(pairs, approach, grid)
     for k in range(len(grid) - 1):
-        # A pair closes on the step when its gap is finite at grid[k] and <= 0 at grid[k + 1].
-        closing = [j for j in np.flatnonzero(touch[:, k])
-                   if np.isfinite(gaps.gap(j, k)) and gaps.gap(j, k + 1) <= 0]
-        if closing:
-            roots = {pairs[j].name: gaps.root(j, k, xtol) for j in closing}
+        # A pair closes on the step when its gap is > 0 at grid[k] and <= 0 at grid[k + 1];
+        # otherwise a pair that comes within the step's travel is marched (`march_root`).
+        roots, travel = {}, grid[k] - grid[k + 1]
+        for j in np.flatnonzero(touch[:, k]):
+            lam = None
+            if 0 < gaps.gap(j, k) < np.inf and gaps.gap(j, k + 1) <= 0:
+                lam = gaps.root(j, k, xtol)
+            elif gaps.distance(j, k) < travel:
+                lam = gaps.march(j, k, xtol)
+            if lam is not None:
+                roots[pairs[j].name] = lam
+        if roots:
             d_c = max(roots.values())
             names = tuple(sorted(n for n, r in roots.items() if r >= d_c - 1e-9))
             return d_c, names, gaps.seeks
