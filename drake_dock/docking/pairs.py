@@ -45,8 +45,9 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     the other ring's face (C-S), the tip arcs vs the guide surfaces they can face (C-S,
     `tip_surface_pairs`), the other APDS's petal corners vs the ring's inside circle
     (point-curve, `corner_pairs`), the guide sides vs the non-partner sides and tip arcs
-    they reach (C-C, `side_edge_pairs`), and the two rings' outside circles (C-C,
-    cc_Crim_Trim, Body 1 the chaser's)."""
+    they reach (C-C, `side_edge_pairs`), the two rings' outside circles (C-C,
+    cc_Crim_Trim, Body 1 the chaser's), and each ring's outside circle vs the other APDS's
+    guide surfaces and sides (`rim_pairs`)."""
     if which not in PAIR_SETS:
         raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)
@@ -65,6 +66,8 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         pairs += corner_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
         pairs += side_edge_pairs(P, R_MATCHED)
         pairs.append(PairSpec("cc_Crim_Trim", "CC", CHASER_APDS, P.rim, TARGET_APDS, P.rim))
+        pairs += rim_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
+        pairs += rim_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
     return pairs
 
 
@@ -81,6 +84,18 @@ def edge_pairs(P, one, other) -> list[PairSpec]:
     out = [PairSpec(f"cc_{x}ring_{y}{i}", "CC", b1, P.ring, b2, P.sides[i]) for i in range(1, 7)]
     out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
     out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
+    return out
+
+
+def rim_pairs(P, one, other) -> list[PairSpec]:
+    """APDS ``one``'s outside circle (Body 1) against APDS ``other``'s guide surfaces,
+    cs_<X>rim_<Y><k> (C-S), and guide sides, cc_<X>rim_<Y><i> (C-C): reached off the axis,
+    where the rim, laterally offset by about the petal's inward slope times its height, comes
+    down onto the middle of a petal (a ring distance of 0.1 m at a lateral offset of 0.1 m).
+    The tip arcs (at rho = Rs, zeta = H) lie beyond the envelope's reach of the rim."""
+    (x, b1), (y, b2) = one, other
+    out = [PairSpec(f"cs_{x}rim_{y}{k}", "CS", b1, P.rim, b2, P.surfaces[k]) for k in (1, 2, 3)]
+    out += [PairSpec(f"cc_{x}rim_{y}{i}", "CC", b1, P.rim, b2, P.sides[i]) for i in range(1, 7)]
     return out
 
 
@@ -140,7 +155,9 @@ PAIR_TYPES = (
     (re.compile(r"cs_[CT]tip\d_[CT]\d$"), "tip arc / guide surface"),
     (re.compile(r"pc_[CT]corner\d_[CT]ring$"), "petal corner / ring inside circle"),
     (re.compile(r"cc_[CT]\d_[CT]tip\d$"), "guide side / tip arc"),
-    (re.compile(r"cc_[CT]rim_[CT]rim$"), "ring outside circle / ring outside circle"))
+    (re.compile(r"cc_[CT]rim_[CT]rim$"), "ring outside circle / ring outside circle"),
+    (re.compile(r"cs_[CT]rim_[CT]\d$"), "ring outside circle / guide surface"),
+    (re.compile(r"cc_[CT]rim_[CT]\d$"), "ring outside circle / guide side"))
 
 
 def pair_type(name: str) -> str:
@@ -167,7 +184,8 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
     """(edge pair, surface pair, `SurfaceEdge`) of each hand-over among ``pairs``
     (`drake_dock.core.handover`): a ring's inside circle passes between guide surface k
     (cs_<X>ring_<Y>k) and its sides 2k - 1, 2k (cc_<X>ring_<Y><i>) and its tip arc
-    (cc_<X>ring_<Y>tip<k>), `petal_edges`; the chaser's rim between the target's face
+    (cc_<X>ring_<Y>tip<k>), `petal_edges`; a rim likewise between guide surface k
+    (cs_<X>rim_<Y>k) and its sides (cc_<X>rim_<Y><i>); the chaser's rim between the target's face
     (cs_Crim_Tface) and the target's rim (cc_Crim_Trim)."""
     names = {p.name for p in pairs}
     out = []
@@ -179,9 +197,10 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
     for x, y in (("C", "T"), ("T", "C")):
         for k in (1, 2, 3):
             for key, edge in petal_edges(g, k).items():
-                e = f"cc_{x}ring_{y}{'tip' + str(k) if key == 'tip' else key}"
-                if {e, f"cs_{x}ring_{y}{k}"} <= names:
-                    out.append((e, f"cs_{x}ring_{y}{k}", edge))
+                for circle in ("ring", "rim"):
+                    e = f"cc_{x}{circle}_{y}{'tip' + str(k) if key == 'tip' else key}"
+                    if {e, f"cs_{x}{circle}_{y}{k}"} <= names:
+                        out.append((e, f"cs_{x}{circle}_{y}{k}", edge))
     return out
 
 

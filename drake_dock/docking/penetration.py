@@ -115,11 +115,19 @@ def _over(g, frac, zeta_f, tol=1e-9):
 def free_edges(g, n=4001) -> dict:
     """{petal k: (M, 3) polyline} of petal k's free edges in the APDS frame, fine enough that
     a chord lies within 1e-9 m of the curve: guide side 2k - 1 from its root to the tip, the
-    tip arc, guide side 2k from the tip to its root (Eq. 14 and zeta = H; the root is fixed
-    to the ring)."""
+    tip arc, guide side 2k from the tip to its root (Eq. 14 and zeta = H), and the root back
+    along the ring's outside circle (zeta = 0). The root is fixed to the ring, but the other
+    APDS's features pass the ring's annulus in the paper's reading (docs/model.md), so they
+    may reach the plate from there."""
     f = feature_points(g, n_side=n, n_arc=n)
-    return {k: np.concatenate([f[f"guide side {2 * k - 1}"], f[f"petal {k} tip arc"],
-                               f[f"guide side {2 * k}"][::-1]]) for k in (1, 2, 3)}
+    out = {}
+    for k in (1, 2, 3):
+        a, b = f[f"guide side {2 * k - 1}"], f[f"guide side {2 * k}"]
+        th_a, th_b = math.atan2(a[0, 1], a[0, 0]), math.atan2(b[0, 1], b[0, 0])
+        th = th_b + np.linspace(0.0, 1.0, n) * ((th_a - th_b + math.pi) % (2 * math.pi) - math.pi)
+        root = np.column_stack([g.R * np.cos(th), g.R * np.sin(th), np.zeros(n)])
+        out[k] = np.concatenate([a, f[f"petal {k} tip arc"], b[::-1], root])
+    return out
 
 
 def foot_on_cone(g, X, s):

@@ -94,8 +94,11 @@ def test_ring_depth_is_the_distance_to_the_nearest_face(geom):
 
 def test_a_ring_passing_through_a_petal_and_out_between_samples_is_seen(geom):
     """Two samples 1 ms apart of a point of the chaser's inside circle: 10 mm outside petal 1,
-    then 50 mm behind it and 0.2 m down along the cone's generatrix, out from under the petal.
-    Neither sample shows it through the plate; the sub-steps do, 32 mm deep as it leaves."""
+    then 50 mm behind it and 0.2 m down along the cone's generatrix, out from under the petal
+    past its root. Neither sample shows it through the plate; the sub-steps do. At path fraction
+    f it is -0.01 + 0.06 f behind the plate and (0.1 - 0.2 f sin(alpha1)) / sin(alpha1) from
+    the root along the surface; its depth, the least of the two, is greatest where they are
+    equal (25 mm)."""
     x, n = _cone_point(geom, 1, 0.5, 0.1)
     e_rho = np.array([x[0], x[1], 0.0]) / math.hypot(x[0], x[1])
     down = math.cos(geom.alpha1) * e_rho - math.sin(geom.alpha1) * np.array([0.0, 0.0, 1.0])
@@ -107,8 +110,9 @@ def test_a_ring_passing_through_a_petal_and_out_between_samples_is_seen(geom):
     assert found.solid == "target_apds petal 1"
     s, frac, zeta = petal_coordinates(geom, end[None], 1)
     assert zeta[0] < 0.0                              # the end is no longer over the plate
-    leaving = 0.1 / (0.2 * math.sin(geom.alpha1))     # path fraction where the foot is at 0
-    assert found.depth == pytest.approx(0.06 * leaving - 0.01, abs=1e-3)
+    sa = math.sin(geom.alpha1)
+    f = (0.1 / sa + 0.01) / (0.06 + 0.2)              # behind = to the root
+    assert found.depth == pytest.approx(0.06 * f - 0.01, abs=1e-3)
     assert 0.0 < found.time < 1e-3
 
 
@@ -147,5 +151,20 @@ def test_depth_near_a_free_edge_is_the_least_motion_out(geom, delta, s, depth):
     x, n = _near_side(geom, delta)
     found = _depth_along(geom, [x + 0.01 * n, x - s * n])
     assert found.depth == pytest.approx(depth, abs=1e-9)      # the edges as chords
+    if depth:
+        assert found.solid == "target_apds petal 1"
+
+
+@pytest.mark.parametrize("zeta,s,depth", [(50e-6, 2e-3, 50e-6 * math.sqrt(2)),
+                                          (3e-3, 2e-3, 2e-3), (0.5e-6, 2e-3, 0.0)])
+def test_depth_near_the_root_is_the_least_motion_out(geom, zeta, s, depth):
+    """A point of a guide side pushed s through the middle of petal 1 at height zeta above its
+    root lies min(s, zeta / sin(alpha1)) deep (alpha1 = 45 deg): the other APDS passes the
+    ring's annulus in the paper's reading, so the root, zeta / sin(alpha1) away along the
+    surface, frees it as a side does; within the 1 um graze it passes below the root."""
+    x, n = _cone_point(geom, 1, 0.5, zeta)
+    found = _depth_along(geom, [x + 0.01 * n, x - s * n], feature="guide side 3")
+    # The root as chords of 0.16 mm on the circle rho = R: within 1e-8 m of it.
+    assert found.depth == pytest.approx(depth, abs=1e-8)
     if depth:
         assert found.solid == "target_apds petal 1"
