@@ -47,7 +47,7 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     (point-curve, `corner_pairs`), the guide sides vs the non-partner sides and tip arcs
     they reach (C-C, `side_edge_pairs`), the two rings' outside circles (C-C,
     cc_Crim_Trim, Body 1 the chaser's), and each ring's outside circle vs the other APDS's
-    guide surfaces and sides (`rim_pairs`)."""
+    guide surfaces (C-S, `rim_pairs`)."""
     if which not in PAIR_SETS:
         raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)
@@ -89,14 +89,13 @@ def edge_pairs(P, one, other) -> list[PairSpec]:
 
 def rim_pairs(P, one, other) -> list[PairSpec]:
     """APDS ``one``'s outside circle (Body 1) against APDS ``other``'s guide surfaces,
-    cs_<X>rim_<Y><k> (C-S), and guide sides, cc_<X>rim_<Y><i> (C-C): reached off the axis,
-    where the rim, laterally offset by about the petal's inward slope times its height, comes
-    down onto the middle of a petal (a ring distance of 0.1 m at a lateral offset of 0.1 m).
-    The tip arcs (at rho = Rs, zeta = H) lie beyond the envelope's reach of the rim."""
+    cs_<X>rim_<Y><k> (C-S): reached off the axis, where the rim, laterally offset by about the
+    petal's inward slope times its height, comes down onto the back of a petal (a ring distance
+    of 0.1 m at a lateral offset of 0.1 m). The tip arcs (at rho = Rs, zeta = H) lie beyond
+    the envelope's reach of the rim; the rim against a guide side is not modelled
+    (docs/model.md)."""
     (x, b1), (y, b2) = one, other
-    out = [PairSpec(f"cs_{x}rim_{y}{k}", "CS", b1, P.rim, b2, P.surfaces[k]) for k in (1, 2, 3)]
-    out += [PairSpec(f"cc_{x}rim_{y}{i}", "CC", b1, P.rim, b2, P.sides[i]) for i in range(1, 7)]
-    return out
+    return [PairSpec(f"cs_{x}rim_{y}{k}", "CS", b1, P.rim, b2, P.surfaces[k]) for k in (1, 2, 3)]
 
 
 def corner_pairs(P, one, other) -> list[PairSpec]:
@@ -156,8 +155,7 @@ PAIR_TYPES = (
     (re.compile(r"pc_[CT]corner\d_[CT]ring$"), "petal corner / ring inside circle"),
     (re.compile(r"cc_[CT]\d_[CT]tip\d$"), "guide side / tip arc"),
     (re.compile(r"cc_[CT]rim_[CT]rim$"), "ring outside circle / ring outside circle"),
-    (re.compile(r"cs_[CT]rim_[CT]\d$"), "ring outside circle / guide surface"),
-    (re.compile(r"cc_[CT]rim_[CT]\d$"), "ring outside circle / guide side"))
+    (re.compile(r"cs_[CT]rim_[CT]\d$"), "ring outside circle / guide surface"))
 
 
 def pair_type(name: str) -> str:
@@ -184,8 +182,7 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
     """(edge pair, surface pair, `SurfaceEdge`) of each hand-over among ``pairs``
     (`drake_dock.core.handover`): a ring's inside circle passes between guide surface k
     (cs_<X>ring_<Y>k) and its sides 2k - 1, 2k (cc_<X>ring_<Y><i>) and its tip arc
-    (cc_<X>ring_<Y>tip<k>), `petal_edges`; a rim likewise between guide surface k
-    (cs_<X>rim_<Y>k) and its sides (cc_<X>rim_<Y><i>); the chaser's rim between the target's face
+    (cc_<X>ring_<Y>tip<k>), `petal_edges`; the chaser's rim between the target's face
     (cs_Crim_Tface) and the target's rim (cc_Crim_Trim)."""
     names = {p.name for p in pairs}
     out = []
@@ -197,10 +194,9 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
     for x, y in (("C", "T"), ("T", "C")):
         for k in (1, 2, 3):
             for key, edge in petal_edges(g, k).items():
-                for circle in ("ring", "rim"):
-                    e = f"cc_{x}{circle}_{y}{'tip' + str(k) if key == 'tip' else key}"
-                    if {e, f"cs_{x}{circle}_{y}{k}"} <= names:
-                        out.append((e, f"cs_{x}{circle}_{y}{k}", edge))
+                e = f"cc_{x}ring_{y}{'tip' + str(k) if key == 'tip' else key}"
+                if {e, f"cs_{x}ring_{y}{k}"} <= names:
+                    out.append((e, f"cs_{x}ring_{y}{k}", edge))
     return out
 
 

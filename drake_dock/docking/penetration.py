@@ -17,14 +17,15 @@ over the plate (its foot, interpolated to s = 0 between two sub-steps, inside th
 point passing round a side or over the tip changes side without crossing. A point that has
 crossed (an odd number of times) is inside while it is over the plate, at the depth of the
 least motion that ends that: back through the plate (|s|) or off the plate past its nearest
-free edge (the distance of its foot to the guide sides and the tip arc; the root is fixed to
-the ring). Near an edge the second is the smaller: a guide side sliding on its partner's edge
+free edge (the distance of its foot to the guide sides, the tip arc and the root: the root is
+fixed to the ring, but the other APDS passes that ring's annulus in the paper's reading, so a
+point may come to the plate from below its root). Near an edge the second is the smaller: a guide side sliding on its partner's edge
 that rides up over the edge by 30 um lies 30 um deep, however far it is above the plate. A point inside
 the other ring's solid lies at its distance to the nearest face. Checked: guide sides, tip arcs
-and the ring's inside circle against the other APDS's petals; the ring's circles and face
-against the other ring. A petal passing through the other ring's annulus (so also the ring's
-face and outside circle against the other's petal roots) is the paper's reading
-(docs/model.md) and is not checked.
+and the ring's inside and outside circles against the other APDS's petals; the ring's circles
+and face against the other ring. A petal passing through the other ring's annulus (so also the
+ring's face against the other's petal roots) is the paper's reading (docs/model.md) and is not
+checked.
 
 Between two samples of the run the relative pose is interpolated (translation linearly,
 rotation along its geodesic) in sub-steps that move no feature point more than ``max_travel``.
@@ -39,7 +40,8 @@ import numpy as np
 
 from drake_dock.docking.rotations import rot_vec
 
-PETAL_FEATURES = ("ring inside circle", "guide side", "petal")     # name prefixes
+PETAL_FEATURES = ("ring inside circle", "ring outside circle", "guide side",
+                  "petal")                                          # name prefixes
 RING_FEATURES = ("ring",)
 
 
@@ -114,7 +116,7 @@ def _over(g, frac, zeta_f, tol=1e-9):
 
 def free_edges(g, n=4001) -> dict:
     """{petal k: (M, 3) polyline} of petal k's free edges in the APDS frame, fine enough that
-    a chord lies within 1e-9 m of the curve: guide side 2k - 1 from its root to the tip, the
+    a chord lies within 1e-8 m of the curve: guide side 2k - 1 from its root to the tip, the
     tip arc, guide side 2k from the tip to its root (Eq. 14 and zeta = H), and the root back
     along the ring's outside circle (zeta = 0). The root is fixed to the ring, but the other
     APDS's features pass the ring's annulus in the paper's reading (docs/model.md), so they

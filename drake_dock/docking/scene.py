@@ -105,8 +105,9 @@ def first_contact(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13,
     pairs that close within 1e-9). The
     search steps the ring-face distance by 1 cm, or by 1/100 of its start distance for a larger
     APDS (H > 0.475 m), so that it takes at most about 100 steps; a pair is sought only at the
-    ends of the steps its patches can touch in (`touch_steps`). Remembered per geometry and
-    approach (a pure function of them)."""
+    ends of the steps its patches can touch in (`touch_steps`), and marched through a step
+    whose travel its couple comes within (`march_root`). Remembered per geometry and approach
+    (a pure function of them)."""
     lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, step, xtol, which)
     if lam_c is None:
         raise NoPairCloses(f"no pair closes on the approach {approach}")
@@ -239,30 +240,39 @@ def march_root(pair, approach, hi, start, lo, floor, xtol):
     translates along the approach, so features a distance D apart cannot touch within a travel
     of D: each sub-step is max(D, ``floor``), the side continued. From an interior gap above
     `TOUCH_GAP`, the pair closes where the gap turns below -`TOUCH_GAP` (brentq) or where
-    it falls into +-`TOUCH_GAP` (the circle cutting the surface; the first touch bisected to
-    1e-12 of the travel). A couple that becomes interior already cutting the surface (its
+    it falls into +-`TOUCH_GAP` (the circle cutting the surface: the first point within
+    `TOUCH_GAP`, bisected to 1e-12 of the travel, `_touch`; a seek that fails next to the
+    touch is taken as touching there). A couple that becomes interior already cutting the surface (its
     distance within `TOUCH_GAP`: a circle that came in over an edge, which the set's edge
     pairs, or none, model) does not close it. Returns (lam of the closing or None; (gap,
     direction, distance) at lo; seeks taken)."""
     lam, (g, ref, dist), seeks = hi, start, 0
     while lam > lo:
-        nxt = max(lam - max(dist, floor), lo)
-        g2, ref2, d2 = _seek(pair, approach, nxt, ref)
+        nxt = max(lam - max(abs(dist), floor), lo)
         seeks += 1
-        if np.isfinite(g) and g > TOUCH_GAP and g2 <= 0 and d2 > TOUCH_GAP:
-            def f(x, ref=ref):
-                return _seek(pair, approach, x, ref)[0]
-            return brentq(f, nxt, lam, xtol=xtol, rtol=1e-15), None, seeks
-        if np.isfinite(g) and g > TOUCH_GAP and np.isfinite(g2) and d2 <= TOUCH_GAP:
+        try:
+            g2, ref2, d2 = _seek(pair, approach, nxt, ref)
+        except SeekingError:              # next to a tangent touch (`_touch`)
+            if not (np.isfinite(g) and g > TOUCH_GAP):
+                raise
             root, more = _touch(pair, approach, lam, nxt, ref)
             return root, None, seeks + more
+        if np.isfinite(g) and g > TOUCH_GAP and np.isfinite(g2):
+            if g2 <= 0 and abs(d2) > TOUCH_GAP:
+                def f(x, ref=ref):
+                    return _seek(pair, approach, x, ref)[0]
+                return brentq(f, nxt, lam, xtol=xtol, rtol=1e-15), None, seeks
+            if abs(d2) <= TOUCH_GAP:
+                root, more = _touch(pair, approach, lam, nxt, ref)
+                return root, None, seeks + more
         lam, g, ref, dist = nxt, g2, ref2, d2
     return None, (g, ref, dist), seeks
 
 
 def _touch(pair, approach, hi, lo, ref):
-    """The features are apart at hi and touch at lo < hi (`march_root`): the first touch,
-    bisected to 1e-12 of the travel. Next to the touch the circle is tangent to the surface and
+    """The features are apart at hi and touch at lo < hi (`march_root`): the first point
+    within `TOUCH_GAP` (about TOUCH_GAP / the gap's rate above the touch itself), bisected to
+    1e-12 of the travel. Next to the touch the circle is tangent to the surface and
     the closest couple degenerate: where its Newton does not converge the features are taken
     to touch (the root moves up by at most the bracket). Returns (its lam, seeks)."""
     seeks = 0
@@ -308,7 +318,7 @@ def _first_contact(geometry: tuple, approach: Approach, step, xtol, which):
             lam = None
             if 0 < gaps.gap(j, k) < np.inf and gaps.gap(j, k + 1) <= 0:
                 lam = gaps.root(j, k, xtol)
-            elif gaps.distance(j, k) < travel:
+            elif abs(gaps.distance(j, k)) < travel:
                 lam = gaps.march(j, k, xtol)
             if lam is not None:
                 roots[pairs[j].name] = lam

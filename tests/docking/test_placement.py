@@ -1,6 +1,7 @@
 """The first-contact search (`first_contact`) against a full scan: every pair's signed gap
 (`signed_gaps`) at every point of the travel grid, the pairs' sides continued from point to
-point, and brentq on the first step where a finite gap turns <= 0 (or the march between). The
+point, and brentq on the first step where a positive gap turns <= 0 (or the march
+between). The
 search seeks a pair only in the steps its covers can touch; the travel, the closing pairs and
 the typed error are the scan's, bit for bit. Independently, the path down to the first
 contact is clear by the interpenetration check (`drake_dock.docking.penetration`)."""
@@ -19,8 +20,8 @@ from drake_dock.errors import NumericalError
 
 def full_scan(g, approach, xtol=1e-13, which="paper"):
     """(lam, names, seeks) of the scan of every pair at every grid point: a pair closes on the
-    first step where its finite gap turns <= 0, or, failing that on a step it comes within the
-    step's travel of, where `march_root` closes it."""
+    first step where its positive gap turns <= 0, or, failing that on a step it comes within
+    the step's travel of, where `march_root` closes it."""
     pairs = apds_pairs(g, which)
     grid = travel_grid(g, approach)
     gaps, refs, dist = seek_gaps(pairs, approach, grid[0], [None] * len(pairs))
@@ -34,7 +35,7 @@ def full_scan(g, approach, xtol=1e-13, which="paper"):
                 roots[pairs[j].name] = brentq(
                     lambda x, j=j: signed_gaps([pairs[j]], approach, x, [refs[j]])[0][0],
                     d_lo, d, xtol=xtol, rtol=1e-15)
-            elif dist[j] < d - d_lo:
+            elif abs(dist[j]) < d - d_lo:
                 lam, end, more = march_root(pairs[j], approach, d, (gaps[j], refs[j], dist[j]),
                                             d_lo, (d - d_lo) / MARCH_SUBSTEPS, xtol)
                 seeks += more
@@ -242,7 +243,9 @@ def test_the_path_to_the_first_contact_is_clear_where_a_pair_closes_inside_a_ste
     and is handed over to the guide surface before the step's end (57, 38), or touches a guide
     surface next to its edge and then cuts it (26). Checked by the independent interpenetration
     check, the straight path down to the placed first contact crosses nothing deeper than 20 um
-    (the grid's ends alone placed 57 15 mm and 38 2.5 mm further along the path)."""
+    (random 26's circle cuts the surface next to a near-tangent touch, where the couple is
+    degenerate: its placement lies 18 um past the touch). The steps' ends alone miss these
+    contacts: the pair that closes is apart (+inf) at one end of its step or the other."""
     from drake_dock.docking.scenario import load_scenario
     from drake_dock.docking.scene import contact_approach
     from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition

@@ -1,18 +1,16 @@
-"""A ring's outside circle (its rim) against the other APDS's guide surfaces and sides
+"""A ring's outside circle (its rim) against the other APDS's guide surfaces
 (`drake_dock.docking.pairs.rim_pairs`): the seek against a closed form (a level rim behind a
-petal's cone, Eq. 12) and against a converged brute-force minimum (a rim over a guide side,
-Eq. 13-14), and the hand-overs between them at the petal's sides."""
+petal's cone, Eq. 12), and the pairs' patches."""
 import math
 
 import numpy as np
 import pytest
-from scipy.optimize import minimize
 
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.docking.apds import side_phi
-from drake_dock.docking.pairs import R_MATCHED, apds_pairs, pair_handovers, pair_type
+from drake_dock.docking.pairs import R_MATCHED, apds_pairs, pair_type
 
 
 def _pair(geom, name):
@@ -62,60 +60,18 @@ def test_a_level_rim_behind_a_petal_is_the_closed_form_couple(geom, k, D, z):
         np.testing.assert_allclose(P2.position(cc.u[1:]), p1 - gap * normal, atol=1e-10)
 
 
-def _brute_force(pr, poses):
-    """The least distance between the rim and the guide side by a dense sampling of both
-    parameters, polished by Nelder-Mead (a converged minimum, independent of the seek)."""
-    P1, P2 = posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2])
-    a = np.linspace(P1.patch.lower[0], P1.patch.upper[0], 721)
-    b = np.linspace(P2.patch.lower[0], P2.patch.upper[0], 401)
-    X1 = np.array([P1.position(np.array([x])) for x in a])
-    X2 = np.array([P2.position(np.array([x])) for x in b])
-    d = np.linalg.norm(X1[:, None, :] - X2[None, :, :], axis=-1)
-    i, j = np.unravel_index(np.argmin(d), d.shape)
-    lo, hi = P2.patch.lower[0], P2.patch.upper[0]
-
-    def f(x):
-        t = min(max(x[1], lo), hi)
-        return np.linalg.norm(P1.position(np.array([x[0]])) - P2.position(np.array([t])))
-
-    res = minimize(f, [a[i], b[j]], method="Nelder-Mead",
-                   options={"xatol": 1e-13, "fatol": 1e-15, "maxiter": 20000})
-    return res.fun
-
-
-@pytest.mark.parametrize("i", range(1, 7))
-def test_a_rim_over_a_guide_side_is_the_converged_minimum(geom, i):
-    """The chaser's rim tilted 3 deg, its centre 0.08 m off the axis away from guide side i's
-    mid-height azimuth and 0.13 m up: the seek's couple (Python and compiled) is interior and
-    its distance is the brute-force minimum to 1e-9."""
-    from drake_dock.docking.scene import rot_vec
-    pr = _pair(geom, f"cc_Crim_T{i}")
-    assert pair_type(pr.name) == "ring outside circle / guide side"
-    side = pr.patch2
-    mid = side.position(np.array([0.5 * (side.lower[0] + side.upper[0])]))
-    e = np.array([mid[0], mid[1], 0.0]) / math.hypot(mid[0], mid[1])
-    poses = {"target_apds": (np.eye(3), np.zeros(3)),
-             "chaser_apds": (rot_vec((0.05 * e[1], -0.05 * e[0], 0.0)) @ R_MATCHED,
-                             -0.08 * e + np.array([0.0, 0.0, 0.13]))}
-    want = _brute_force(pr, poses)
-    for c in _seeks(pr, poses):
-        assert c.interior
-        assert c.distance == pytest.approx(want, abs=1e-9)
-
-
-def test_the_rim_pairs_and_their_handovers(geom):
-    """Each APDS's rim against the other's three guide surfaces and six sides (18 pairs,
-    Body 1 the rim: radius R, height 0), and a hand-over from each rim/surface pair to the
-    rim/side pairs of its two sides, over the surface's edges s = 0 and s = 1."""
+def test_the_rim_pairs(geom):
+    """Each APDS's rim against the other's three guide surfaces (6 pairs, Body 1 the rim:
+    radius R, height 0; Body 2 the other APDS's guide surface k)."""
     pairs = {p.name: p for p in apds_pairs(geom, "complete")}
-    for x, y, b1 in (("C", "T", "chaser_apds"), ("T", "C", "target_apds")):
-        for name in [f"cs_{x}rim_{y}{k}" for k in (1, 2, 3)] + [f"cc_{x}rim_{y}{i}"
-                                                                 for i in range(1, 7)]:
-            pr = pairs[name]
-            assert pr.body1 == b1 and (pr.patch1.radius, pr.patch1.height) == (geom.R, 0.0)
-    hand = {(e, s): edge for e, s, edge in pair_handovers(geom, list(pairs.values()))}
-    for x, y in (("C", "T"), ("T", "C")):
+    surfaces = {k: _pair(geom, f"cs_Cring_T{k}").patch2 for k in (1, 2, 3)}
+    for x, y, b1, b2 in (("C", "T", "chaser_apds", "target_apds"),
+                         ("T", "C", "target_apds", "chaser_apds")):
         for k in (1, 2, 3):
-            lo = hand[(f"cc_{x}rim_{y}{2 * k - 1}", f"cs_{x}rim_{y}{k}")]
-            hi = hand[(f"cc_{x}rim_{y}{2 * k}", f"cs_{x}rim_{y}{k}")]
-            assert (lo.fixed, lo.upper, hi.fixed, hi.upper) == (0, False, 0, True)
+            pr = pairs[f"cs_{x}rim_{y}{k}"]
+            assert (pr.kind, pr.body1, pr.body2) == ("CS", b1, b2)
+            assert (pr.patch1.radius, pr.patch1.height) == (geom.R, 0.0)
+            u = np.array([[0.1, 0.02], [0.5, 0.1], [0.9, 0.18]])
+            np.testing.assert_array_equal(pr.patch2.position(u), surfaces[k].position(u))
+    assert not [n for n in pairs if n.startswith(("cc_Crim_T", "cc_Trim_C"))
+                and n != "cc_Crim_Trim"]
