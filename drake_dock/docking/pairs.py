@@ -45,9 +45,8 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     the other ring's face (C-S), the tip arcs vs the guide surfaces they can face (C-S,
     `tip_surface_pairs`), the other APDS's petal corners vs the ring's inside circle
     (point-curve, `corner_pairs`), the guide sides vs the non-partner sides and tip arcs
-    they reach (C-C, `side_edge_pairs`), the two rings' outside circles (C-C,
-    cc_Crim_Trim, Body 1 the chaser's), and each ring's outside circle vs the other APDS's
-    guide surfaces (C-S, `rim_pairs`)."""
+    they reach (C-C, `side_edge_pairs`), and the two rings' outside circles (C-C,
+    cc_Crim_Trim, Body 1 the chaser's)."""
     if which not in PAIR_SETS:
         raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)
@@ -66,8 +65,6 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         pairs += corner_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
         pairs += side_edge_pairs(P, R_MATCHED)
         pairs.append(PairSpec("cc_Crim_Trim", "CC", CHASER_APDS, P.rim, TARGET_APDS, P.rim))
-        pairs += rim_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
-        pairs += rim_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
     return pairs
 
 
@@ -85,17 +82,6 @@ def edge_pairs(P, one, other) -> list[PairSpec]:
     out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
     out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
     return out
-
-
-def rim_pairs(P, one, other) -> list[PairSpec]:
-    """APDS ``one``'s outside circle (Body 1) against APDS ``other``'s guide surfaces,
-    cs_<X>rim_<Y><k> (C-S): reached off the axis, where the rim, laterally offset by about the
-    petal's inward slope times its height, comes down onto the back of a petal (a ring distance
-    of 0.1 m at a lateral offset of 0.1 m). The tip arcs (at rho = Rs, zeta = H) lie beyond
-    the envelope's reach of the rim; the rim against a guide side is not modelled
-    (docs/model.md)."""
-    (x, b1), (y, b2) = one, other
-    return [PairSpec(f"cs_{x}rim_{y}{k}", "CS", b1, P.rim, b2, P.surfaces[k]) for k in (1, 2, 3)]
 
 
 def corner_pairs(P, one, other) -> list[PairSpec]:
@@ -154,8 +140,7 @@ PAIR_TYPES = (
     (re.compile(r"cs_[CT]tip\d_[CT]\d$"), "tip arc / guide surface"),
     (re.compile(r"pc_[CT]corner\d_[CT]ring$"), "petal corner / ring inside circle"),
     (re.compile(r"cc_[CT]\d_[CT]tip\d$"), "guide side / tip arc"),
-    (re.compile(r"cc_[CT]rim_[CT]rim$"), "ring outside circle / ring outside circle"),
-    (re.compile(r"cs_[CT]rim_[CT]\d$"), "ring outside circle / guide surface"))
+    (re.compile(r"cc_[CT]rim_[CT]rim$"), "ring outside circle / ring outside circle"))
 
 
 def pair_type(name: str) -> str:

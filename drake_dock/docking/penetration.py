@@ -21,11 +21,11 @@ free edge (the distance of its foot to the guide sides, the tip arc and the root
 fixed to the ring, but the other APDS passes that ring's annulus in the paper's reading, so a
 point may come to the plate from below its root). Near an edge the second is the smaller: a guide side sliding on its partner's edge
 that rides up over the edge by 30 um lies 30 um deep, however far it is above the plate. A point inside
-the other ring's solid lies at its distance to the nearest face. Checked: guide sides, tip arcs
-and the ring's inside and outside circles against the other APDS's petals; the ring's circles
-and face against the other ring. A petal passing through the other ring's annulus (so also the
-ring's face against the other's petal roots) is the paper's reading (docs/model.md) and is not
-checked.
+the other ring's solid lies at its distance to the nearest face. Checked: guide sides (but
+their roots, on the outside circle), tip arcs and the ring's inside circle against the other
+APDS's petals; the ring's circles and face against the other ring. A petal passing through the
+other ring's annulus (so also the ring's face and outside circle against the other's petals)
+is the paper's reading (docs/model.md) and is not checked.
 
 Between two samples of the run the relative pose is interpolated (translation linearly,
 rotation along its geodesic) in sub-steps that move no feature point more than ``max_travel``.
@@ -40,8 +40,7 @@ import numpy as np
 
 from drake_dock.docking.rotations import rot_vec
 
-PETAL_FEATURES = ("ring inside circle", "ring outside circle", "guide side",
-                  "petal")                                          # name prefixes
+PETAL_FEATURES = ("ring inside circle", "guide side", "petal")     # name prefixes
 RING_FEATURES = ("ring",)
 
 
@@ -132,6 +131,13 @@ def free_edges(g, n=4001) -> dict:
     return out
 
 
+def annulus_rim(g, X):
+    """Which of the points X (M, 3), in their own APDS frame, lie on the ring's outside circle
+    (rho = R, zeta = 0): the guide sides' roots, the outer edge of the annulus that the other
+    APDS's petals pass in the paper's reading, so not checked against them."""
+    return (np.abs(X[:, 2]) < 1e-12) & (np.abs(np.hypot(X[:, 0], X[:, 1]) - g.R) < 1e-9)
+
+
 def foot_on_cone(g, X, s):
     """The feet of points X (M, 3) at signed distances s (M,) from the cone (Eq. 12)."""
     e = X[:, :2] / np.maximum(np.hypot(X[:, 0], X[:, 1]), 1e-300)[:, None]
@@ -214,6 +220,7 @@ class _PetalWatch:
         """Updates with the sub-step's points X and their coordinates; returns the depth of
         each point."""
         foot = foot_on_cone(g, X, s)
+        s_now, foot_now = s, foot
         if self.s is None:
             self.crossed = np.zeros(len(s), dtype=bool)
         else:
@@ -228,12 +235,19 @@ class _PetalWatch:
                     at = self.foot[idx] + w * (foot[idx] - self.foot[idx])
                     idx = idx[distance_to_polyline(at, self.edges) > self.graze]
                 self.crossed[idx] = ~self.crossed[idx]
+            # A point exactly on the cone (s = 0) keeps its last side: the crossing is seen
+            # at the next sub-step off the cone.
+            on = s == 0.0
+            if on.any():
+                s, foot, frac, zeta = (np.where(on, a, b) for a, b in (
+                    (self.s, s), (self.foot.T, foot.T), (self.frac, frac), (self.zeta, zeta)))
+                foot = foot.T
         self.s, self.foot, self.frac, self.zeta = s, foot, frac, zeta
         depth = np.zeros(len(s))
         inside = np.flatnonzero(self.crossed & _over(g, frac, zeta))
         if len(inside):
-            off = distance_to_polyline(foot[inside], self.edges)
-            depth[inside] = np.minimum(np.abs(s[inside]), off)
+            off = distance_to_polyline(foot_now[inside], self.edges)
+            depth[inside] = np.minimum(np.abs(s_now[inside]), off)
         return depth
 
 
@@ -251,6 +265,7 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
     reach = max(float(np.linalg.norm(X, axis=1).max()) for X in feats.values())
     best = Penetration()
     edges = free_edges(g)
+    on_petals = {f: ~annulus_rim(g, X) for f, X in feats.items()}
     for a, b in ((0, 1), (1, 0)):
         R, p = relative_poses(R_WA, p_WA, a, b)
         watches = {(f, k): _PetalWatch(f"{names[a]} {f}", f"{names[b]} petal {k}", edges[k],
@@ -259,12 +274,13 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
         for tt, Rab, pab in sub_steps(t, R, p, reach, max_travel):
             for fname, X in feats.items():
                 Y = X @ Rab.T + pab
-                found = [(w.solid, w.step(g, Y, *petal_coordinates(g, Y, k)))
+                Yp = Y[on_petals[fname]]
+                found = [(w.solid, w.step(g, Yp, *petal_coordinates(g, Yp, k)))
                          for (f, k), w in watches.items() if f == fname]
                 if fname.startswith(RING_FEATURES):
                     found.append((f"{names[b]} ring", ring_depth_of(g, Y, ring_depth)))
                 for solid, depth in found:
-                    d = float(depth.max())
+                    d = float(depth.max()) if len(depth) else 0.0
                     if d > best.depth:
                         best = Penetration(d, float(tt), f"{names[a]} {fname}", solid)
     return best

@@ -169,12 +169,11 @@ def test_complete_set_names_and_patches(geom):
     the other's guide surfaces they can face (32 pairs), its ring's inside circle against
     the other's 6 petal corners, each the top end of its guide side (12 point-curve pairs),
     the guide sides against the non-partner sides and the tip arcs they can reach (36
-    pairs), the two rims (1 pair, the chaser's Body 1), and each rim against the other's
-    guide surfaces (6 pairs, tests/docking/test_rim_pairs.py)."""
+    pairs), and the two rims (1 pair, the chaser's Body 1)."""
     paper, complete = apds_pairs(geom), apds_pairs(geom, "complete")
     assert [p.name for p in complete[:12]] == [p.name for p in paper] and len(paper) == 12
     new = {p.name: p for p in complete[12:]}
-    assert len(new) == len(complete) - 12 == 87
+    assert len(new) == len(complete) - 12 == 81
     P = apds_patches(geom)
     for x, y, bx, by in (("C", "T", "chaser_apds", "target_apds"),
                          ("T", "C", "target_apds", "chaser_apds")):

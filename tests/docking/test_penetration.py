@@ -168,3 +168,17 @@ def test_depth_near_the_root_is_the_least_motion_out(geom, zeta, s, depth):
     assert found.depth == pytest.approx(depth, abs=1e-8)
     if depth:
         assert found.solid == "target_apds petal 1"
+
+
+@pytest.mark.parametrize("inset, depth", [(0.0, 0.0), (1e-3, 2e-3)])
+def test_a_guide_side_root_passing_a_petal_is_the_annulus_passing(geom, inset, depth):
+    """A point of a chaser guide side pushed 2 mm through the middle of target petal 1 at
+    mid-height. At the side's root (rho = R, zeta = 0) it lies on the chaser ring's outside
+    circle, the outer edge of the annulus that the target's petals pass in the paper's reading,
+    and is not counted; 1 mm up the side it is, 2 mm deep."""
+    x, n = _cone_point(geom, 1, 0.5, 0.1)
+    own = np.array([[geom.R - inset, 0.0, 0.0]])
+    path = np.array([x + 0.01 * n, x - 2e-3 * n]) - own[0]
+    t, R_WA, p_WA = _path(path)
+    found = deepest_penetration(geom, t, R_WA, p_WA, NAMES, features={"guide side 1": own})
+    assert found.depth == pytest.approx(depth, abs=1e-9)
