@@ -19,13 +19,14 @@ crossed (an odd number of times) is inside while it is over the plate, at the de
 least motion that ends that: back through the plate (|s|) or off the plate past its nearest
 free edge (the distance of its foot to the guide sides, the tip arc and the root: the root is
 fixed to the ring, but the other APDS passes that ring's annulus in the paper's reading, so a
-point may come to the plate from below its root). Near an edge the second is the smaller: a guide side sliding on its partner's edge
-that rides up over the edge by 30 um lies 30 um deep, however far it is above the plate. A point inside
-the other ring's solid lies at its distance to the nearest face. Checked: guide sides (but
-their roots, on the outside circle), tip arcs and the ring's inside circle against the other
-APDS's petals; the ring's circles and face against the other ring. A petal passing through the
-other ring's annulus (so also the ring's face and outside circle against the other's petals)
-is the paper's reading (docs/model.md) and is not checked.
+point may come to the plate from below its root). Near an edge the second is the smaller: a
+guide side sliding on its partner's edge that rides up over the edge by 30 um lies 30 um deep,
+however far it is above the plate. A point inside the other ring's solid lies at its distance
+to the nearest face. Checked: guide sides (but their roots, on the outside circle), tip arcs and
+the ring's inside circle against the other APDS's petals; the ring's circles and face against
+the other ring. A petal passing through the other ring's annulus (so also the ring's face and
+outside circle against the other's petals) is the paper's reading (docs/model.md) and is not
+checked.
 
 Between two samples of the run the relative pose is interpolated (translation linearly,
 rotation along its geodesic) in sub-steps that move no feature point more than ``max_travel``.
@@ -134,7 +135,9 @@ def free_edges(g, n=4001) -> dict:
 def annulus_rim(g, X):
     """Which of the points X (M, 3), in their own APDS frame, lie on the ring's outside circle
     (rho = R, zeta = 0): the guide sides' roots, the outer edge of the annulus that the other
-    APDS's petals pass in the paper's reading, so not checked against them."""
+    APDS's petals pass in the paper's reading, so not checked against them. Only the root's
+    own sample is left out; the next sample of a side (`feature_points`) lies 4 mm above the
+    ring face."""
     return (np.abs(X[:, 2]) < 1e-12) & (np.abs(np.hypot(X[:, 0], X[:, 1]) - g.R) < 1e-9)
 
 

@@ -242,9 +242,9 @@ def march_root(pair, approach, hi, start, lo, floor, xtol):
     `TOUCH_GAP`, the pair closes where the gap turns below -`TOUCH_GAP` (brentq) or where
     it falls into +-`TOUCH_GAP` (the circle cutting the surface: the first point within
     `TOUCH_GAP`, bisected to 1e-12 of the travel, `_touch`; a seek that fails next to the
-    touch is taken as touching there). A couple that becomes interior already cutting the surface (its
-    distance within `TOUCH_GAP`: a circle that came in over an edge, which the set's edge
-    pairs, or none, model) does not close it. Returns (lam of the closing or None; (gap,
+    touch is taken as touching there). A couple that becomes interior already cutting the
+    surface (its distance within `TOUCH_GAP`: a circle that came in over an edge, which the
+    set's edge pairs, or none, model) does not close it. Returns (lam of the closing or None; (gap,
     direction, distance) at lo; seeks taken)."""
     lam, (g, ref, dist), seeks = hi, start, 0
     while lam > lo:

@@ -172,10 +172,11 @@ def test_depth_near_the_root_is_the_least_motion_out(geom, zeta, s, depth):
 
 @pytest.mark.parametrize("inset, depth", [(0.0, 0.0), (1e-3, 2e-3)])
 def test_a_guide_side_root_passing_a_petal_is_the_annulus_passing(geom, inset, depth):
-    """A point of a chaser guide side pushed 2 mm through the middle of target petal 1 at
-    mid-height. At the side's root (rho = R, zeta = 0) it lies on the chaser ring's outside
-    circle, the outer edge of the annulus that the target's petals pass in the paper's reading,
-    and is not counted; 1 mm up the side it is, 2 mm deep."""
+    """A point of the chaser pushed 2 mm through the middle of target petal 1 at mid-height
+    (named a guide side's). On the chaser ring's outside circle (rho = R, zeta = 0: a side's
+    root), the outer edge of the annulus that the target's petals pass in the paper's reading,
+    it is not counted; 1 mm inside that circle it is, 2 mm deep. The sub-steps land exactly on
+    the cone (s = 0) here: the point keeps its side there and the crossing is seen next."""
     x, n = _cone_point(geom, 1, 0.5, 0.1)
     own = np.array([[geom.R - inset, 0.0, 0.0]])
     path = np.array([x + 0.01 * n, x - 2e-3 * n]) - own[0]
