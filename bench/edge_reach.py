@@ -3,7 +3,7 @@ over seeded random poses (roll -60..60 deg, tilt up to 10 deg, offset up to 0.15
 distance -0.2..0.45 m), per candidate pair, the poses where its closest couple is interior and
 within 2 cm, the rolls where that happens and the least interior distance found; and whether
 `contact.pairs: complete` declares the pair (`drake_dock.docking.pairs.side_edge_pairs`). The
-tip arcs against the other APDS's tip arcs are swept too (no pair models them yet).
+tip arcs against the other APDS's tip arcs are swept too (`tip_tip_pairs`).
 
     python bench/edge_reach.py [N]        (default 20000 poses)
 """

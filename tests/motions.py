@@ -45,3 +45,23 @@ class Motion:
         acc = -self.A * self.W ** 2 * np.sin(self.W * t)
         r = P - self.pose(t)[1]
         return acc + np.cross(alpha, r) + np.cross(w, np.cross(w, r))
+
+
+def check_rates_by_finite_differences(ev_at, m1, m2, times=(0.2, 0.55, 0.9), h=1e-4):
+    """For a couple evaluated along prescribed motions m1 (Body 1) and m2 (Body 2) by
+    ``ev_at(t)`` (a `CoupleEval` at the closed-form couple): vn = g', u' = du/dt, g'' =
+    n . (a1 - a2) + bias_n and (t . v_rel)' = t . (a1 - a2) + bias_t (the tangential velocity
+    components of the material points, differentiated with the frame moving along the couple),
+    by central differences."""
+    for t in times:
+        e0, ep, em = ev_at(t), ev_at(t + h), ev_at(t - h)
+        fp, fm = ev_at(t + 1e-6), ev_at(t - 1e-6)
+        np.testing.assert_allclose(e0.vn, (fp.gap - fm.gap) / 2e-6, atol=1e-8)
+        np.testing.assert_allclose(e0.udot, (fp.u - fm.u) / 2e-6, atol=1e-8)
+        gdd = (ep.gap - 2 * e0.gap + em.gap) / h ** 2
+        acc = m1.acceleration(t, e0.p1) - m2.acceleration(t, e0.p2)
+        np.testing.assert_allclose(e0.n @ acc + e0.bias_n, gdd, atol=1e-5)
+        vt_dot = (ep.vt - em.vt) / (2 * h)
+        np.testing.assert_allclose(np.array([e0.ta @ acc, e0.tb @ acc]) + e0.bias_t, vt_dot,
+                                   atol=1e-6)
+        np.testing.assert_allclose(e0.vt, [e0.ta @ e0.v_rel, e0.tb @ e0.v_rel], atol=1e-15)

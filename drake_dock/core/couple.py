@@ -1,5 +1,6 @@
 """Kinematics of one couple of two moving patches (Sect. 5 and 7 of the paper), generic over
-curve-curve ("CC") and curve-surface ("CS") pairs; plain numpy.
+curve-curve ("CC"), curve-surface ("CS"), point-curve ("PC") and point-surface ("PS") pairs;
+plain numpy.
 
 Patch 1 is a curve on Body 1; patch 2 a curve (CC) or a surface (CS) on Body 2. Each body frame
 F_i has the world pose (R_i, p_i) and twist (w_i, v_i), v_i the velocity of its origin. A point
@@ -32,6 +33,12 @@ conditioning is |Fu| / (t2 . t2 + |k2| |d|). d = 0 (the corner on the curve, r d
 touch) has no normal: `SingularCoupleError`. A point-curve couple is a potential contact only
 with the point on the concave side of the curve (`point_curve_side`; docs/model.md, "The petal
 corner").
+
+Point-surface ("PS", a petal corner against a guide surface): patch 1 a point p (a sphere of
+radius r), u = (u, v) of the surface, d = p - s(u); F = [s_u . d, s_v . d] (Eq. 38 without its
+tangency row), n = sigma N/|N| as for C-S, g = n . d - r, ta = s_u/|s_u|. Its Jacobian is
+[[s_uu . d - s_u . s_u, s_uv . d - s_u . s_v], [.., s_vv . d - s_v . s_v]], regular at d = 0 (the
+point on the surface): singular only at a centre of curvature of the surface.
 
 Relative velocity (Eq. 23-25) of the material points at the couple, v_rel = v_1(P_1) - v_2(P_2);
 g' = n . v_rel exactly at the couple (the points' own motion along the tangents is
@@ -121,6 +128,14 @@ def _residual(kind, d, T1, K1, T2, K2):
         # The analogue of Eq. (37) for a point: d (p - c(s)) . t2 = 0; d/ds = k2 . d - t2 . t2.
         t2, k2 = T2[0], K2[0][0]
         return [_dot(t2, d)], [[_dot(k2, d) - _dot(t2, t2)]]
+    if kind == "PS":
+        # Eq. (38) for a point: su . d = sv . d = 0; d/du of su . d is suu . d - su . su.
+        su, sv = T2
+        (suu, suv), (_, svv) = K2
+        susv = _dot(su, sv)
+        return ([_dot(su, d), _dot(sv, d)],
+                [[_dot(suu, d) - _dot(su, su), _dot(suv, d) - susv],
+                 [_dot(suv, d) - susv, _dot(svv, d) - _dot(sv, sv)]])
     t1, k1 = T1[0], K1[0][0]
     if kind == "CC":
         t2, k2 = T2[0], K2[0][0]
@@ -209,6 +224,8 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
     the integrated couple before anything else is computed (its size is returned)."""
     if kind == "PC":
         return _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, project)
+    if kind == "PS":
+        return _evaluate_point_surface(patch1, X1, V1, patch2, X2, V2, u_state, sigma, project)
     n1 = patch1.dim
     (R1, p1o), (R2, p2o) = _pose(X1), _pose(X2)
     w1, v1 = (float_vec(x) for x in V1)
@@ -283,17 +300,47 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
         vn=_dot(n, v_rel), vt=T[0], bias_n=_dot(n, conv) + _dot(ndot, v_rel), bias_t=T[1])
 
 
-def _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, project):
-    """`evaluate_couple` for kind "PC" (module docstring): patch 1 a `Point`, patch 2 a curve,
-    u = (s,). s' = -Ft / Fu (Eq. 47 with F = t2 . d); the frame and its rates from d' = v_rel -
-    t2 s' and t2' = w2 x t2 + k2 s' (`frame_rates_pc`: n' = sigma (d' - dh (dh . d')) / |d|,
-    dh = d / |d|; c = -(w2 x t2) s', Eq. 52)."""
+def _point_setup(patch1, X1, V1, X2, V2):
+    """(R2, p2, w1, v1, w2, v2, r1, P1) of a point couple: Body 2's pose, both twists in
+    floats, the point's offset R1 p from its frame's origin and its world position."""
     (R1, p1o), (R2, p2o) = _pose(X1), _pose(X2)
     w1, v1 = (float_vec(x) for x in V1)
     w2, v2 = (float_vec(x) for x in V2)
     r1 = _rot(R1, patch1.jet(())[0])
-    P1 = _add(r1, p1o)
-    u0 = [float(a) for a in u_state]
+    return R2, p2o, w1, v1, w2, v2, r1, _add(r1, p1o)
+
+
+def _point_couple(U, cond, P1, P2, frame, v_rel, w1, radius, gap):
+    """The `CoupleEval` of a point couple (kinds "PC", "PS") whose sphere of ``radius`` is
+    centred at P1: U = (u, drift, udot, residual), frame = (n, n', ta, ta', conv, qhat,
+    qhat'). The contact point is the sphere's point towards Body 2, q = -radius qhat from its
+    centre: v_rel there, and its motion over the sphere, w1 x (q' - w1 x q), in the Eq. (52)
+    term (the normal row's terms equal the centre's)."""
+    u, du, udot, residual = U
+    n, ndot, ta, tadot, conv, qhat, qhat_dot = frame
+    q = _mul(qhat, -radius)
+    qdot = _mul(qhat_dot, -radius)
+    P1 = _add(P1, q)
+    v_rel = _add(v_rel, _cr(w1, q))
+    conv = _add(conv, _cr(w1, _sub(qdot, _cr(w1, q))))
+    tb = _cr(n, ta)
+    tbdot = _add(_cr(ndot, ta), _cr(n, tadot))
+    return CoupleEval(
+        u=np.array(u), drift=np.array(du), residual=residual, udot=np.array(udot),
+        conditioning=cond, p1=np.array(P1), p2=np.array(P2), n=np.array(n), ta=np.array(ta),
+        tb=np.array(tb), gap=gap, v_rel=np.array(v_rel),
+        vn=_dot(n, v_rel), vt=np.array((_dot(ta, v_rel), _dot(tb, v_rel))),
+        bias_n=_dot(n, conv) + _dot(ndot, v_rel),
+        bias_t=np.array((_dot(ta, conv) + _dot(tadot, v_rel),
+                         _dot(tb, conv) + _dot(tbdot, v_rel))))
+
+
+def _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, project):
+    """`evaluate_couple` for kind "PC" (module docstring): patch 1 a `Point`, patch 2 a curve,
+    u = (s,). s' = -Ft / Fu (Eq. 47 with F = t2 . d); the frame and its rates from d' = v_rel -
+    t2 s' and t2' = w2 x t2 + k2 s' (`frame_rates_pc`: n' = sigma (d' - dh (dh . d')) / |d|,
+    dh = d / |d|; c = -(w2 x t2) s', Eq. 52); the contact point q = -r dh from the centre."""
+    R2, p2o, w1, v1, w2, v2, r1, P1 = _point_setup(patch1, X1, V1, X2, V2)
 
     def at(s):
         r2, (t2,), ((k2,),) = _geometry(patch2, R2, [s])
@@ -301,7 +348,7 @@ def _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, projec
         (F,), ((Fu,),) = _residual("PC", d, None, None, (t2,), ((k2,),))
         return r2, t2, k2, d, F, Fu
 
-    s = u0[0]
+    s = float(u_state[0])
     r2, t2, k2, d, F, Fu = at(s)
     residual = abs(F)
     cond = _pc_conditioning([[Fu]], d, (t2,), ((k2,),))
@@ -315,7 +362,6 @@ def _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, projec
     if not dist > 0.0:
         raise SingularCoupleError("point-curve couple: the point lies on the curve (|d| = 0), "
                                   "its normal is undefined")
-    P2 = _add(r2, p2o)
     v_rel = _sub(_add(v1, _cr(w1, r1)), _add(v2, _cr(w2, r2)))
     w2t2 = _cr(w2, t2)
     Ft = _dot(w2t2, d) + _dot(t2, v_rel)
@@ -324,21 +370,44 @@ def _evaluate_point_curve(patch1, X1, V1, patch2, X2, V2, u_state, sigma, projec
     sig = float(sigma)
     n, ndot, ta, tadot, conv = frame_rates_pc(d, t2, _axpy(-sdot, t2, v_rel),
                                               _axpy(sdot, k2, w2t2), tuple(w2), sdot, sig)
-    # The contact point is the sphere's point towards the curve, q = -r d/|d| from its centre:
-    # v_rel there, and its motion over the sphere, w1 x (q' - w1 x q), in the Eq. (52) term
-    # (the normal row's terms equal the centre's).
-    q = _mul(n, -patch1.radius * sig)
-    qdot = _mul(ndot, -patch1.radius * sig)
-    P1 = _add(P1, q)
-    v_rel = _add(v_rel, _cr(w1, q))
-    conv = _add(conv, _cr(w1, _sub(qdot, _cr(w1, q))))
-    tb = _cr(n, ta)
-    tbdot = _add(_cr(ndot, ta), _cr(n, tadot))
-    return CoupleEval(
-        u=np.array([s]), drift=np.array([ds]), residual=residual, udot=np.array([sdot]),
-        conditioning=cond, p1=np.array(P1), p2=np.array(P2), n=np.array(n), ta=np.array(ta),
-        tb=np.array(tb), gap=sig * dist - patch1.radius, v_rel=np.array(v_rel),
-        vn=_dot(n, v_rel), vt=np.array((_dot(ta, v_rel), _dot(tb, v_rel))),
-        bias_n=_dot(n, conv) + _dot(ndot, v_rel),
-        bias_t=np.array((_dot(ta, conv) + _dot(tadot, v_rel),
-                         _dot(tb, conv) + _dot(tbdot, v_rel))))
+    return _point_couple(([s], [ds], [sdot], residual), cond, P1, _add(r2, p2o),
+                         (n, ndot, ta, tadot, conv, _mul(n, sig), _mul(ndot, sig)), v_rel, w1,
+                         patch1.radius, sig * dist - patch1.radius)
+
+
+def _evaluate_point_surface(patch1, X1, V1, patch2, X2, V2, u_state, sigma, project):
+    """`evaluate_couple` for kind "PS" (module docstring): patch 1 a `Point`, patch 2 a
+    surface, u = (u, v). u' = -Fu^-1 Ft (Eq. 47 with F = [s_u . d, s_v . d]); the frame and its
+    rates as for C-S with no curve on Body 1 (`frame_rates_cs` with t1 = 0); the contact point
+    is the sphere's point towards the surface, q = -r n from its centre."""
+    R2, p2o, w1, v1, w2, v2, r1, P1 = _point_setup(patch1, X1, V1, X2, V2)
+
+    def at(u):
+        r2, T2, K2 = _geometry(patch2, R2, u)
+        d = _sub(P1, _add(r2, p2o))
+        F, Fu = _residual("PS", d, (), (), T2, K2)
+        return r2, T2, K2, d, F, Fu, _conditioning(Fu, (), T2)
+
+    u = [float(a) for a in u_state]
+    r2, T2, K2, d, F, Fu, cond = at(u)
+    residual = math.hypot(*F)
+    du = [0.0, 0.0]
+    if project and residual > 0.0 and cond > 1e-14:
+        du = [-a for a in _solve(Fu, F)]
+        u = [a + b for a, b in zip(u, du)]
+        r2, T2, K2, d, F, Fu, cond = at(u)
+    su, sv = T2
+    (suu, suv), (_, svv) = K2
+    w2su, w2sv = _cr(w2, su), _cr(w2, sv)
+    v_rel = _sub(_add(v1, _cr(w1, r1)), _add(v2, _cr(w2, r2)))
+    Ft = [_dot(w2su, d) + _dot(su, v_rel), _dot(w2sv, d) + _dot(sv, v_rel)]
+    # Eq. (47); a singular Fu (p at a centre of curvature) gives zeros, reported by
+    # `conditioning`.
+    udot = _solve(Fu, [-f for f in Ft]) if cond > 1e-14 else [0.0, 0.0]
+    sudot = _axpy(udot[1], suv, _axpy(udot[0], suu, w2su))
+    svdot = _axpy(udot[1], svv, _axpy(udot[0], suv, w2sv))
+    n, ndot, ta, tadot, conv = frame_rates_cs((0.0, 0.0, 0.0), *map(tuple, (
+        su, sv, sudot, svdot, _cr(su, sv), w1, w2)), 0.0, udot[0], udot[1], float(sigma))
+    return _point_couple((u, du, udot, residual), cond, P1, _add(r2, p2o),
+                         (n, ndot, ta, tadot, conv, n, ndot), v_rel, w1, patch1.radius,
+                         _dot(n, d) - patch1.radius)

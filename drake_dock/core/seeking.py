@@ -299,7 +299,8 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, **grid_options) 
     ``distance_rtol`` the Newton finish ends once the distance has converged to that fraction,
     where it is beyond ``rtol_beyond`` (see `newton_closest`)."""
     if P1.patch.dim == 0:
-        return seek_point_curve(P1, P2)
+        return (seek_point_curve(P1, P2) if P2.patch.dim == 1 else
+                seek_point_surface(P1, P2, distance_rtol=distance_rtol, rtol_beyond=rtol_beyond))
     best = None
     tol = 1e-9 * np.concatenate([P1.patch.span, P2.patch.span])
     started = []
@@ -364,6 +365,26 @@ def seek_point_curve(P1, P2, *, n_grid=64, max_iter=30) -> Couple:
     # A potential contact only on the curve's concave side (`point_curve_side`).
     concave = point_curve_side(curve, P2.R, s[0], d) > 0.0
     return Couple(np.zeros(0), s, p, p2, dist, it, is_interior(curve, s) and concave)
+
+
+def seek_point_surface(P1, P2, *, n_grid=16, distance_rtol=None, rtol_beyond=0.0) -> Couple:
+    """The couple of a posed point P1 (`Point`, a sphere of radius r) and a posed surface P2:
+    the u of least |p - s(u)| (the distance is |p - s(u)| - r), from the nearest point of an
+    ``n_grid`` x ``n_grid`` grid over the domain, finished by the bounded Newton of
+    `newton_closest` (held on a domain end the gradient pushes outwards). The couple is
+    ``interior`` only inside the surface's domain."""
+    pt, surface = P1.patch, P2.patch
+    p = P1.position(np.zeros(0))
+    U, r = surface.grid_points(n_grid)
+    u0 = U[int(np.argmin(((P2.p + r @ P2.R.T - p) ** 2).sum(axis=-1)))]
+    _, u2, it = newton_closest(P1, P2, np.zeros(0), u0, distance_rtol=distance_rtol,
+                               rtol_beyond=rtol_beyond)
+    p2 = P2.position(u2)
+    dist = float(np.linalg.norm(p - p2)) - pt.radius
+    if not math.isfinite(dist):
+        raise SeekingError("no finite distance between the point and the surface (a "
+                           "non-finite pose)")
+    return Couple(np.zeros(0), u2, p, p2, dist, it, is_interior(surface, u2))
 
 
 def is_interior(patch, u, rtol=1e-9) -> bool:

@@ -337,13 +337,16 @@ class ApdsPatches:
     rim: Circle      # outside circle of the ring
     face: Annulus    # the ring's face
     corners: dict = dataclasses.field(default_factory=dict)   # i -> corner at side i's top
+    # i -> the bare corner point (radius 0), against the other APDS's guide surfaces
+    corner_points: dict = dataclasses.field(default_factory=dict)
 
 
 def apds_patches(g: ApdsGeometry) -> ApdsPatches:
     return ApdsPatches({i: guide_side(g, i) for i in range(1, 7)},
                        {k: guide_surface(g, k) for k in (1, 2, 3)}, ring_circle(g),
                        {k: tip_arc(g, k) for k in (1, 2, 3)}, ring_rim(g), ring_face(g),
-                       {i: petal_corner(g, i) for i in range(1, 7)})
+                       {i: petal_corner(g, i) for i in range(1, 7)},
+                       {i: Point(corner_point(g, i)) for i in range(1, 7)})
 
 
 # Visual mesh --------------------------------------------------------------------------------

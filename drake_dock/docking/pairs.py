@@ -45,7 +45,9 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     the other ring's face (C-S), the tip arcs vs the guide surfaces they can face (C-S,
     `tip_surface_pairs`), the other APDS's petal corners vs the ring's inside circle
     (point-curve, `corner_pairs`), the guide sides vs the non-partner sides and tip arcs
-    they reach (C-C, `side_edge_pairs`), and the two rings' outside circles (C-C,
+    they reach (C-C, `side_edge_pairs`), the tip arcs vs the other APDS's tip arcs they reach
+    (C-C, `tip_tip_pairs`), the petal corners vs the other APDS's guide surfaces
+    they reach (point-surface, `corner_surface_pairs`), and the two rings' outside circles (C-C,
     cc_Crim_Trim, Body 1 the chaser's)."""
     if which not in PAIR_SETS:
         raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
@@ -64,6 +66,9 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         pairs += corner_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
         pairs += corner_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
         pairs += side_edge_pairs(P, R_MATCHED)
+        pairs += tip_tip_pairs(P, R_MATCHED)
+        pairs += corner_surface_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
+        pairs += corner_surface_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
         pairs.append(PairSpec("cc_Crim_Trim", "CC", CHASER_APDS, P.rim, TARGET_APDS, P.rim))
     return pairs
 
@@ -91,6 +96,44 @@ def corner_pairs(P, one, other) -> list[PairSpec]:
     (x, b_ring), (y, b_corner) = one, other
     return [PairSpec(f"pc_{y}corner{i}_{x}ring", "PC", b_corner, P.corners[i], b_ring, P.ring)
             for i in range(1, 7)]
+
+
+def tip_tip_pairs(P, R) -> list[PairSpec]:
+    """The chaser's tip arcs against the target's tip arcs they can reach, cc_Ctip<j>_Ttip<k>
+    (C-C, Body 1 the chaser's arc): those whose `azimuth_span`s at the matched facing (R:
+    chaser frame to target frame) come within `SIDE_REACH`, a petal tip over a petal tip at
+    a large relative roll (docs/model.md)."""
+    return [PairSpec(f"cc_Ctip{j}_Ttip{k}", "CC", CHASER_APDS, P.tips[j], TARGET_APDS,
+                     P.tips[k]) for j in (1, 2, 3) for k in (1, 2, 3)
+            if spans_within(azimuth_span(P.tips[j], R), azimuth_span(P.tips[k]))]
+
+
+def corner_surface_pairs(P, one, other, R) -> list[PairSpec]:
+    """APDS ``one``'s six petal corners (Body 1, the bare `corner_point`s) against the guide
+    surfaces of APDS ``other`` they can reach, ps_<X>corner<i>_<Y><k> (point-surface, kind
+    "PS"); R turns ``other``'s frame into ``one``'s at the matched facing. A guide side whose
+    petal lies across a non-partner petal at a large relative roll crosses that petal's face,
+    and the crossing starts at the side's corner (docs/model.md); corner i reaches surface k
+    when its azimuth comes within `SIDE_REACH` of the surface's span at its root."""
+    (x, b1), (y, b2) = one, other
+    out = []
+    for i in range(1, 7):
+        c = P.corner_points[i].p
+        for k in (1, 2, 3):
+            if spans_within((math.atan2(c[1], c[0]), 0.0), _root_span(P.surfaces[k], R)):
+                out.append(PairSpec(f"ps_{x}corner{i}_{y}{k}", "PS", b1, P.corner_points[i],
+                                    b2, P.surfaces[k]))
+    return out
+
+
+def _root_span(surface, R):
+    """(mid azimuth, half width) of a guide surface's root (zeta = 0) turned by R."""
+    lo, hi = surface.lower.copy(), surface.upper.copy()
+    hi[1] = lo[1]
+    a, b = (math.atan2(p[1], p[0]) for p in (R @ surface.position(lo),
+                                            R @ surface.position(hi)))
+    half = 0.5 * ((b - a + math.pi) % (2 * math.pi) - math.pi)
+    return a + half, abs(half)
 
 
 def tip_surface_pairs(P, one, other, R) -> list[PairSpec]:
@@ -140,7 +183,9 @@ PAIR_TYPES = (
     (re.compile(r"cs_[CT]tip\d_[CT]\d$"), "tip arc / guide surface"),
     (re.compile(r"pc_[CT]corner\d_[CT]ring$"), "petal corner / ring inside circle"),
     (re.compile(r"cc_[CT]\d_[CT]tip\d$"), "guide side / tip arc"),
-    (re.compile(r"cc_[CT]rim_[CT]rim$"), "ring outside circle / ring outside circle"))
+    (re.compile(r"cc_[CT]rim_[CT]rim$"), "ring outside circle / ring outside circle"),
+    (re.compile(r"ps_[CT]corner\d_[CT]\d$"), "petal corner / guide surface"),
+    (re.compile(r"cc_Ctip\d_Ttip\d$"), "tip arc / tip arc"))
 
 
 def pair_type(name: str) -> str:
@@ -167,8 +212,9 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
     """(edge pair, surface pair, `SurfaceEdge`) of each hand-over among ``pairs``
     (`drake_dock.core.handover`): a ring's inside circle passes between guide surface k
     (cs_<X>ring_<Y>k) and its sides 2k - 1, 2k (cc_<X>ring_<Y><i>) and its tip arc
-    (cc_<X>ring_<Y>tip<k>), `petal_edges`; the chaser's rim between the target's face
-    (cs_Crim_Tface) and the target's rim (cc_Crim_Trim)."""
+    (cc_<X>ring_<Y>tip<k>), `petal_edges`; a chaser tip arc j between target surface k
+    (cs_Ctip<j>_T<k>) and its tip arc (cc_Ctip<j>_Ttip<k>); the chaser's rim between the
+    target's face (cs_Crim_Tface) and the target's rim (cc_Crim_Trim)."""
     names = {p.name for p in pairs}
     out = []
     if {"cc_Crim_Trim", "cs_Crim_Tface"} <= names:
@@ -176,6 +222,12 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
         # theta)): the target's rim, its parameter theta.
         out.append(("cc_Crim_Trim", "cs_Crim_Tface",
                     SurfaceEdge(0, True, lambda th: th, lambda th: th)))
+    for j in (1, 2, 3):
+        for k in (1, 2, 3):
+            # A chaser tip arc over target tip arc k and target guide surface k.
+            if {f"cc_Ctip{j}_Ttip{k}", f"cs_Ctip{j}_T{k}"} <= names:
+                out.append((f"cc_Ctip{j}_Ttip{k}", f"cs_Ctip{j}_T{k}",
+                            petal_edges(g, k)["tip"]))
     for x, y in (("C", "T"), ("T", "C")):
         for k in (1, 2, 3):
             for key, edge in petal_edges(g, k).items():

@@ -46,8 +46,8 @@ def side_candidates(g: ApdsGeometry) -> list[PairSpec]:
 
 
 def tip_candidates(g: ApdsGeometry) -> list[PairSpec]:
-    """Every chaser tip arc against every target tip arc, cc_Ctip<j>_Ttip<k> (C-C): not in
-    `complete` (docs/model.md); the sweep measures which the motion reaches."""
+    """Every chaser tip arc against every target tip arc, cc_Ctip<j>_Ttip<k> (C-C), as
+    `pairs.tip_tip_pairs` names them; the sweep measures which the motion reaches."""
     P = apds_patches(g)
     return [PairSpec(f"cc_Ctip{j}_Ttip{k}", "CC", "chaser_apds", P.tips[j], "target_apds",
                      P.tips[k]) for j in (1, 2, 3) for k in (1, 2, 3)]

@@ -13,13 +13,14 @@ from drake_dock.core import covers
 from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import posed
-from drake_dock.core.seeking import seek_couple
+from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.docking.apds import ApdsGeometry
 from drake_dock.docking.pairs import (CHASER_APDS, R_MATCHED, TARGET_APDS, PairSpec,
                                       apds_pairs)
-from drake_dock.docking.penetration import deepest_penetration
+from drake_dock.docking.path_check import (MissedContact, NoPairCloses,  # noqa: F401
+                                           check_free_approach, check_path_to_contact)
 from drake_dock.docking.rotations import rot_vec, rot_x, rot_z  # noqa: F401 (re-exported)
-from drake_dock.errors import InputError, NumericalError, SeekingError
+from drake_dock.errors import InputError, SeekingError
 
 def relative_pose(yaw_rad: float, d: float):
     """Pose (R, p) of the chaser APDS in the target APDS frame: coaxial, ring faces d apart,
@@ -112,10 +113,6 @@ def first_contact(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13,
     if lam_c is None:
         raise NoPairCloses(f"no pair closes on the approach {approach}")
     return lam_c, list(names)
-
-
-class NoPairCloses(NumericalError):
-    """No pair of the contact set closes on the approach down to a ring-face distance of -H."""
 
 
 def first_contact_or_faces(g: ApdsGeometry, approach: Approach, which="paper"):
@@ -421,8 +418,28 @@ def contact_approach(scenario):
     a = approach(s)
     lam_c, closing = first_contact_or_faces(g, a, which)
     if not closing:
-        _check_free_approach(g, a, which)
+        check_free_approach(g, a, which, travel_grid(g, a)[0])
+    elif which == "complete":
+        check_path_to_contact(g, a, travel_grid(g, a)[0], lam_c,
+                              line=not _isolated(g, a, lam_c, closing))
     return a, lam_c, closing
+
+
+def _isolated(g: ApdsGeometry, approach: Approach, lam: float, names) -> bool:
+    """True when a pair of ``names`` has a usable couple at lam (interior and isolated, the
+    conditioning of its Jacobian, Eq. 40, above 1e-10; `contact_couple`): a point contact
+    that the simulation follows. Coaxial arcs of one radius (a ring's inside circle at a tip
+    arc, a tip arc on a tip arc) touch along an arc and have none."""
+    R, p = approach.pose(lam)
+    poses = {TARGET_APDS: (np.eye(3), np.zeros(3)), CHASER_APDS: (R, p)}
+    for pr in search_pairs(dataclasses.astuple(g), "complete"):
+        if pr.name in names:
+            X1, X2 = poses[pr.body1], poses[pr.body2]
+            c = pair_couples([pr], poses)[0]
+            f = contact_couple(pr.kind, pr.patch1, X1, pr.patch2, X2, c, conditioning_min=1e-10)
+            if f.usable:
+                return True
+    return False
 
 
 def _consistent_height(mismatch, s_max, cells=46):
@@ -447,30 +464,3 @@ def _consistent_height(mismatch, s_max, cells=46):
             return brentq(mismatch, grid[k], grid[k + 1], xtol=1e-10)
         f_above = f_k
     return None
-
-
-# Deeper than this, a feature crossing the other APDS on a free approach is a contact (m).
-FREE_APPROACH_TOL = 1e-4
-
-
-def _check_free_approach(g: ApdsGeometry, approach: Approach, which: str):
-    """Where no pair of the set closes, the chaser may still meet the target's APDS with a
-    feature the set does not model: the independent interpenetration check
-    (`drake_dock.docking.penetration`) follows the straight approach from the search's start
-    down to the ring-face plane, and a crossing deeper than `FREE_APPROACH_TOL` is a
-    `NoPairCloses` naming it. A clear approach (a roll of 0: the petals pass between each
-    other) goes on to the faces. A crossing within the tolerance of a petal's edge grazes it: in
-    the paper's geometry (Rs = R - H cot(alpha1)) a ring's inside circle passes exactly through
-    the petal tips of a coaxial approach."""
-    lam0 = travel_grid(g, approach)[0]
-    (R0, p0), (R1, p1) = approach.pose(lam0), approach.pose(0.0)
-    eye, zero = np.eye(3), np.zeros(3)
-    found = deepest_penetration(g, np.array([0.0, 1.0]), np.array([[eye, R0], [eye, R1]]),
-                                np.array([[zero, p0], [zero, p1]]), ("target", "chaser"),
-                                graze=FREE_APPROACH_TOL)
-    if found.depth > FREE_APPROACH_TOL:
-        height = approach.height(lam0) * (1.0 - found.time)
-        raise NoPairCloses(
-            f"no pair of contact.pairs: {which} closes on the approach {approach}, but there "
-            f"the {found.feature} passes through the {found.solid} (by {found.depth * 1e3:.3g}"
-            f" mm at the ring-face distance {height:.4g} m): a contact the set does not model")

@@ -92,7 +92,7 @@ def check_pairs(plant, pairs, energy_scale):
     if len(set(names)) != len(names):
         raise ValueError(f"pairs: names must be unique, got {names}")
     for p in pairs:
-        want = {"CC": (1, 1), "CS": (1, 2), "PC": (0, 1)}.get(p.kind)
+        want = {"CC": (1, 1), "CS": (1, 2), "PC": (0, 1), "PS": (0, 2)}.get(p.kind)
         if want is None or (p.patch1.dim, p.patch2.dim) != want:
             raise ValueError(f"pairs[{p.name}]: kind {p.kind!r} needs patch dims {want}, "
                              f"got ({p.patch1.dim}, {p.patch2.dim})")

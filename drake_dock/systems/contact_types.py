@@ -2,7 +2,6 @@
 the abstract state, one evaluation, and the layout of each couple's output port."""
 from __future__ import annotations
 
-import copy
 import dataclasses
 import math
 
@@ -32,8 +31,9 @@ PAINLEVE = ("impact", "error")   # `ContactOptions.painleve`
 
 @dataclasses.dataclass
 class ContactPair:
-    """A declared pair: ``patch1`` (a curve, or a `Point` for "PC") on ``frame1``, ``patch2``
-    (a curve for "CC" and "PC", a surface for "CS") on ``frame2``; the couple's normal points
+    """A declared pair: ``patch1`` (a curve, or a `Point` for "PC" and "PS") on ``frame1``,
+    ``patch2`` (a curve for "CC" and "PC", a surface for "CS" and "PS") on ``frame2``; the
+    couple's normal points
     from body 2 to body 1.
     ``sigma`` (+-1) fixes the orientation of n (Definition 2) when the scene knows it (a body
     that starts resting on a plane); by default it is taken when the pair becomes potential,
@@ -112,6 +112,18 @@ class PairState:
         """Enters TRACKED (from contact: the couple separates, or is left out of an impact)."""
         self.mode, self.slide_dir = Mode.TRACKED, None
 
+    def copied(self) -> "PairState":
+        """A copy that an event may change: its arrays are replaced, never written in place,
+        so they are shared (`copy.copy` without its generic protocol)."""
+        new = PairState.__new__(PairState)
+        new.__dict__.update(self.__dict__)
+        return new
+
+
+def copied_states(states) -> list:
+    """`PairState.copied` of each of ``states``."""
+    return [st.copied() for st in states]
+
 
 @dataclasses.dataclass
 class ContactModes:
@@ -127,7 +139,7 @@ class ContactModes:
         replaced, never written in place); the impact log's entries are never changed once
         logged, so the log is copied as a list of the same entries (Drake clones the abstract
         state at every event)."""
-        return ContactModes([copy.copy(st) for st in self.pairs], list(self.impacts),
+        return ContactModes(copied_states(self.pairs), list(self.impacts),
                             self.impact_loss, self.mode_changes)
 
 

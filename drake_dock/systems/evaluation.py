@@ -80,6 +80,7 @@ class PlantEvaluator:
         self.side_pairs = frozenset(i for i, p in enumerate(self.pairs) if p.kind == "PC")
         self.links = HandoverLinks(self.pairs, handovers)
         self.evaluations = 0
+        self._far_index = {}     # `_far_entries`, by the set of pairs not far
         self._zero_v = np.zeros(self.nv)         # never written
         self._world = plant.world_frame()
         self._no_forces = MultibodyForces(plant)  # never written
@@ -128,16 +129,15 @@ class PlantEvaluator:
         evals = [None] * k
         udot = np.zeros(self.nu)
         python = range(k) if self.kernel is None else self.kernel.python
-        if any(modes.pairs[i].mode != Mode.FAR for i in python):
+        near = [i for i in python if modes.pairs[i].mode != Mode.FAR]
+        if near:
             # The couples work in plain floats: the frames' poses and twists converted once.
             fposes = [float_pose(X) for X in poses]
             ftwists = [(float_vec(w), float_vec(v)) for w, v in twists]
-            for i in python:
-                st = modes.pairs[i]
-                if st.mode != Mode.FAR:
-                    sl = self.couple_slice(i)
-                    ev = evals[i] = self.couple(i, u[sl], fposes, ftwists, st.sigma, t)
-                    udot[sl] = ev.udot + fb * ev.drift
+            for i in near:
+                sl = self.couple_slice(i)
+                ev = evals[i] = self.couple(i, u[sl], fposes, ftwists, modes.pairs[i].sigma, t)
+                udot[sl] = ev.udot + fb * ev.drift
         if self.kernel is None:
             return evals, udot
         active = np.array([st.mode != Mode.FAR for st in modes.pairs], dtype=np.bool_)
@@ -164,7 +164,7 @@ class PlantEvaluator:
                              couples=[self.pairs[i].name])
         for i in np.flatnonzero(active).tolist():
             evals[i] = self.kernel.couple_eval(out, i)
-        for i in self.kernel.python:
+        for i in near:
             sl = self.couple_slice(i)
             udot[sl] = python_udot[sl]
         return evals, udot
@@ -245,19 +245,29 @@ class PlantEvaluator:
         Minv = np.linalg.inv(M)
         return M, Minv, Minv @ (tau_el + tau_in - bias), float(tau_el @ v), float(tau_in @ v)
 
+    def _far_entries(self, tracked: tuple):
+        """The indices in x of the far pairs' u* for the pairs ``tracked`` not far, built once
+        per such set (one numpy assignment per evaluation instead of one per far pair)."""
+        hit = self._far_index.get(tracked)
+        if hit is None:
+            if len(self._far_index) > 256:
+                self._far_index.clear()
+            keep = set(tracked)
+            base = self.nq + self.nv
+            hit = self._far_index[tracked] = np.array(
+                [base + k for i in range(len(self.pairs)) if i not in keep
+                 for k in range(self.uoff[i], self.uoff[i + 1])], dtype=np.intp)
+        return hit
+
     def key(self, t, x, modes, inputs) -> tuple:
         """Everything an evaluation depends on: time, the continuous state (the bodies' and the
         tracked couples' u*; a far pair's u* and its far-pair data are not used), the modes of
         the pairs that are not far, and the inputs."""
         x = x[:self.ie].copy()
-        base = self.nq + self.nv
-        sig = []
-        for i, st in enumerate(modes.pairs):
-            if st.mode == Mode.FAR:
-                x[base + self.uoff[i]:base + self.uoff[i + 1]] = 0.0
-            else:
-                sig.append((i, st.mode, st.sigma, None if st.slide_dir is None
-                            else np.asarray(st.slide_dir, dtype=float).tobytes()))
+        sig = [(i, st.mode, st.sigma, None if st.slide_dir is None
+                else np.asarray(st.slide_dir, dtype=float).tobytes())
+               for i, st in enumerate(modes.pairs) if st.mode != Mode.FAR]
+        x[self._far_entries(tuple(s[0] for s in sig))] = 0.0
         generalized, wrenches = inputs
         key = [t, x.tobytes(), tuple(sig)]
         if generalized is not None:

@@ -5,7 +5,6 @@ v_plus, the velocity just after its impulse, and impact_loss_plus, the impact lo
 then (`Transitions.resolve` turns them into the states just before and after it)."""
 from __future__ import annotations
 
-import copy
 import os
 
 import numpy as np
@@ -14,6 +13,7 @@ from drake_dock.core import hybrid
 from drake_dock.core.iwc import impact_without_collision
 from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.errors import NumericalError, PainleveInconsistency, ZenoError
+from drake_dock.systems.contact_types import copied_states
 
 
 def admit(ev, t, modes, couples):
@@ -92,7 +92,7 @@ def states_around(ev, modes, n, x, x_new):
         if j < len(new) - 1:
             x_plus[ev.nq:ev.nq + ev.nv] = imp["v_plus"]
         else:
-            imp.update(pairs_plus=copy.deepcopy(modes.pairs),
+            imp.update(pairs_plus=copied_states(modes.pairs),
                        impact_loss_plus=modes.impact_loss)
         del imp["v_plus"]
         imp.update(x_minus=x.copy() if j == 0 else new[j - 1]["x_plus"], x_plus=x_plus)

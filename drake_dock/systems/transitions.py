@@ -17,6 +17,7 @@ from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import (InputError, PainleveInconsistency, SeekingError,
                                SingularCoupleError)
 from drake_dock.systems import handovers, impacts
+from drake_dock.systems.contact_types import copied_states
 from drake_dock.systems.handovers import applied
 
 
@@ -259,7 +260,7 @@ class Transitions:
                     closed.append(i)       # closed at the end of the impact: in contact
                 else:
                     states[i].track()      # separating
-            modes.impacts[-1]["pairs_plus"] = copy.deepcopy(states)
+            modes.impacts[-1]["pairs_plus"] = copied_states(states)
             poses = evaluate_all(v)
             gap, vn = gaps_and_rates()
         new, cand = hybrid.contact_candidates([st.mode for st in states], gap, vn, bool(hit),

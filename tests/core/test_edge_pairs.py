@@ -169,11 +169,14 @@ def test_complete_set_names_and_patches(geom):
     the other's guide surfaces they can face (32 pairs), its ring's inside circle against
     the other's 6 petal corners, each the top end of its guide side (12 point-curve pairs),
     the guide sides against the non-partner sides and the tip arcs they can reach (36
-    pairs), and the two rims (1 pair, the chaser's Body 1)."""
+    pairs), the chaser's tip arcs against the target's tip arcs they can reach (6 pairs),
+    the petal corners against the other's guide surfaces they can reach (24
+    point-surface pairs, each corner a bare point) and the two rims (1 pair, the chaser's
+    Body 1)."""
     paper, complete = apds_pairs(geom), apds_pairs(geom, "complete")
     assert [p.name for p in complete[:12]] == [p.name for p in paper] and len(paper) == 12
     new = {p.name: p for p in complete[12:]}
-    assert len(new) == len(complete) - 12 == 81
+    assert len(new) == len(complete) - 12 == 111
     P = apds_patches(geom)
     for x, y, bx, by in (("C", "T", "chaser_apds", "target_apds"),
                          ("T", "C", "target_apds", "chaser_apds")):
@@ -193,6 +196,15 @@ def test_complete_set_names_and_patches(geom):
             assert rho == pytest.approx(math.hypot(*corner[:2]) + r, abs=1e-15)
             (a, b), (c, d) = pc.patch1.p[:2], corner[:2]
             assert a * d - b * c == pytest.approx(0.0, abs=1e-15)
+            for k in (1, 2, 3):
+                ps = new.get(f"ps_{y}corner{i}_{x}{k}")
+                if ps is not None:
+                    assert (ps.kind, ps.body1, ps.body2) == ("PS", by, bx)
+                    assert ps.patch1.radius == 0.0
+                    np.testing.assert_allclose(ps.patch1.p, corner, atol=1e-15)
+                    assert ps.patch2 is P.surfaces[k] or np.array_equal(
+                        ps.patch2.position(np.array([0.3, 0.1])),
+                        P.surfaces[k].position(np.array([0.3, 0.1])))
     side = new["cc_Cring_T3"]
     assert side.kind == "CC" and type(side.patch2) is type(P.sides[3])
     for patch, expected in ((side.patch2, P.sides[3]), (side.patch1, P.ring)):
@@ -236,7 +248,7 @@ def test_complete_pairs_compiled_seek_equals_python(g, d):
                              np.array([0.03, -0.02, d]))}
     for pr in apds_pairs(g, "complete")[12:]:
         P1, P2 = posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2])
-        if pr.kind == "PC":         # sought in Python (closed form), not compiled
+        if pr.kind in ("PC", "PS"):     # a point: sought in Python, not compiled
             assert not compiled_seek.supported(P1, P2)
             continue
         assert compiled_seek.supported(P1, P2)
@@ -268,6 +280,26 @@ def test_tip_arcs_face_the_surfaces_their_pairs_name(geom):
     assert names == reach and len(names) == 12
 
 
+def test_corners_reach_the_surfaces_their_pairs_name(geom):
+    """A petal corner has a point-surface pair with a guide surface of the other APDS exactly
+    when, at some relative roll in the scenario's range (-60 to 60 deg), the corner lies over
+    the surface's angular span at its base (sampled rolls)."""
+    from drake_dock.docking.scene import relative_pose
+    P = apds_patches(geom)
+    names = {p.name for p in apds_pairs(geom, "complete") if p.kind == "PS"}
+    reach = set()
+    for yaw in np.radians(np.linspace(-60.0, 60.0, 241)):
+        R = relative_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
+        for x, y, turn in (("C", "T", R), ("T", "C", R.T)):
+            for i in range(1, 7):
+                c = turn @ corner_point(geom, i)
+                for k in (1, 2, 3):
+                    lo = (k - 1) * 2 * math.pi / 3
+                    if (math.atan2(c[1], c[0]) - lo) % (2 * math.pi) <= math.pi / 3:
+                        reach.add(f"ps_{x}corner{i}_{y}{k}")
+    assert names == reach and len(names) == 24
+
+
 def _azimuths(curve, R, n=40):
     """The directions about the axis (rad) of n points along a guide side or tip arc turned by
     R."""
@@ -285,7 +317,8 @@ def test_sides_reach_the_edges_their_pairs_name(geom):
     from drake_dock.docking.scene import relative_pose
     P = apds_patches(geom)
     names = {p.name for p in apds_pairs(geom, "complete")[12:]
-             if p.name.startswith("cc_") and "ring" not in p.name and "rim" not in p.name}
+             if p.name.startswith("cc_") and "ring" not in p.name and "rim" not in p.name
+             and not p.name.startswith("cc_Ctip")}
     margin = math.radians(10.0)
     rolls = np.radians(np.linspace(-60.0, 60.0, 241))
     R = {roll: relative_pose(roll, 0.0)[0] for roll in rolls}    # the chaser's frame
@@ -330,3 +363,96 @@ def test_the_reach_sweep_finds_no_undeclared_side_pair(geom):
                         azimuth_span(pr.patch2, turn[pr.body2]), math.radians(50.0)):
             close.add(k)
     assert len(close) == 24 and close <= reached, sorted(close - reached)
+
+
+def _tip_tip_exact(geom, tips, j, k, R, p):
+    """The closed-form couples of chaser tip arc j (frame (R, p), level: R e3 = -e3) over
+    target tip arc k: both are circles of radius Rs, the target's at z = H about the axis, the
+    chaser's at z = p_z - H about (p_x, p_y); their projections cross at ell e +- h e_perp
+    (ell = |c| / 2, h = sqrt(Rs^2 - ell^2), c = (p_x, p_y)), where the couple lies, the points
+    one above the other, gap p_z - 2H. Returns the interior couples (u, distance)."""
+    c = p[:2]
+    ell = 0.5 * np.linalg.norm(c)
+    e = c / np.linalg.norm(c)
+    h = math.sqrt(geom.Rs ** 2 - ell ** 2)
+    out = []
+    for b in (1.0, -1.0):
+        x = ell * e + b * h * np.array([-e[1], e[0]])
+        th_t = math.atan2(x[1], x[0])
+        q = R.T @ (np.array([x[0], x[1], p[2] - geom.H]) - p)      # in the chaser's frame
+        th_c = math.atan2(q[1], q[0])
+        u = []
+        for th, arc in ((th_c, tips[j]), (th_t, tips[k])):
+            th = arc.lower[0] + (th - arc.lower[0]) % (2 * math.pi)
+            if th >= arc.upper[0]:
+                break
+            u.append(th)
+        if len(u) == 2:
+            out.append((np.array(u), abs(p[2] - 2 * geom.H)))
+    return out
+
+
+def test_tip_tip_pairs_follow_the_closed_form(geom):
+    """Each tip-tip pair (C-C, `tip_tip_pairs`) with the chaser level, rolled and offset so
+    that its tip arc crosses the target's over both arcs (seeded search): the seek (Python and
+    compiled) finds the closed-form couple and distance to 1e-12, the normal is along the
+    axis, and u* integrated by Eq. (47) along a motion (the chaser closing at 0.05 m/s and
+    drifting sideways at 0.02 m/s) equals the closed form to 1e-8."""
+    from drake_dock.docking.scene import relative_pose
+    P = apds_patches(geom)
+    pairs = [p for p in apds_pairs(geom, "complete") if p.name.startswith("cc_Ctip")]
+    assert len(pairs) == 6
+    rng = np.random.default_rng(7)
+    for pr in pairs:
+        j, k = int(pr.name[7]), int(pr.name[-1])
+        while True:
+            roll = math.radians(rng.uniform(-60.0, 60.0))
+            c0 = rng.uniform(-0.1, 0.1, 2)
+            R, _ = relative_pose(roll, 0.0)
+            pose = lambda t: (R, np.array([c0[0] + 0.02 * t, c0[1], 0.43 - 0.05 * t]))
+            if all(len(_tip_tip_exact(geom, P.tips, j, k, *pose(t))) == 1
+                   for t in np.linspace(0.0, 0.5, 6)):
+                break
+        target = (np.eye(3), np.zeros(3))
+        (u0, dist), = _tip_tip_exact(geom, P.tips, j, k, *pose(0.0))
+        P1, P2 = posed(pr.patch1, *pose(0.0)), posed(pr.patch2, *target)
+        for seek in (seek_couple, compiled_seek.seek_couple):
+            c = seek(P1, P2)
+            assert c.interior and c.distance == pytest.approx(dist, abs=1e-12), pr.name
+            np.testing.assert_allclose(c.u, u0, atol=1e-8)
+        twist1 = (np.zeros(3), np.array([0.02, 0.0, -0.05]))
+        still = (np.zeros(3), np.zeros(3))
+        ev = evaluate_couple("CC", pr.patch1, pose(0.0), twist1, pr.patch2, target, still, u0,
+                             1.0)
+        np.testing.assert_allclose(np.abs(ev.n), [0.0, 0.0, 1.0], atol=1e-12)
+        assert abs(ev.gap) == pytest.approx(dist, abs=1e-12)
+        assert ev.vn * np.sign(ev.gap) == pytest.approx(-0.05, abs=1e-12)
+        sol = solve_ivp(lambda t, u: evaluate_couple("CC", pr.patch1, pose(t), twist1,
+                                                     pr.patch2, target, still, u, 1.0,
+                                                     project=False).udot,
+                        (0.0, 0.5), u0, method="DOP853", rtol=1e-12, atol=1e-14,
+                        t_eval=np.linspace(0.0, 0.5, 6))
+        for t, u in zip(sol.t, sol.y.T):
+            (want, _), = _tip_tip_exact(geom, P.tips, j, k, *pose(t))
+            np.testing.assert_allclose(u, want, atol=1e-8)
+
+
+def test_declared_handovers_map_each_edge_onto_its_surface(geom):
+    """Every hand-over of the complete set (`pair_handovers`, 25): the two pairs share Body 1's
+    curve, and along the edge curve (the edge pair's patch 2) the surface point at the mapped
+    parameters (`surface_params`) is the edge's point, 21 samples to 1e-12 m, and maps back."""
+    from drake_dock.core.handover import surface_params
+    from drake_dock.docking.pairs import pair_handovers
+    pairs = {p.name: p for p in apds_pairs(geom, "complete")}
+    found = pair_handovers(geom, list(pairs.values()))
+    assert len(found) == 25
+    for e_name, s_name, edge in found:
+        e, s = pairs[e_name], pairs[s_name]
+        assert (e.kind, s.kind) == ("CC", "CS") and e.patch1 is s.patch1
+        assert (e.body1, e.body2) == (s.body1, s.body2)
+        E, S = e.patch2, s.patch2
+        for t in np.linspace(E.lower[0], E.upper[0], 21):
+            a = surface_params(edge, S.lower, S.upper, t)
+            np.testing.assert_allclose(S.position(np.array(a)), E.position(np.array([t])),
+                                       atol=1e-12)
+            assert edge.to_edge(a[edge.free]) == pytest.approx(t, abs=1e-12)

@@ -28,7 +28,8 @@ from drake_dock.errors import DrakeDockError, SingularCoupleError
 COND_MIN = 1e-6          # the contact system's default conditioning_min
 G = ApdsGeometry()
 PAIRS = apds_pairs(G)
-# Every C-C and C-S pair type of the complete set (the point-curve corners: tests/core/test_point_curve.py).
+# Every C-C, C-S and point-surface pair of the complete set (the point-curve corners:
+# tests/core/test_point_curve.py).
 COMPLETE = [p for p in apds_pairs(G, "complete") if p.kind != "PC"]
 TARGET = (np.eye(3), np.zeros(3))
 
@@ -134,16 +135,18 @@ def _unit(a):
 def near_contact_pose(kind, p1, p2, rng, gap):
     """A pose of body 1 (body 2 at the origin) at which the interior couple u = (u1, u2) drawn
     at random solves the contact form with the gap ``gap``: the points are ``gap`` apart along
-    a normal n of patch 2 (C-S) or of both tangents (C-C), and the curve's tangent is turned
-    into the plane normal to n. Returns (X1, u)."""
+    a normal n of patch 2 (C-S, P-S) or of both tangents (C-C), and the curve's tangent is
+    turned into the plane normal to n (a point, P-S, is turned at random). Returns (X1, u)."""
     u1 = p1.lower + p1.span * rng.uniform(0.05, 0.95, p1.dim)
     u2 = p2.lower + p2.span * rng.uniform(0.05, 0.95, p2.dim)
     T2 = p2.first(u2)
-    if kind == "CS":
+    if kind in ("CS", "PS"):
         n = _unit(np.cross(T2[:, 0], T2[:, 1]))
     else:
         n = _unit(np.cross(T2[:, 0], rng.normal(size=3)))
     R0 = rot_vec(rng.normal(0, 2.0, 3))
+    if kind == "PS":                 # a point: any orientation
+        return (R0, p2.position(u2) + gap * n - R0 @ p1.position(u1)), np.concatenate([u1, u2])
     t = _unit(R0 @ p1.first(u1)[:, 0])
     want = _unit(t - (t @ n) * n)
     axis = np.cross(t, want)

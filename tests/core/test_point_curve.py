@@ -12,7 +12,7 @@ from drake_dock.core.couple import closest_point_conditions, evaluate_couple, po
 from drake_dock.core.patches import Arc, Circle, Point, posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import SingularCoupleError
-from tests.motions import Motion
+from tests.motions import Motion, check_rates_by_finite_differences
 
 R_C = 0.4
 
@@ -95,21 +95,7 @@ def test_rates_and_bias_by_finite_differences(m1, r_pt):
         return evaluate_couple("PC", point, X1, m1.twist(t), ring, RING.pose(t),
                                RING.twist(t), [s], 1.0)
 
-    h = 1e-4
-    for t in (0.2, 0.55, 0.9):
-        e0, ep, em = ev_at(t), ev_at(t + h), ev_at(t - h)
-        fp, fm = ev_at(t + 1e-6), ev_at(t - 1e-6)
-        assert e0.vn == pytest.approx((fp.gap - fm.gap) / 2e-6, abs=1e-8)
-        assert e0.udot[0] == pytest.approx((fp.u[0] - fm.u[0]) / 2e-6, abs=1e-8)
-        gdd = (ep.gap - 2 * e0.gap + em.gap) / h ** 2
-        acc = m1.acceleration(t, e0.p1) - RING.acceleration(t, e0.p2)
-        assert e0.n @ acc + e0.bias_n == pytest.approx(gdd, abs=1e-5)
-        # The tangential velocity components of the material points, differentiated with the
-        # frame moving along the couple.
-        vt_dot = (ep.vt - em.vt) / (2 * h)
-        np.testing.assert_allclose(np.array([e0.ta @ acc, e0.tb @ acc]) + e0.bias_t, vt_dot,
-                                   atol=1e-6)
-        np.testing.assert_allclose(e0.vt, [e0.ta @ e0.v_rel, e0.tb @ e0.v_rel], atol=1e-15)
+    check_rates_by_finite_differences(ev_at, m1, RING)
 
 
 def test_projection_corrects_drift():

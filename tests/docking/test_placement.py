@@ -134,6 +134,78 @@ def test_a_large_roll_that_meets_unmodelled_features_is_a_typed_error():
         initial_state(_scenario(target_yaw_deg=40.0))
 
 
+def test_a_coaxial_tip_on_tip_stub_is_a_typed_error_and_a_tilt_places_it():
+    """Coaxial and level at 40 deg roll (complete set) the tips overlap about the axis and meet
+    at ring distance 2H (closed form: both tip arcs are the circle rho = Rs at zeta = H of their
+    APDS), two coaxial arcs of one radius: the tip-tip pairs close there with no isolated couple,
+    and the path past it crosses a petal: `MissedContact` before any simulation, from a roll of
+    2 theta_end (closed form) on. Tilted by 2 deg the same approach is placed on a point
+    contact, and the independent check finds its path clear."""
+    from drake_dock.docking.penetration import deepest_penetration
+    from drake_dock.docking.scene import (MissedContact, contact_approach, first_contact_or_faces,
+                                          initial_state)
+    s = _scenario(target_yaw_deg=40.0)
+    s.contact.pairs = "complete"
+    g = s.geometry
+    a = Approach(math.radians(40.0))
+    lam_c, names = first_contact_or_faces(g, a, "complete")
+    assert lam_c == pytest.approx(2 * g.H, abs=1e-9) and names and all(
+        n.startswith("cc_Ctip") for n in names)
+    with pytest.raises(MissedContact, match=r"guide side \d passes through the \w+ petal \d "
+                                            r"past its first contact.*line contact"):
+        initial_state(s)
+    # The tips (each 60 deg - 2 theta_end wide, centred between the sides of a gap at the
+    # matched facing) overlap beyond a roll of 2 theta_end = 37.18 deg.
+    edge = math.degrees(2 * g.theta_end)
+    for yaw, stub in ((edge - 0.05, False), (edge + 0.05, True), (-edge - 0.05, True)):
+        s.initial.target_yaw_deg = yaw
+        if stub:
+            with pytest.raises(MissedContact):
+                initial_state(s)
+        else:
+            assert not initial_state(s).closing_pairs[0].startswith("cc_Ctip")
+    s.initial.target_yaw_deg = 40.0
+    s.initial.tilt_deg = [2.0, 0.0]
+    a, lam_c, names = contact_approach(s)
+    eye, zero = np.eye(3), np.zeros(3)
+    (R0, p0), (R1, p1) = a.pose(0.45), a.pose(lam_c)
+    found = deepest_penetration(g, np.array([0.0, 1.0]), np.array([[eye, R0], [eye, R1]]),
+                                np.array([[zero, p0], [zero, p1]]), ("target", "chaser"),
+                                graze=1e-6)
+    assert names and found.depth <= 1e-6
+
+
+@pytest.mark.parametrize("yaw, tilt, offset, pair", [
+    (59.9, [1.0, 1.0], [0.03, 0.0], "cc_Ctip3_Ttip3"),
+    (-59.9, [0.0, 1.0], [0.0, 0.03], "ps_Ccorner6_T1")])
+def test_a_large_roll_with_tilt_is_placed_on_the_new_pairs(yaw, tilt, offset, pair):
+    """Near the roll range's ends, tilted and offset: the first contact is a tip arc on a tip
+    arc, or a chaser corner on a target guide surface, and the independent check finds the
+    straight path down to it clear (within 1 nm)."""
+    from drake_dock.docking.penetration import deepest_penetration
+    from drake_dock.docking.scene import contact_approach
+    s = _scenario(target_yaw_deg=yaw, tilt_deg=tilt, lateral_offset=offset)
+    s.contact.pairs = "complete"
+    a, lam_c, names = contact_approach(s)
+    assert names == [pair]
+    eye, zero = np.eye(3), np.zeros(3)
+    (R0, p0), (R1, p1) = a.pose(0.45), a.pose(lam_c)
+    found = deepest_penetration(s.geometry, np.array([0.0, 1.0]), np.array([[eye, R0], [eye, R1]]),
+                                np.array([[zero, p0], [zero, p1]]), ("target", "chaser"),
+                                graze=1e-6)
+    assert found.depth <= 1e-9
+
+
+def test_a_crossing_before_the_first_contact_is_a_missed_contact():
+    """`check_path_to_contact` asked to verify a first contact 1 cm below the tips' meeting of
+    a coaxial 40 deg approach (ring distance 2H - 1 cm): the petals crossed on the way, so
+    `MissedContact` names the crossing before it."""
+    from drake_dock.docking.path_check import MissedContact, check_path_to_contact
+    g = _scenario().geometry
+    with pytest.raises(MissedContact, match=r"petal \d before its first contact"):
+        check_path_to_contact(g, Approach(math.radians(40.0)), 0.45, 2 * g.H - 0.01)
+
+
 def _idss_sample(k):
     from pathlib import Path
     from drake_dock.campaign.plan import load_plan

@@ -11,11 +11,11 @@ from drake_dock.core.kernels.jets import N_PARAMS, patch_spec
 
 
 class TrackedCouples:
-    """Pairs given as (kind "CC"/"CS"/"PC", patch1, patch2, (frame index 1, frame index 2)).
+    """Pairs given as (kind "CC"/"CS"/"PC"/"PS", patch1, patch2, (frame index 1, frame index 2)).
     `supported` is False when a patch has no kernel description (`patch_spec`; a "PC" pair's
     point is described by its coordinates and radius); the caller then evaluates the couples
-    in Python. ``python`` lists the pairs the caller evaluates in Python even so (none: kept
-    for pair kinds without a kernel)."""
+    in Python. ``python`` lists the pairs the caller evaluates in Python even so: the
+    point-surface ("PS") pairs, which have no kernel."""
 
     def __init__(self, pairs):
         k = len(pairs)
@@ -30,6 +30,12 @@ class TrackedCouples:
         self.pc = np.array([i for i, (kind, *_) in enumerate(pairs) if kind == "PC"],
                            dtype=np.int64)
         for i, (kind, p1, p2, (a, b)) in enumerate(pairs):
+            if kind == "PS":
+                # No kernel: the caller evaluates the couple in Python (its two parameters
+                # keep their place in the layout of u).
+                self.python.append(i)
+                self.dims[i] = 2
+                continue
             if kind == "PC":
                 s2 = patch_spec(p2)
                 if p1.dim != 0 or s2 is None or p2.dim != 1:
