@@ -36,14 +36,18 @@ class Mode(enum.IntEnum):
 
 
 # ---------------------------------------------------------------------------- seeking
-def couple_sigma(kind: str, declared: float | None, gap: float) -> float:
+def couple_sigma(kind: str, declared: float | None, gap: float, radius: float = 0.0) -> float:
     """The orientation sigma of n (Definition 2): the declared one, else the side the patches
     are on. A point-curve couple's n is always along d = p - c(s) (sigma = +1): its gap
-    |d| - r is negative while the sphere overlaps the curve, and d does not change side."""
+    |d| - r is negative while the sphere overlaps the curve, and d does not change side. A
+    point-surface couple's side is its centre's: ``gap`` (taken with sigma = +1) + ``radius``
+    (a sphere of radius r that overlaps the surface from the +N side is on that side)."""
     if kind == "PC":
         return 1.0
     if declared is not None:
         return declared
+    if kind == "PS":
+        gap = gap + radius
     return 1.0 if gap >= 0.0 else -1.0
 
 

@@ -147,8 +147,9 @@ class Circle(Patch):
 
 class Point(Patch):
     """A point ``p`` of its frame (a 0-D patch, u = ()), rounded to a sphere of radius
-    ``radius`` >= 0 (a petal corner, `drake_dock.core.couple`, kind "PC"): its couple with a
-    curve has the gap |p - c(s)| - radius."""
+    ``radius`` >= 0 (a petal corner, `drake_dock.core.couple`, kinds "PC" and "PS"): its
+    couple with a curve has the gap |p - c(s)| - radius, with a surface n . (p - s(u)) -
+    radius."""
 
     dim = 0
     periodic = ()

@@ -26,10 +26,11 @@ CC_SIDE_PAIRS = ((1, 5), (2, 4), (3, 3), (4, 2), (5, 1), (6, 6))
 @dataclasses.dataclass(frozen=True)
 class PairSpec:
     """A potential contact pair. Body 1 carries the curve (Sect. 4.3), or the point of a
-    point-curve pair; the normal of its couple points from Body 2 to Body 1 (Definition 2)."""
+    point-curve or point-surface pair; the normal of its couple points from Body 2 to Body 1
+    (Definition 2)."""
 
     name: str
-    kind: str            # "CC", "CS" or "PC" (a point on Body 1)
+    kind: str            # "CC", "CS", or "PC" / "PS" (a point on Body 1)
     body1: str
     patch1: Patch
     body2: str

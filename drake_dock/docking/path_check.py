@@ -67,8 +67,9 @@ def check_path_to_contact(g: ApdsGeometry, approach, lam0: float, lam_c: float, 
     found = _checked(dataclasses.astuple(g), approach, lam0, end)
     if found.depth > FREE_APPROACH_TOL:
         height = approach.height(lam0 + found.time * (end - lam0))
+        past = line and lam0 + found.time * (end - lam0) < lam_c
         what = ("past its first contact, which has no isolated couple (a line contact of "
-                "coaxial arcs)" if line else "before its first contact")
+                "coaxial arcs)" if past else "before its first contact")
         raise MissedContact(
             f"on the approach {approach} the {found.feature} passes through the "
             f"{found.solid} {what} (contact.pairs: complete, first contact at the ring-face"

@@ -21,6 +21,7 @@ from drake_dock.docking.path_check import (MissedContact, NoPairCloses,  # noqa:
                                            check_free_approach, check_path_to_contact)
 from drake_dock.docking.rotations import rot_vec, rot_x, rot_z  # noqa: F401 (re-exported)
 from drake_dock.errors import InputError, SeekingError
+from drake_dock.systems.contact_types import ContactOptions
 
 def relative_pose(yaw_rad: float, d: float):
     """Pose (R, p) of the chaser APDS in the target APDS frame: coaxial, ring faces d apart,
@@ -426,17 +427,19 @@ def contact_approach(scenario):
 
 
 def _isolated(g: ApdsGeometry, approach: Approach, lam: float, names) -> bool:
-    """True when a pair of ``names`` has a usable couple at lam (interior and isolated, the
-    conditioning of its Jacobian, Eq. 40, above 1e-10; `contact_couple`): a point contact
-    that the simulation follows. Coaxial arcs of one radius (a ring's inside circle at a tip
-    arc, a tip arc on a tip arc) touch along an arc and have none."""
+    """True when a pair of ``names`` has a usable couple at lam (interior and isolated by the
+    contact system's rule, `contact_couple` with the default `ContactOptions.conditioning_min`):
+    a point contact that the simulation follows, and past which the features cross. Coaxial
+    arcs of one radius (a ring's inside circle at a tip arc, a tip arc on a tip arc) touch
+    along an arc and have none."""
     R, p = approach.pose(lam)
     poses = {TARGET_APDS: (np.eye(3), np.zeros(3)), CHASER_APDS: (R, p)}
     for pr in search_pairs(dataclasses.astuple(g), "complete"):
         if pr.name in names:
             X1, X2 = poses[pr.body1], poses[pr.body2]
             c = pair_couples([pr], poses)[0]
-            f = contact_couple(pr.kind, pr.patch1, X1, pr.patch2, X2, c, conditioning_min=1e-10)
+            f = contact_couple(pr.kind, pr.patch1, X1, pr.patch2, X2, c,
+                               conditioning_min=ContactOptions.conditioning_min)
             if f.usable:
                 return True
     return False

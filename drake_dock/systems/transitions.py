@@ -193,7 +193,8 @@ class Transitions:
             raw = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
                                   poses[b], (np.zeros(3),) * 2, uc, 1.0, project=False)
             gap = raw.gap
-            sigma = hybrid.couple_sigma(p.kind, p.sigma, gap)
+            sigma = hybrid.couple_sigma(p.kind, p.sigma, gap,
+                                        p.patch1.radius if p.kind == "PS" else 0.0)
             crossing = hybrid.patches_cross(gap, c.distance, sigma, opt.impact_gap_tol)
         if initial and p.sigma is not None and (
                 (usable and sigma * gap < -opt.impact_gap_tol)

@@ -283,7 +283,8 @@ def test_tip_arcs_face_the_surfaces_their_pairs_name(geom):
 def test_corners_reach_the_surfaces_their_pairs_name(geom):
     """A petal corner has a point-surface pair with a guide surface of the other APDS exactly
     when, at some relative roll in the scenario's range (-60 to 60 deg), the corner lies over
-    the surface's angular span at its base (sampled rolls)."""
+    the surface's angular span at its base (sampled rolls): a second rule beside the code's
+    (the corner's azimuth at the matched facing within 70 deg of the span)."""
     from drake_dock.docking.scene import relative_pose
     P = apds_patches(geom)
     names = {p.name for p in apds_pairs(geom, "complete") if p.kind == "PS"}

@@ -9,6 +9,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from drake_dock.core.couple import closest_point_conditions, evaluate_couple
+from drake_dock.core.hybrid import couple_sigma
 from drake_dock.core.patches import Cone, PlaneRect, Point, posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from tests.motions import Motion, check_rates_by_finite_differences
@@ -135,3 +136,22 @@ def test_point_on_axis_is_not_isolated_and_off_domain_not_interior():
     assert not c.interior and c.u2[1] == pytest.approx(CONE.upper[1], abs=1e-12)
     f = contact_couple("PS", beyond, X, CONE, X, c, conditioning_min=1e-6)
     assert not f.usable and "domain end" in f.reason
+
+
+@pytest.mark.parametrize("height", [0.001, -0.001, 0.005, -0.005])
+def test_an_overlapping_sphere_keeps_its_centres_side(height):
+    """A corner sphere of radius 2 mm whose centre lies ``height`` from a plane: sigma is the
+    side of the centre (sign of height), also while the sphere overlaps the plane (|height| <
+    r), and the gap is |height| - r (closed form), negative for the overlap."""
+    r = 0.002
+    plane, X = PlaneRect((-1.0, -1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), size=(2.0, 2.0)), \
+        (np.eye(3), np.zeros(3))
+    point = Point((0.1, 0.2, height), r)
+    c = seek_couple(posed(point, *X), posed(plane, *X))
+    still = (np.zeros(3),) * 2
+    raw = evaluate_couple("PS", point, X, still, plane, X, still, c.u, 1.0)
+    sigma = couple_sigma("PS", None, raw.gap, r)
+    assert sigma == math.copysign(1.0, height)
+    ev = evaluate_couple("PS", point, X, still, plane, X, still, c.u, sigma)
+    assert ev.gap == pytest.approx(abs(height) - r, abs=1e-15)
+    np.testing.assert_allclose(ev.n, [0.0, 0.0, sigma], atol=1e-15)

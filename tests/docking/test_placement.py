@@ -188,6 +188,12 @@ def test_a_large_roll_with_tilt_is_placed_on_the_new_pairs(yaw, tilt, offset, pa
     s.contact.pairs = "complete"
     a, lam_c, names = contact_approach(s)
     assert names == [pair]
+    # The pair's couple touches there (its seek's distance, from the geometry afresh).
+    from drake_dock.docking.scene import CHASER_APDS, TARGET_APDS, pair_couples
+    spec, = [p for p in apds_pairs(s.geometry, "complete") if p.name == pair]
+    c, = pair_couples([spec], {TARGET_APDS: (np.eye(3), np.zeros(3)),
+                                CHASER_APDS: a.pose(lam_c)})
+    assert c.interior and abs(c.distance) < 1e-9
     eye, zero = np.eye(3), np.zeros(3)
     (R0, p0), (R1, p1) = a.pose(0.45), a.pose(lam_c)
     found = deepest_penetration(s.geometry, np.array([0.0, 1.0]), np.array([[eye, R0], [eye, R1]]),
