@@ -231,6 +231,17 @@ class Annulus(Patch):
                 (((0.0, 0.0, 0.0), r_rt), (r_rt, (-rho * c, -rho * s, 0.0))))
 
 
+class AnnularSector(Annulus):
+    """The part theta_range of an `Annulus` (a petal's tip land): the same u = (rho, theta)
+    and normal +z, theta bounded, not periodic."""
+
+    periodic = (False, False)
+
+    def __init__(self, r_in: float, r_out: float, height: float, theta_range):
+        super().__init__(r_in, r_out, height)
+        self.lower[1], self.upper[1] = min(theta_range), max(theta_range)
+
+
 class Segment(Patch):
     """Straight segment a + u (b - a), u in [0, 1]."""
 

@@ -29,8 +29,8 @@ import math
 import numpy as np
 
 from drake_dock.core.handover import SurfaceEdge
-from drake_dock.core.patches import (Annulus, Arc, Circle, Cone, Point, PolarCurve,
-                                     Reparametrized)
+from drake_dock.core.patches import (Annulus, AnnularSector, Arc, Circle, Cone, Point,
+                                     PolarCurve, Reparametrized)
 from drake_dock.errors import InputError
 
 # The contact sets a docking scene names (`contact.pairs`; `drake_dock.docking.pairs.apds_pairs`):
@@ -272,6 +272,21 @@ def tip_arc(g: ApdsGeometry, k: int) -> Arc:
                (phi0 + g.theta_end, phi0 + math.pi / 3 - g.theta_end))
 
 
+# Half-width of a petal's tip land (`tip_land`): a corner within it of a tip arc rests on the
+# arc's plane (docs/model.md, "Tip on tip").
+TIP_LAND = 1e-3
+
+
+def tip_land(g: ApdsGeometry, k: int) -> AnnularSector:
+    """The land of petal k's tip: the plane zeta = H within `TIP_LAND` of the tip arc
+    (`tip_arc`), over the arc's azimuths; u = (rho, theta), normal +e3 (away from the ring).
+    The thin plate's end face seen from along the axis, where the other APDS's corners land
+    when two tips meet coaxially (docs/model.md, "Tip on tip")."""
+    arc = tip_arc(g, k)
+    return AnnularSector(arc.radius - TIP_LAND, arc.radius + TIP_LAND, g.H,
+                         (float(arc.lower[0]), float(arc.upper[0])))
+
+
 def ring_rim(g: ApdsGeometry) -> Circle:
     """Outside circle of the guide ring, rho = R at zeta = 0."""
     return Circle(g.R, 0.0)
@@ -339,6 +354,7 @@ class ApdsPatches:
     corners: dict = dataclasses.field(default_factory=dict)   # i -> corner at side i's top
     # i -> the bare corner point (radius 0), against the other APDS's guide surfaces
     corner_points: dict = dataclasses.field(default_factory=dict)
+    lands: dict = dataclasses.field(default_factory=dict)     # k -> the land of tip k
 
 
 def apds_patches(g: ApdsGeometry) -> ApdsPatches:
@@ -346,7 +362,8 @@ def apds_patches(g: ApdsGeometry) -> ApdsPatches:
                        {k: guide_surface(g, k) for k in (1, 2, 3)}, ring_circle(g),
                        {k: tip_arc(g, k) for k in (1, 2, 3)}, ring_rim(g), ring_face(g),
                        {i: petal_corner(g, i) for i in range(1, 7)},
-                       {i: Point(corner_point(g, i)) for i in range(1, 7)})
+                       {i: Point(corner_point(g, i)) for i in range(1, 7)},
+                       {k: tip_land(g, k) for k in (1, 2, 3)})
 
 
 # Visual mesh --------------------------------------------------------------------------------

@@ -70,6 +70,8 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         pairs += tip_tip_pairs(P, R_MATCHED)
         pairs += corner_surface_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
         pairs += corner_surface_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
+        pairs += corner_land_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
+        pairs += corner_land_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
         pairs.append(PairSpec("cc_Crim_Trim", "CC", CHASER_APDS, P.rim, TARGET_APDS, P.rim))
     return pairs
 
@@ -124,6 +126,31 @@ def corner_surface_pairs(P, one, other, R) -> list[PairSpec]:
             if spans_within((math.atan2(c[1], c[0]), 0.0), _root_span(P.surfaces[k], R)):
                 out.append(PairSpec(f"ps_{x}corner{i}_{y}{k}", "PS", b1, P.corner_points[i],
                                     b2, P.surfaces[k]))
+    return out
+
+
+# A corner comes over a tip arc of the other APDS at the relative roll equal to their gap about
+# the axis (2 theta_end = 37.18 deg for the nearest tip); the next tip lies exactly 60 deg away,
+# the end of the scenario's roll range (|roll| < 60 deg), which it does not reach.
+LAND_REACH = math.radians(60.0 - 0.5)
+
+
+def corner_land_pairs(P, one, other, R) -> list[PairSpec]:
+    """APDS ``one``'s six bare petal corners (Body 1) against the tip lands of APDS ``other``
+    (`apds.tip_land`) they come over within the scenario's roll range, ps_<X>corner<i>_<Y>tip<k>
+    (point-surface); R turns ``other``'s frame into ``one``'s at the matched facing. Two tips
+    meeting coaxially touch along an arc, a line contact with no isolated couple: it is carried
+    by the two corners at the ends of the overlap, each on the other's tip land (docs/model.md,
+    "Tip on tip")."""
+    (x, b1), (y, b2) = one, other
+    out = []
+    for i in range(1, 7):
+        c = P.corner_points[i].p
+        for k in (1, 2, 3):
+            if spans_within((math.atan2(c[1], c[0]), 0.0), azimuth_span(P.tips[k], R),
+                            LAND_REACH):
+                out.append(PairSpec(f"ps_{x}corner{i}_{y}tip{k}", "PS", b1, P.corner_points[i],
+                                    b2, P.lands[k]))
     return out
 
 
@@ -186,7 +213,8 @@ PAIR_TYPES = (
     (re.compile(r"cc_[CT]\d_[CT]tip\d$"), "guide side / tip arc"),
     (re.compile(r"cc_[CT]rim_[CT]rim$"), "ring outside circle / ring outside circle"),
     (re.compile(r"ps_[CT]corner\d_[CT]\d$"), "petal corner / guide surface"),
-    (re.compile(r"cc_Ctip\d_Ttip\d$"), "tip arc / tip arc"))
+    (re.compile(r"cc_Ctip\d_Ttip\d$"), "tip arc / tip arc"),
+    (re.compile(r"ps_[CT]corner\d_[CT]tip\d$"), "petal corner / tip land"))
 
 
 def pair_type(name: str) -> str:

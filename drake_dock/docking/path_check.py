@@ -60,9 +60,9 @@ def check_path_to_contact(g: ApdsGeometry, approach, lam0: float, lam_c: float, 
     names the feature, the petal and the ring-face distance. With ``line`` (the closing pairs
     have no isolated couple: coaxial arcs of one radius touching along an arc) the path is
     followed `LINE_PROBE` further: a ring's inside circle at the tip arcs of a coaxial
-    approach grazes them and the way on is clear, but tip arcs meeting tip arcs (a coaxial
-    approach at a relative roll at which the tips overlap about the axis) are a line contact
-    that no pair can follow, and the petals would pass through each other (docs/model.md)."""
+    approach grazes them and the way on is clear; a line contact that no pair can follow
+    would let the petals pass through each other (docs/model.md). Tip arcs meeting tip arcs
+    coaxially close on the corner-land pairs, which are isolated."""
     end = lam_c - LINE_PROBE if line else lam_c
     found = _checked(dataclasses.astuple(g), approach, lam0, end)
     if found.depth > FREE_APPROACH_TOL:

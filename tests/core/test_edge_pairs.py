@@ -171,12 +171,13 @@ def test_complete_set_names_and_patches(geom):
     the guide sides against the non-partner sides and the tip arcs they can reach (36
     pairs), the chaser's tip arcs against the target's tip arcs they can reach (6 pairs),
     the petal corners against the other's guide surfaces they can reach (24
-    point-surface pairs, each corner a bare point) and the two rims (1 pair, the chaser's
+    point-surface pairs, each corner a bare point), the petal corners against the other's tip
+    lands they come over (12 point-surface pairs) and the two rims (1 pair, the chaser's
     Body 1)."""
     paper, complete = apds_pairs(geom), apds_pairs(geom, "complete")
     assert [p.name for p in complete[:12]] == [p.name for p in paper] and len(paper) == 12
     new = {p.name: p for p in complete[12:]}
-    assert len(new) == len(complete) - 12 == 111
+    assert len(new) == len(complete) - 12 == 123
     P = apds_patches(geom)
     for x, y, bx, by in (("C", "T", "chaser_apds", "target_apds"),
                          ("T", "C", "target_apds", "chaser_apds")):
@@ -287,7 +288,8 @@ def test_corners_reach_the_surfaces_their_pairs_name(geom):
     (the corner's azimuth at the matched facing within 70 deg of the span)."""
     from drake_dock.docking.scene import relative_pose
     P = apds_patches(geom)
-    names = {p.name for p in apds_pairs(geom, "complete") if p.kind == "PS"}
+    names = {p.name for p in apds_pairs(geom, "complete") if p.kind == "PS"
+             and "tip" not in p.name}
     reach = set()
     for yaw in np.radians(np.linspace(-60.0, 60.0, 241)):
         R = relative_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
@@ -299,6 +301,31 @@ def test_corners_reach_the_surfaces_their_pairs_name(geom):
                     if (math.atan2(c[1], c[0]) - lo) % (2 * math.pi) <= math.pi / 3:
                         reach.add(f"ps_{x}corner{i}_{y}{k}")
     assert names == reach and len(names) == 24
+
+
+def test_corners_come_over_the_tip_lands_their_pairs_name(geom):
+    """A petal corner has a pair with a tip land of the other APDS exactly when, at some
+    relative roll strictly inside the scenario's range (sampled rolls, -59.9 to 59.9 deg), the
+    corner lies over the tip arc's span: a second rule beside the code's (`LAND_REACH`). Each
+    corner comes over one tip, from a roll of 2 theta_end on (closed form)."""
+    from drake_dock.docking.scene import relative_pose
+    P = apds_patches(geom)
+    names = {p.name for p in apds_pairs(geom, "complete") if p.kind == "PS" and "tip" in p.name}
+    reach, first = set(), {}
+    for yaw in np.radians(np.linspace(-59.9, 59.9, 1199)):
+        R = relative_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
+        for x, y, turn in (("C", "T", R), ("T", "C", R.T)):
+            for i in range(1, 7):
+                c = turn @ corner_point(geom, i)
+                for k in (1, 2, 3):
+                    tip = P.tips[k]
+                    if ((math.atan2(c[1], c[0]) - tip.lower[0]) % (2 * math.pi)
+                            <= tip.upper[0] - tip.lower[0]):
+                        name = f"ps_{x}corner{i}_{y}tip{k}"
+                        reach.add(name)
+                        first[name] = min(first.get(name, np.inf), abs(yaw))
+    assert names == reach and len(names) == 12
+    np.testing.assert_allclose(list(first.values()), 2 * geom.theta_end, atol=math.radians(0.1))
 
 
 def _azimuths(curve, R, n=40):

@@ -31,6 +31,7 @@ def test_pair_types_partition_the_complete_set(geom):
     sides = side_edge_pairs(P, R_MATCHED)
     assert got["guide side / guide side"] == 6 + sum("tip" not in p.name for p in sides)
     assert got["guide side / tip arc"] == sum("tip" in p.name for p in sides)
+    assert got["petal corner / tip land"] == 12
     assert sum(got.values()) == len(apds_pairs(geom, "complete"))
     assert all(pair_type(p.name) != p.name for p in apds_pairs(geom, "complete"))
 

@@ -134,37 +134,15 @@ def test_a_large_roll_that_meets_unmodelled_features_is_a_typed_error():
         initial_state(_scenario(target_yaw_deg=40.0))
 
 
-def test_a_coaxial_tip_on_tip_stub_is_a_typed_error_and_a_tilt_places_it():
-    """Coaxial and level at 40 deg roll (complete set) the tips overlap about the axis and meet
-    at ring distance 2H (closed form: both tip arcs are the circle rho = Rs at zeta = H of their
-    APDS), two coaxial arcs of one radius: the tip-tip pairs close there with no isolated couple,
-    and the path past it crosses a petal: `MissedContact` before any simulation, from a roll of
-    2 theta_end (closed form) on. Tilted by 2 deg the same approach is placed on a point
-    contact, and the independent check finds its path clear."""
+def test_a_tilted_tip_on_tip_approach_is_placed_on_a_point_contact():
+    """Coaxial and level at 40 deg roll the tips meet along an arc (tests/docking/
+    test_tip_on_tip.py); tilted by 2 deg the same approach is placed on a point contact, and
+    the independent check finds its path clear."""
     from drake_dock.docking.penetration import deepest_penetration
-    from drake_dock.docking.scene import (MissedContact, contact_approach, first_contact_or_faces,
-                                          initial_state)
+    from drake_dock.docking.scene import contact_approach
     s = _scenario(target_yaw_deg=40.0)
     s.contact.pairs = "complete"
     g = s.geometry
-    a = Approach(math.radians(40.0))
-    lam_c, names = first_contact_or_faces(g, a, "complete")
-    assert lam_c == pytest.approx(2 * g.H, abs=1e-9) and names and all(
-        n.startswith("cc_Ctip") for n in names)
-    with pytest.raises(MissedContact, match=r"guide side \d passes through the \w+ petal \d "
-                                            r"past its first contact.*line contact"):
-        initial_state(s)
-    # The tips (each 60 deg - 2 theta_end wide, centred between the sides of a gap at the
-    # matched facing) overlap beyond a roll of 2 theta_end = 37.18 deg.
-    edge = math.degrees(2 * g.theta_end)
-    for yaw, stub in ((edge - 0.05, False), (edge + 0.05, True), (-edge - 0.05, True)):
-        s.initial.target_yaw_deg = yaw
-        if stub:
-            with pytest.raises(MissedContact):
-                initial_state(s)
-        else:
-            assert not initial_state(s).closing_pairs[0].startswith("cc_Ctip")
-    s.initial.target_yaw_deg = 40.0
     s.initial.tilt_deg = [2.0, 0.0]
     a, lam_c, names = contact_approach(s)
     eye, zero = np.eye(3), np.zeros(3)
@@ -176,12 +154,12 @@ def test_a_coaxial_tip_on_tip_stub_is_a_typed_error_and_a_tilt_places_it():
 
 
 @pytest.mark.parametrize("yaw, tilt, offset, pair", [
-    (59.9, [1.0, 1.0], [0.03, 0.0], "cc_Ctip3_Ttip3"),
+    (59.9, [1.0, 1.0], [0.03, 0.0], "ps_Tcorner6_Ctip3"),
     (-59.9, [0.0, 1.0], [0.0, 0.03], "ps_Ccorner6_T1")])
 def test_a_large_roll_with_tilt_is_placed_on_the_new_pairs(yaw, tilt, offset, pair):
-    """Near the roll range's ends, tilted and offset: the first contact is a tip arc on a tip
-    arc, or a chaser corner on a target guide surface, and the independent check finds the
-    straight path down to it clear (within 1 nm)."""
+    """Near the roll range's ends, tilted and offset: the first contact is a target corner on a
+    chaser tip land, or a chaser corner on a target guide surface, and the independent check
+    finds the straight path down to it clear (within 1 nm)."""
     from drake_dock.docking.penetration import deepest_penetration
     from drake_dock.docking.scene import contact_approach
     s = _scenario(target_yaw_deg=yaw, tilt_deg=tilt, lateral_offset=offset)
