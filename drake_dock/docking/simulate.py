@@ -14,7 +14,6 @@ follow from it (`drake_dock.systems.simulator.tolerances`).
 from __future__ import annotations
 
 import contextlib
-import copy
 import dataclasses
 import time as _time
 
@@ -22,6 +21,7 @@ from pydrake.systems.analysis import Simulator, SimulatorStatus
 
 from drake_dock.core.hybrid import Mode
 from drake_dock.systems.contact_system import COUPLE_OUTPUT_SIZE, ContactModes
+from drake_dock.systems.contact_types import copied_states
 from drake_dock.docking.diagram import DockingDiagram, build_docking_diagram
 from drake_dock.docking.outcome import OutcomeWatch, progress_fraction
 from drake_dock.docking.plant import set_initial_state
@@ -117,7 +117,7 @@ class _Recorder:
         contact = self.dd.contact
         cc = contact.GetMyMutableContextFromRoot(s)
         cc.SetContinuousState(imp["x_plus"])
-        after = ContactModes(copy.deepcopy(imp["pairs_plus"]), [], imp["impact_loss_plus"],
+        after = ContactModes(copied_states(imp["pairs_plus"]), [], imp["impact_loss_plus"],
                              modes.mode_changes)
         cc.get_mutable_abstract_state(contact._mode_index).set_value(after)
         self._append(s, POST_IMPACT)

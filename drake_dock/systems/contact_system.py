@@ -251,8 +251,12 @@ class RigidContactSystem(LeafSystem):
         E = self._cache.Eval(context)
         x = context.get_continuous_state_vector().CopyToVector()
         Y = np.zeros((len(self.pairs), COUPLE_OUTPUT_SIZE))
-        for i, st in enumerate(self.get_modes(context).pairs):
-            self._rows.fill(Y[i], x, E, st, i)
+        states = self.get_modes(context).pairs
+        far = [i for i, c in enumerate(E.evals) if c is None]
+        for i, c in enumerate(E.evals):
+            if c is not None:
+                self._rows.fill(Y[i], x, E, states[i], i)
+        self._rows.fill_far(Y, x, E, states, far)
         return Y
 
     # ------------------------------------------------------------------ witnesses

@@ -29,13 +29,10 @@ def relative_pose(pose1, pose2):
     return R2.T @ R1, R2.T @ (p1 - p2)
 
 
-def travel_bounds(X21, X21_ref, centres, radii):
+def travel_bounds(R21, p21, R0, p0, centres, radii):
     """|delta(X21 c1)| + |delta R21|_2 r1 per pair, for the current and reference relative poses
-    (lists of (R21, p21)) and the bounding spheres (c1, r1) of the pairs' patches 1."""
-    R21 = np.array([R for R, _ in X21])
-    p21 = np.array([p for _, p in X21])
-    R0 = np.array([R for R, _ in X21_ref])
-    p0 = np.array([p for _, p in X21_ref])
+    of frame 1 in frame 2, stacked (R21, R0 (K, 3, 3), p21, p0 (K, 3)), and the bounding
+    spheres (c1, r1) of the pairs' patches 1."""
     lin = np.einsum("kij,kj->ki", R21 - R0, centres) + p21 - p0
     # |R21 - R0|_2 = |R0^T R21 - I|_2 = 2 sin(theta / 2) = sqrt(3 - tr(R0^T R21)).
     rot = np.sqrt(np.maximum(3.0 - np.einsum("kij,kij->k", R0, R21), 0.0))
@@ -52,6 +49,13 @@ class FarPairs:
         self.centres = np.array([c for c, _ in spheres]).reshape(-1, 3)
         self.radii = np.array([r for _, r in spheres])
         self.pairs = pairs
+        # The frame pairs (frame 1, frame 2) and each pair's among them; each pair's reference
+        # pose (`PairState.ref_X21`, a tuple replaced at every seek) stacked, by identity.
+        self.frame_pairs = sorted(set(frame_index))
+        self._fp = np.array([self.frame_pairs.index(ab) for ab in frame_index], dtype=np.intp)
+        self._refs = [None] * len(pairs)
+        self._R0 = np.zeros((len(pairs), 3, 3))
+        self._p0 = np.zeros((len(pairs), 3))
 
     def covers(self, i):
         """The covers (`BROAD_CELLS`) of pair i's two patches, compiled where the patches have
@@ -75,18 +79,25 @@ class FarPairs:
         """Travel bounds of the far pairs ``idx`` (their `PairState`s in ``states``) at
         ``poses``, at once; inf for a pair never sought."""
         out = np.full(len(idx), math.inf)
-        known = [k for k, i in enumerate(idx) if states[i].ref_X21 is not None]
+        known, ids = [], []
+        for k, i in enumerate(idx):
+            ref = states[i].ref_X21
+            if ref is not None:
+                known.append(k)
+                ids.append(i)
+                if self._refs[i] is not ref:
+                    self._refs[i] = ref
+                    self._R0[i], self._p0[i] = ref
         if not known:
             return out
-        ids = [idx[k] for k in known]
-        rel = {}
-        for i in ids:
-            ab = self.frame_index[i]
-            if ab not in rel:
-                rel[ab] = relative_pose(poses[ab[0]], poses[ab[1]])
-        out[known] = travel_bounds([rel[self.frame_index[i]] for i in ids],
-                                   [states[i].ref_X21 for i in ids], self.centres[ids],
-                                   self.radii[ids])
+        fp = self._fp[ids]
+        R21 = np.zeros((len(self.frame_pairs), 3, 3))
+        p21 = np.zeros((len(self.frame_pairs), 3))
+        for m in set(fp.tolist()):
+            a, b = self.frame_pairs[m]
+            R21[m], p21[m] = relative_pose(poses[a], poses[b])
+        out[known] = travel_bounds(R21[fp], p21[fp], self._R0[ids], self._p0[ids],
+                                   self.centres[ids], self.radii[ids])
         return out
 
     def bound(self, i, poses, state):

@@ -17,6 +17,7 @@ class CoupleRows:
         # Far pairs' points in their body frames, by (pair, u*): they change only when the
         # pair is sought again.
         self._points = Memo(2 * len(ev.pairs))
+        self._entries = {}      # `_u_entries`, by the tuple of far pairs
 
     def fill(self, y, x, E, st, i):
         """Fills the zeroed row y of pair i (state x, evaluation E, `PairState` st)."""
@@ -42,6 +43,47 @@ class CoupleRows:
             y[S["p1"]], y[S["p2"]] = c.p1, c.p2
             frame = y[S["frame"]].reshape(3, 3)     # columns ta, tb, n (CoupleEval.frame)
             frame[:, 0], frame[:, 1], frame[:, 2] = c.ta, c.tb, c.n
+
+    def fill_far(self, Y, x, E, states, far):
+        """Fills the zeroed rows Y[far] of the far pairs ``far`` (each one's `PairState` in
+        ``states``) at once: what `fill` writes for each."""
+        ev, S = self.ev, COUPLE_SLICES
+        if not len(far):
+            return
+        base = ev.nq + ev.nv
+        Y[far, S["gap"].start] = [states[i].distance - ev.bound(E, i, states[i]) for i in far]
+        at = self._u_entries(far)
+        Y[at[0], S["u"].start + at[1]] = x[base + at[2]]
+        r1, r2, a, b = [], [], [], []
+        for i in far:
+            u = x[base + ev.uoff[i]:base + ev.uoff[i + 1]]
+            p, q = self._points.get((i, u.tobytes()), lambda: self._far_points(i, u))
+            r1.append(p)
+            r2.append(q)
+            a.append(ev.fidx[i][0])
+            b.append(ev.fidx[i][1])
+        Rf = np.array([R for R, _ in E.poses])
+        pf = np.array([o for _, o in E.poses])
+        for col, r, f in ((S["p1"], r1, a), (S["p2"], r2, b)):
+            Y[far, col] = np.einsum("kij,kj->ki", Rf[f], np.array(r)) + pf[f]
+        Y[far, S["frame"]] = _EYE
+
+    def _u_entries(self, far):
+        """(rows of Y, places in a row's u, places in u*) of the far pairs' u* entries."""
+        key = tuple(far)
+        hit = self._entries.get(key)
+        if hit is None:
+            ev = self.ev
+            rows, cols, xs = [], [], []
+            for i in far:
+                for c, k in enumerate(range(ev.uoff[i], ev.uoff[i + 1])):
+                    rows.append(i)
+                    cols.append(c)
+                    xs.append(k)
+            if len(self._entries) > 256:
+                self._entries.clear()
+            hit = self._entries[key] = tuple(np.array(v, dtype=np.intp) for v in (rows, cols, xs))
+        return hit
 
     def _far_points(self, i, u):
         p = self.ev.pairs[i]
