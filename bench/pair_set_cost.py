@@ -1,8 +1,8 @@
-"""What the point-surface (petal corner / guide surface) and tip-tip pairs of `complete` cost
-where the motion does not reach them: the first conditions of the conditions sweep (seed 2026,
+"""What the pairs of `complete` that only a large relative roll reaches cost where the motion
+does not reach them (petal corner / guide surface, tip arc / tip arc, petal corner / tip land): the first conditions of the conditions sweep (seed 2026,
 inside the IDSS box, rolls within 4 deg), each run twice in this process with the same
-placement, once with the `complete` set and once with those 30 pairs patched out of it
-(`pairs.corner_surface_pairs`, `pairs.tip_tip_pairs`). The far pairs' screenings add events,
+placement, once with the `complete` set and once with those 42 pairs patched out of it
+(`pairs.corner_surface_pairs`, `pairs.tip_tip_pairs`, `pairs.corner_land_pairs`). The far pairs' screenings add events,
 which change the step sequence; in a long jam with many impacts the two runs then part at
 round-off and end differently, so the wall time per derivative evaluation is the measure
 compared. Prints, per run, each version's wall time, evaluations, impacts and end time, the
@@ -23,7 +23,7 @@ from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.docking.simulate import simulate
 from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
 
-LEFT_OUT = ("petal corner / guide surface", "tip arc / tip arc")
+LEFT_OUT = ("petal corner / guide surface", "tip arc / tip arc", "petal corner / tip land")
 
 
 def run(s):
@@ -43,7 +43,8 @@ def main(argv=None):
         s = with_condition(base, cond)
         full, wall_full = run(s)
         with mock.patch.object(pair_sets, "corner_surface_pairs", lambda *a, **k: []), \
-                mock.patch.object(pair_sets, "tip_tip_pairs", lambda *a, **k: []):
+                mock.patch.object(pair_sets, "tip_tip_pairs", lambda *a, **k: []), \
+                mock.patch.object(pair_sets, "corner_land_pairs", lambda *a, **k: []):
             less, wall_less = run(s)
         costs = cost_by_pair_type(full.timing)
         seeks = {t: costs[t]["seeks"] for t in LEFT_OUT if t in costs}
@@ -51,7 +52,7 @@ def main(argv=None):
         ratios.append(per[0] / per[1])
         print(f"{name}: complete ({full.timing['pairs_declared']} pairs) {wall_full:.1f} s, "
               f"{full.evaluations} evaluations, {len(full.impacts)} impacts, end "
-              f"{full.end_time:.3f} s; without the two types ({less.timing['pairs_declared']} "
+              f"{full.end_time:.3f} s; without the three types ({less.timing['pairs_declared']} "
               f"pairs) {wall_less:.1f} s, {less.evaluations}, {len(less.impacts)}, "
               f"{less.end_time:.3f} s; their seeks {seeks}; wall per evaluation "
               f"{per[0] * 1e6:.0f} / {per[1] * 1e6:.0f} us, ratio {ratios[-1]:.2f}", flush=True)
