@@ -1,7 +1,7 @@
 """The working-conditions sweep (`drake-dock study conditions`): seeded random conditions inside
 the International Docking System Standard's initial-contact box, and corners of it, each run to
-its outcome and checked by the independent interpenetration check
-(`drake_dock.docking.penetration`).
+its outcome and checked by the two independent interpenetration checks: the analytic one
+(`drake_dock.docking.penetration`) and the triangle-mesh one (`drake_dock.docking.mesh_check`).
 
 The box (docs/model.md, "Initial conditions"): closing rate 0.05-0.10 m/s; lateral
 misalignment |offset| <= 0.10 m; lateral rate |v| <= 0.04 m/s; pitch and yaw (the tilt's two
@@ -13,8 +13,8 @@ corners off-axis approaches reach); the base scenario gives everything else.
 
 One row per run: the inputs, the outcome (captured, rebound, jammed, timeout, or `error` with
 the typed error's class and message), capture time, impacts, peak contact force, momentum drift,
-the energy ledger's closure, the deepest interpenetration with where and when it was found,
-and the wall time.
+the energy ledger's closure, the deepest interpenetration (the deeper of the two checks', each
+also in a column of its own) with where and when it was found, and the wall time.
 """
 from __future__ import annotations
 
@@ -28,6 +28,7 @@ import time as _time
 
 import numpy as np
 
+from drake_dock.docking.mesh_check import deepest_penetration_mesh
 from drake_dock.docking.output import atomic_directory
 from drake_dock.docking.penetration import deepest_penetration
 from drake_dock.docking.results import summary, timeseries
@@ -107,6 +108,19 @@ def with_condition(scenario, condition: dict):
     return validate(s)
 
 
+def penetrations(g, ts) -> dict:
+    """The row's interpenetration columns from both checks over the timeseries ts: each check's
+    depth, the deeper one's and its description (naming the check)."""
+    args = (g, ts["t"], ts["R_WA"], ts["p_WA"], ts["apds_names"].tolist())
+    found = {"analytic": deepest_penetration(*args), "mesh": deepest_penetration_mesh(*args)}
+    which = max(found, key=lambda k: found[k].depth)        # the analytic one on a tie
+    deep = found[which]
+    return {"penetration_m": deep.depth,
+            "penetration_analytic_m": found["analytic"].depth,
+            "penetration_mesh_m": found["mesh"].depth,
+            "penetration": deep.describe() + (f" ({which} check)" if deep.depth else "")}
+
+
 def run_condition(scenario, name: str, condition: dict) -> dict:
     """One row: the run's outcome and checks, or the typed error that ended it."""
     row = {"name": name, **{k: json.dumps(v) if isinstance(v, list) else v
@@ -121,15 +135,15 @@ def run_condition(scenario, name: str, condition: dict) -> dict:
         row.update(outcome="error", reason=f"{type(e).__name__}: {e}",
                    wall_time_s=_time.perf_counter() - wall0)
         return row
-    wall = _time.perf_counter() - wall0          # the run and its outputs, not the check
-    pen = deepest_penetration(s.geometry, ts["t"], ts["R_WA"], ts["p_WA"], ts["apds_names"].tolist())
+    wall = _time.perf_counter() - wall0          # the run and its outputs, not the checks
+    pen = penetrations(s.geometry, ts)
     row.update(outcome=summ["outcome"], reason=summ["outcome_reason"],
                capture_time_s=summ["capture_time_s"], impacts=summ["number_of_impacts"],
                peak_contact_force_N=summ["peak_contact_force_N"],
                momentum_drift_linear=summ["momentum_drift_relative"]["linear"],
                momentum_drift_angular=summ["momentum_drift_relative"]["angular"],
                energy_closure=summ["energy_ledger"]["closure_error_relative"],
-               penetration_m=pen.depth, penetration=pen.describe(),
+               **pen,
                final_lateral_m=summ["final_misalignment"]["lateral_m"],
                final_tilt_deg=summ["final_misalignment"]["tilt_deg"], wall_time_s=wall)
     return row
@@ -163,9 +177,12 @@ def summary_lines(result) -> list:
     lines = [f"{len(rows)} conditions: " + ", ".join(f"{k} {v}"
                                                      for k, v in sorted(counts(rows).items()))]
     if ran:
+        each = [f"{k} check {max(r[f'penetration_{k}_m'] for r in ran) * 1e3:.3g} mm"
+                for k in ("analytic", "mesh") if all(f"penetration_{k}_m" in r for r in ran)]
         lines.append(f"interpenetration deeper than {PENETRATION_LIMIT * 1e3:g} mm in "
                      f"{len(deep)} of {len(ran)} finished runs; deepest "
-                     f"{max(r['penetration_m'] for r in ran) * 1e3:.3g} mm")
+                     f"{max(r['penetration_m'] for r in ran) * 1e3:.3g} mm"
+                     + (f" ({', '.join(each)})" if each else ""))
         lines.append(f"largest momentum drift {max(r['momentum_drift_linear'] for r in ran):.2e}"
                      f" (linear), {max(r['momentum_drift_angular'] for r in ran):.2e} "
                      f"(angular); largest energy-ledger closure error "
@@ -174,7 +191,7 @@ def summary_lines(result) -> list:
     if walls:
         lines.append(f"median wall time per run {np.median(walls):.3g} s (fastest "
                      f"{min(walls):.3g} s, slowest {max(walls):.3g} s; the run and its "
-                     f"outputs, the interpenetration check excluded)")
+                     f"outputs, the interpenetration checks excluded)")
     errors = {}
     for r in rows:
         if r["outcome"] == "error":
@@ -188,7 +205,8 @@ def summary_lines(result) -> list:
 FIELDS = ("name", "chaser_speed", "lateral_offset", "lateral_velocity", "tilt_deg",
           "target_yaw_deg", "angular_velocity_deg_s", "outcome", "reason", "capture_time_s",
           "impacts", "peak_contact_force_N", "momentum_drift_linear", "momentum_drift_angular",
-          "energy_closure", "penetration_m", "penetration", "final_lateral_m",
+          "energy_closure", "penetration_m", "penetration_analytic_m", "penetration_mesh_m",
+          "penetration", "final_lateral_m",
           "final_tilt_deg", "wall_time_s")
 
 

@@ -96,3 +96,32 @@ def test_every_run_has_the_plans_contact_set(paper_scenario, monkeypatch):
     study.run_conditions(paper_scenario, ConditionsPlan(1, 0, pairs="paper"), log=lambda s: None)
     assert seen == ["complete"] * 3 + ["paper"]
     assert paper_scenario.contact.pairs == "paper"
+
+
+@pytest.mark.parametrize("analytic,mesh,which", [(2e-4, 3e-4, "mesh"), (5e-4, 1e-7, "analytic"),
+                                                 (0.0, 0.0, "")])
+def test_a_row_keeps_both_checks_and_the_deeper_one(monkeypatch, analytic, mesh, which):
+    """The row's penetration_m and its text are the deeper check's (the analytic one on a tie);
+    each check's depth has a column of its own, in the CSV and in the summary."""
+    import drake_dock.studies.conditions as study
+    from drake_dock.docking.penetration import Penetration
+    found = {"analytic": Penetration(analytic, 1.5, "chaser_apds guide side 1",
+                                     "target_apds petal 2"),
+             "mesh": Penetration(mesh, 2.5, "target_apds tip arc 1", "chaser_apds petal 3")}
+    monkeypatch.setattr(study, "deepest_penetration", lambda *a: found["analytic"])
+    monkeypatch.setattr(study, "deepest_penetration_mesh", lambda *a: found["mesh"])
+    ts = {"t": None, "R_WA": None, "p_WA": None, "apds_names": np.array(["a", "b"])}
+    row = study.penetrations(None, ts)
+    assert row["penetration_m"] == max(analytic, mesh)
+    assert (row["penetration_analytic_m"], row["penetration_mesh_m"]) == (analytic, mesh)
+    assert row["penetration"] == (found[which].describe() + f" ({which} check)" if which
+                                  else "no interpenetration")
+    back = next(csv.DictReader(rows_csv([{"name": "random 1", "outcome": "jammed", **row}])
+                               .splitlines()))
+    assert float(back["penetration_mesh_m"]) == mesh
+    line, = [ln for ln in summary_lines({"rows": [{"outcome": "jammed", "momentum_drift_linear": 0,
+                                                    "momentum_drift_angular": 0,
+                                                    "energy_closure": 0, **row}]})
+             if ln.startswith("interpenetration")]
+    assert line.endswith(f"(analytic check {analytic * 1e3:.3g} mm, mesh check "
+                         f"{mesh * 1e3:.3g} mm)")
