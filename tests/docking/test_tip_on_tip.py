@@ -5,13 +5,14 @@ roll beyond which the tips overlap (2 theta_end), the ring distance of the meeti
 corners that close (the overlap's ends), the first impact (two bodies along the axis with
 Newton's restitution: the impulses are axial and equal by symmetry), and the tips never passing
 each other (the ring distance stays >= 2H while the chaser stays coaxial); the independent
-interpenetration check finds nothing."""
+interpenetration checks (analytic and mesh) find nothing."""
 import math
 
 import numpy as np
 import pytest
 
 from drake_dock.docking.apds import tip_arc
+from drake_dock.docking.mesh_check import deepest_penetration_mesh
 from drake_dock.docking.penetration import deepest_penetration
 from drake_dock.docking.results import summary, timeseries
 from drake_dock.docking.scenario import load_scenario
@@ -103,8 +104,9 @@ def test_the_first_impact_is_the_two_body_closed_form():
 @pytest.mark.parametrize("yaw", [-45.0, 59.9])
 def test_a_coaxial_tip_on_tip_run_ends_in_a_named_outcome(yaw):
     """The run ends jammed (the chaser held on the tips, no progress for jam_time): the ring
-    distance never falls below 2H (the tips cannot pass while coaxial; less the witness window), the independent check
-    finds no interpenetration, momentum and the energy ledger close."""
+    distance never falls below 2H (the tips cannot pass while coaxial; less the witness
+    window), neither independent check finds interpenetration, momentum and the energy ledger
+    close."""
     s = _coaxial(yaw, duration=3.0, jam_time=0.5)
     r = simulate(s)
     ts = timeseries(r)
@@ -114,8 +116,8 @@ def test_a_coaxial_tip_on_tip_run_ends_in_a_named_outcome(yaw):
     # times the closing speed.
     window = 1e-2 * s.simulator_config.accuracy * s.initial.chaser_speed
     assert ts["ring_distance"].min() >= 2 * s.geometry.H - window
-    pen = deepest_penetration(s.geometry, ts["t"], ts["R_WA"], ts["p_WA"],
-                              ts["apds_names"].tolist())
-    assert pen.depth == 0.0, pen.describe()
+    for check in (deepest_penetration, deepest_penetration_mesh):
+        pen = check(s.geometry, ts["t"], ts["R_WA"], ts["p_WA"], ts["apds_names"].tolist())
+        assert pen.depth == 0.0, pen.describe()
     assert sm["momentum_drift_relative"]["linear"] < 1e-9
     assert sm["energy_ledger"]["closure_error_relative"] < 1e-6
