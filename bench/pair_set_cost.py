@@ -1,8 +1,10 @@
 """What the pairs of `complete` that only a large relative roll reaches cost where the motion
-does not reach them (petal corner / guide surface, tip arc / tip arc, petal corner / tip land): the first conditions of the conditions sweep (seed 2026,
+does not reach them (petal corner / guide surface, tip arc / tip arc, petal corner / tip
+land): the first conditions of the conditions sweep (seed 2026,
 inside the IDSS box, rolls within 4 deg), each run twice in this process with the same
 placement, once with the `complete` set and once with those 42 pairs patched out of it
-(`pairs.corner_surface_pairs`, `pairs.tip_tip_pairs`, `pairs.corner_land_pairs`). The far pairs' screenings add events,
+(`pairs.corner_surface_pairs`, `pairs.tip_tip_pairs`,
+`pairs.corner_land_pairs`). The far pairs' screenings add events,
 which change the step sequence; in a long jam with many impacts the two runs then part at
 round-off and end differently, so the wall time per derivative evaluation is the measure
 compared. Prints, per run, each version's wall time, evaluations, impacts and end time, the

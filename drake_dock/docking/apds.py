@@ -273,12 +273,13 @@ def tip_arc(g: ApdsGeometry, k: int) -> Arc:
 
 
 # Half-width of a petal's tip land (`tip_land`): a corner within it of a tip arc rests on the
-# arc's plane (docs/model.md, "Tip on tip").
-TIP_LAND = 1e-3
+# arc's plane (docs/model.md, "Tip on tip"). Small: the petals are thin plates, and a corner
+# farther from the arc meets the tip arc at an isolated crossing (the tip-tip pairs).
+TIP_LAND = 1e-5
 
 
 def tip_land(g: ApdsGeometry, k: int) -> AnnularSector:
-    """The land of petal k's tip: the plane zeta = H within `TIP_LAND` of the tip arc
+    """The land of petal k's tip: the plane zeta = H within `TIP_LAND` (10 um) of the tip arc
     (`tip_arc`), over the arc's azimuths; u = (rho, theta), normal +e3 (away from the ring).
     The thin plate's end face seen from along the axis, where the other APDS's corners land
     when two tips meet coaxially (docs/model.md, "Tip on tip")."""

@@ -154,12 +154,12 @@ def test_a_tilted_tip_on_tip_approach_is_placed_on_a_point_contact():
 
 
 @pytest.mark.parametrize("yaw, tilt, offset, pair", [
-    (59.9, [1.0, 1.0], [0.03, 0.0], "ps_Tcorner6_Ctip3"),
+    (59.9, [1.0, 1.0], [0.03, 0.0], "cc_Ctip3_Ttip3"),
     (-59.9, [0.0, 1.0], [0.0, 0.03], "ps_Ccorner6_T1")])
 def test_a_large_roll_with_tilt_is_placed_on_the_new_pairs(yaw, tilt, offset, pair):
-    """Near the roll range's ends, tilted and offset: the first contact is a target corner on a
-    chaser tip land, or a chaser corner on a target guide surface, and the independent check
-    finds the straight path down to it clear (within 1 nm)."""
+    """Near the roll range's ends, tilted and offset: the first contact is a tip arc on a tip
+    arc, or a chaser corner on a target guide surface, and the independent check finds the
+    straight path down to it clear (within 1 nm)."""
     from drake_dock.docking.penetration import deepest_penetration
     from drake_dock.docking.scene import contact_approach
     s = _scenario(target_yaw_deg=yaw, tilt_deg=tilt, lateral_offset=offset)

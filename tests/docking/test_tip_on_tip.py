@@ -56,7 +56,8 @@ def test_the_overlap_ends_close_on_the_tip_lands_at_2H(yaw):
             for k in (1, 2, 3):
                 if _in_span(math.atan2(q[1], q[0]), tip_arc(g, k)):
                     assert q[2] == pytest.approx(g.H, abs=1e-9)
-                    assert math.hypot(q[0], q[1]) == pytest.approx(g.Rs, abs=1e-9)
+                    r_tip = g.R - g.H / math.tan(g.alpha1)          # Eq. (12) at zeta = H
+                    assert math.hypot(q[0], q[1]) == pytest.approx(r_tip, abs=1e-9)
                     expected.add(f"ps_{x}corner{i}_{'T' if x == 'C' else 'C'}tip{k}")
     assert len(expected) == 6 and set(lands) == expected
     specs = [p for p in apds_pairs(g, "complete") if p.name in expected]
