@@ -71,9 +71,12 @@ class FarPairs:
         return compiled_cover.cover_gap(c1.posed(*self.reference(i, poses)), c2)
 
     def reference(self, i, poses):
-        """The relative pose of pair i kept at a seek."""
+        """The relative pose of pair i kept at a seek, read-only: `bounds` keeps it stacked by
+        its identity, so it is replaced at the next seek, never written in place."""
         a, b = self.frame_index[i]
-        return relative_pose(poses[a], poses[b])
+        R, p = relative_pose(poses[a], poses[b])
+        R.flags.writeable = p.flags.writeable = False
+        return R, p
 
     def bounds(self, idx, poses, states):
         """Travel bounds of the far pairs ``idx`` (their `PairState`s in ``states``) at
