@@ -135,23 +135,32 @@ def _chol_solve(A, b):
     return x, det
 
 
+# Eigenvalues of the descent step's Hessian below FLAT max(1, |w|max) are flat directions.
+FLAT = 1e-10
+
+
 def _descent_step(H, g):
-    """-|H|^-1 g with the eigenvalues of H made positive and floored at 1e-10 max(1, |w|max):
-    the Newton step where H is safely positive definite, always a descent direction. A
-    Cholesky solve when the floor cannot bind (lambda_min >= det / tr^(n-1) is above it), the
+    """The descent step -|H|^-1 g with the eigenvalues of H made positive, in two parts (lists):
+    along the directions where |w| >= FLAT max(1, |w|max) (the Newton step where H is safely
+    positive definite), and along the flat ones, where -(v.g) / |w| (|w| floored at 1e-16)
+    is far too long and the caller caps it (`newton_closest`). A Cholesky solve where H is well
+    conditioned (lambda_min >= det / tr^(n-1) is above FLAT max(1, tr)), the
     eigen-decomposition otherwise."""
     n = len(g)
     if n == 1:
-        return [-g[0] / max(abs(H[0][0]), 1e-10 * max(1.0, abs(H[0][0])))]
+        return [-g[0] / max(abs(H[0][0]), FLAT * max(1.0, abs(H[0][0])))], [0.0]
     fact = _chol_solve(H, g)
     if fact is not None:
         x, det = fact
         tr = sum(H[i][i] for i in range(n))
-        if det / tr ** (n - 1) >= 1e-10 * max(1.0, tr):
-            return [-a for a in x]
+        if det / tr ** (n - 1) >= FLAT * max(1.0, tr):
+            return [-a for a in x], [0.0] * n
     w, V = np.linalg.eigh(np.array(H))
-    w = np.maximum(np.abs(w), 1e-10 * max(1.0, np.abs(w).max()))
-    return (-V @ ((V.T @ np.array(g)) / w)).tolist()
+    w = np.abs(w)
+    top = max(1.0, w.max())
+    c = -(V.T @ np.array(g)) / np.maximum(w, 1e-16 * top)
+    flat = w < FLAT * top
+    return (V @ np.where(flat, 0.0, c)).tolist(), (V @ np.where(flat, c, 0.0)).tolist()
 
 
 def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None,
@@ -241,12 +250,21 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None
         if free:
             # Newton step with the Hessian's eigenvalues made positive (|lambda|, floored), so
             # that the step always descends; unchanged near a strict minimum.
-            sf = _descent_step([[H[a][b] for b in free] for a in free], [g[a] for a in free])
-            for a, s in zip(free, sf):
-                step[a] = s
-            # A nearly flat direction (a coaxial circle along a surface of revolution) gives a
-            # huge step that backtracking would shrink by many trials: cap it at a quarter
-            # of the domain instead.
+            sf, flat = _descent_step([[H[a][b] for b in free] for a in free],
+                                     [g[a] for a in free])
+            # Along a flat direction (a circle over a coaxial arc of its radius, a coaxial
+            # circle along a surface of revolution) the step runs to a quarter of the domain,
+            # or to the first domain end on its way: a valley that ends there is followed
+            # to it (clipping one coordinate would leave the valley's floor).
+            reach = max([abs(f) / scale[a] for a, f in zip(free, flat)])
+            cut = 0.25 / reach if reach > 0.25 else 1.0
+            for a, f in zip(free, flat):
+                if f != 0.0 and not periodic[a]:
+                    cut = min(cut, max(((upper[a] if f > 0 else lower[a]) - u[a]) / f, 0.0))
+            for a, s, f in zip(free, sf, flat):
+                step[a] = s + cut * f
+            # A huge Newton step that backtracking would shrink by many trials: capped at a
+            # quarter of the domain instead.
             reach = max(abs(s) / c for s, c in zip(step, scale))
             if reach > 0.25:
                 step = [s * (0.25 / reach) for s in step]

@@ -95,15 +95,19 @@ def feature_points(g, *, n_circle=1440, n_side=80, n_arc=60, n_face=9):
     return out
 
 
+def cone_distance(g, X):
+    """Signed distance s of points X (M, 3) to the cone of Eq. (12), positive away from the
+    axis: the same for the three petals."""
+    return (np.hypot(X[:, 0], X[:, 1]) - g.R) * math.sin(g.alpha1) + X[:, 2] * math.cos(g.alpha1)
+
+
 def petal_coordinates(g, X, k):
     """For points X (M, 3) in the APDS frame and petal k: the signed distance s to the cone
     (positive away from the axis), the foot's fraction across the petal (0 and 1 on its guide
     sides) and the foot's height zeta. The foot is over the plate for 0 <= fraction <= 1 and
     0 <= zeta <= H."""
-    rho = np.hypot(X[:, 0], X[:, 1])
-    sa, ca = math.sin(g.alpha1), math.cos(g.alpha1)
-    s = (rho - g.R) * sa + X[:, 2] * ca
-    zeta_f = X[:, 2] - s * ca
+    s = cone_distance(g, X)
+    zeta_f = X[:, 2] - s * math.cos(g.alpha1)
     inset = _inset(g, np.clip(zeta_f, 0.0, g.H))
     phi = (2 * k - 2) * math.pi / 3
     dth = np.mod(np.arctan2(X[:, 1], X[:, 0]) - phi + math.pi, 2 * math.pi) - math.pi
@@ -206,52 +210,58 @@ def sub_steps(t, R, p, reach, max_travel):
 
 @dataclasses.dataclass
 class _PetalWatch:
-    """One feature against one petal: each point's last s, foot and place on the petal, and
-    whether it has crossed."""
+    """One feature against the three petals of the other APDS: each point's last place X and
+    cone distance s (the same for the three), and which petal it has crossed. The place on a
+    petal (`petal_coordinates`) and the foot are computed only for the points that change side
+    or have crossed."""
 
-    name: str
-    solid: str
-    edges: np.ndarray          # the petal's free edges (`free_edges`)
+    solids: tuple              # the three petals' names
+    edges: dict                # petal k: its free edges (`free_edges`)
     graze: float = 1e-6        # m: a crossing this close to a free edge passes round it
+    X: np.ndarray = None
     s: np.ndarray = None
-    foot: np.ndarray = None
-    frac: np.ndarray = None
-    zeta: np.ndarray = None
-    crossed: np.ndarray = None
+    crossed: np.ndarray = None  # (3, M)
 
-    def step(self, g, X, s, frac, zeta):
-        """Updates with the sub-step's points X and their coordinates; returns the depth of
-        each point."""
-        foot = foot_on_cone(g, X, s)
-        s_now, foot_now = s, foot
+    def _crossings(self, g, k, X, s, flip):
+        """Of the points ``flip`` that changed side, those whose crossing (s = 0, linearly
+        between the sub-steps) lies on petal k, more than `graze` from its free edges."""
+        w = self.s[flip] / (self.s[flip] - s[flip])
+        (_, frac0, zeta0), (_, frac1, zeta1) = (petal_coordinates(g, Y[flip], k)
+                                                for Y in (self.X, X))
+        idx = flip[_over(g, frac0 + w * (frac1 - frac0), zeta0 + w * (zeta1 - zeta0))]
+        if len(idx) and self.graze > 0.0:
+            w = (self.s[idx] / (self.s[idx] - s[idx]))[:, None]
+            foot0 = foot_on_cone(g, self.X[idx], self.s[idx])
+            at = foot0 + w * (foot_on_cone(g, X[idx], s[idx]) - foot0)
+            idx = idx[distance_to_polyline(at, self.edges[k]) > self.graze]
+        return idx
+
+    def step(self, g, X, s):
+        """Updates with the sub-step's points X and their cone distances s (`cone_distance`);
+        yields (petal name, depth of each point) for the petals some point has crossed."""
+        X_now, s_now = X, s
         if self.s is None:
-            self.crossed = np.zeros(len(s), dtype=bool)
+            self.crossed = np.zeros((3, len(s)), dtype=bool)
         else:
             flip = np.flatnonzero(np.sign(s) * np.sign(self.s) < 0)
-            if len(flip):
-                w = (self.s[flip] / (self.s[flip] - s[flip]))[:, None]     # s = 0, linearly
-                mid = [a + w[:, 0] * (b - a) for a, b in ((self.frac[flip], frac[flip]),
-                                                          (self.zeta[flip], zeta[flip]))]
-                idx = flip[_over(g, *mid)]
-                if len(idx) and self.graze > 0.0:
-                    w = (self.s[idx] / (self.s[idx] - s[idx]))[:, None]
-                    at = self.foot[idx] + w * (foot[idx] - self.foot[idx])
-                    idx = idx[distance_to_polyline(at, self.edges) > self.graze]
-                self.crossed[idx] = ~self.crossed[idx]
+            for k in (1, 2, 3) if len(flip) else ():
+                idx = self._crossings(g, k, X, s, flip)
+                self.crossed[k - 1, idx] = ~self.crossed[k - 1, idx]
             # A point exactly on the cone (s = 0) keeps its last side: the crossing is seen
             # at the next sub-step off the cone.
             on = s == 0.0
             if on.any():
-                s, foot, frac, zeta = (np.where(on, a, b) for a, b in (
-                    (self.s, s), (self.foot.T, foot.T), (self.frac, frac), (self.zeta, zeta)))
-                foot = foot.T
-        self.s, self.foot, self.frac, self.zeta = s, foot, frac, zeta
-        depth = np.zeros(len(s))
-        inside = np.flatnonzero(self.crossed & _over(g, frac, zeta))
-        if len(inside):
-            off = distance_to_polyline(foot_now[inside], self.edges)
+                X, s = np.where(on[:, None], self.X, X), np.where(on, self.s, s)
+        self.X, self.s = X, s
+        for k in np.flatnonzero(self.crossed.any(axis=1)) + 1:
+            held = np.flatnonzero(self.crossed[k - 1])
+            _, frac, zeta = petal_coordinates(g, X[held], k)
+            inside = held[_over(g, frac, zeta)]
+            off = distance_to_polyline(foot_on_cone(g, X_now[inside], s_now[inside]),
+                                       self.edges[k])
+            depth = np.zeros(len(s))
             depth[inside] = np.minimum(np.abs(s_now[inside]), off)
-        return depth
+            yield self.solids[k - 1], depth
 
 
 def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=1e-3,
@@ -271,15 +281,16 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
     on_petals = {f: ~annulus_rim(g, X) for f, X in feats.items()}
     for a, b in ((0, 1), (1, 0)):
         R, p = relative_poses(R_WA, p_WA, a, b)
-        watches = {(f, k): _PetalWatch(f"{names[a]} {f}", f"{names[b]} petal {k}", edges[k],
-                                       graze)
-                   for f in feats if f.startswith(PETAL_FEATURES) for k in (1, 2, 3)}
+        watches = {f: _PetalWatch(tuple(f"{names[b]} petal {k}" for k in (1, 2, 3)), edges,
+                                  graze) for f in feats if f.startswith(PETAL_FEATURES)}
         for tt, Rab, pab in sub_steps(t, R, p, reach, max_travel):
             for fname, X in feats.items():
                 Y = X @ Rab.T + pab
-                Yp = Y[on_petals[fname]]
-                found = [(w.solid, w.step(g, Yp, *petal_coordinates(g, Yp, k)))
-                         for (f, k), w in watches.items() if f == fname]
+                found = []
+                if fname in watches:
+                    Yp = Y[on_petals[fname]]
+                    s = cone_distance(g, Yp)
+                    found = list(watches[fname].step(g, Yp, s))
                 if fname.startswith(RING_FEATURES):
                     found.append((f"{names[b]} ring", ring_depth_of(g, Y, ring_depth)))
                 for solid, depth in found:

@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from drake_dock.core.couple import closest_point_conditions, evaluate_couple
+from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.core.tracking import couple_rate
@@ -199,6 +200,38 @@ def test_ring_coaxial_with_guide_surface(h):
             c = seek_couple(posed(pair.patch1, *X1), posed(pair.patch2, *X2))
             want = (G.R - h / math.tan(G.alpha1) - G.Rs) * math.sin(G.alpha1)
             assert c.distance == pytest.approx(want, rel=1e-9)
+
+
+def _circle_to_arc(circle, X1, arc, n=200001):
+    """Least distance of the posed circle X1 = (R, p) (`Circle`: radius, height) to the arc
+    (in the target frame) by the point-to-circle closed form at n points of the arc and its
+    ends."""
+    (R, p), nrm = X1, X1[0][:, 2]
+    centre = p + circle.height * nrm
+    q = arc.position(np.linspace(arc.lower, arc.upper, n).reshape(-1, 1)) - centre
+    axial = q @ nrm
+    radial = np.linalg.norm(q - axial[:, None] * nrm, axis=1) - circle.radius
+    return float(np.sqrt(axial ** 2 + radial ** 2).min())
+
+
+@pytest.mark.parametrize("gap", [0.0196, 1e-3, 1e-5])
+def test_ring_nearly_coaxial_over_tip_arcs(gap):
+    """A ring's inside circle over the other APDS's tip arcs, of the same radius (Rs = R -
+    H cot(alpha1)), coaxial to 0-1e-6 rad: a valley of couples at nearly one distance, whose
+    bottom is at an arc end (a tilt of 2e-10 rad at 19.6 mm made the Newton creep along it,
+    50 iterations short of the end). Both seeks converge to the closed-form distance."""
+    rng = np.random.default_rng(int(gap * 1e6))
+    yaw = math.radians(36.5)
+    for tilt in (0.0, 1e-12, 1e-11, 1e-10, 2e-10, 1e-9, 1e-8, 1e-6):
+        axis = rng.normal(size=3) * [1.0, 1.0, 0.0]
+        R = rot_vec(tilt * axis / np.linalg.norm(axis)) @ rot_z(-yaw) @ R_MATCHED
+        X_chaser = (R, np.array([*rng.normal(0.0, 1e-10, 2), G.H + gap]))
+        for pair in (p for p in COMPLETE if p.name.startswith("cc_Cring_Ttip")):
+            X1, X2 = _scene_poses(pair, X_chaser)
+            want = _circle_to_arc(pair.patch1, X1, pair.patch2)
+            P1, P2 = posed(pair.patch1, *X1), posed(pair.patch2, *X2)
+            for seek in (seek_couple, compiled_seek.seek_couple):
+                assert seek(P1, P2).distance == pytest.approx(want, abs=1e-12)
 
 
 def _plane_normal(curve):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from drake_dock.core.patches import Circle, Cone
-from drake_dock.core.seeking import _descent_step, _local_grids
+from drake_dock.core.seeking import FLAT, _descent_step, _local_grids
 
 
 @pytest.mark.parametrize("patch", [Cone(0.6, math.radians(45), (0.1, 1.0), (0.0, 0.2)),
@@ -29,15 +29,24 @@ def test_local_grids_match_meshgrid(patch):
         np.testing.assert_allclose(g, want, rtol=0, atol=1e-15)
 
 
-def _floored_eigen_step(H, g):
+def _eigen_parts(H, g):
+    """The step -V (V^T g) / |w| with |w| floored at 1e-16 max(1, |w|max), split into its
+    parts along the directions with |w| >= FLAT max(1, |w|max) and along the others."""
     w, V = np.linalg.eigh(H)
-    w = np.maximum(np.abs(w), 1e-10 * max(1.0, np.abs(w).max()))
-    return -V @ ((V.T @ g) / w)
+    w = np.abs(w)
+    top = max(1.0, w.max())
+    c = -(V.T @ g) / np.maximum(w, 1e-16 * top)
+    flat = w < FLAT * top
+    return V @ np.where(flat, 0.0, c), V @ np.where(flat, c, 0.0), flat
 
 
 @pytest.mark.parametrize("n", [1, 2, 3, 4])
 def test_descent_step_is_the_floored_eigen_step(n):
+    """The two parts of `_descent_step` (Cholesky where H is well conditioned) against the
+    eigen-decomposition; the nearly singular Hessians have flat directions (but in 1-D, where
+    the floor is FLAT |H|)."""
     rng = np.random.default_rng(n)
+    flat_seen = 0
     for case in range(30):
         A = rng.normal(size=(n, n))
         if case % 3 == 0:        # positive definite
@@ -48,7 +57,14 @@ def test_descent_step_is_the_floored_eigen_step(n):
             Q, _ = np.linalg.qr(A)
             H = Q @ np.diag(np.logspace(0, -13, n)) @ Q.T
         g = rng.normal(size=n)
-        want = _floored_eigen_step(H, g)
-        got = np.array(_descent_step(H.tolist(), g.tolist()))
-        np.testing.assert_allclose(got, want, rtol=1e-7, atol=1e-12 * np.abs(want).max())
-        assert got @ g < 0.0     # a descent direction
+        newton, flat = (np.array(a) for a in _descent_step(H.tolist(), g.tolist()))
+        if n == 1:
+            want_newton = -g / max(abs(H[0, 0]), FLAT * max(1.0, abs(H[0, 0])))
+            want_flat = np.zeros(1)
+        else:
+            want_newton, want_flat, dirs = _eigen_parts(H, g)
+            flat_seen += dirs.any()
+        for got, want in ((newton, want_newton), (flat, want_flat)):
+            np.testing.assert_allclose(got, want, rtol=1e-7, atol=1e-12 * np.abs(want).max())
+        assert newton @ g < 0.0 and flat @ g <= 0.0    # descent directions
+    assert flat_seen == (10 if n > 1 else 0)

@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from drake_dock.core.kernels.jets import PETAL, jet, patch_spec, petal_point, petal_row, position
-from drake_dock.core.seeking import Couple
+from drake_dock.core.seeking import FLAT, Couple
 from drake_dock.errors import SeekingError
 
 EPS8 = 8 * np.finfo(float).eps
@@ -179,10 +179,11 @@ def hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, p
 
 @njit(cache=True)
 def _descent_step(H, g):
-    """`seeking._descent_step`: -|H|^-1 g, eigenvalues made positive and floored."""
+    """`seeking._descent_step`: -|H|^-1 g, eigenvalues made positive, as (Newton part, flat
+    part)."""
     n = g.shape[0]
     if n == 1:
-        return np.array([-g[0] / max(abs(H[0, 0]), 1e-10 * max(1.0, abs(H[0, 0])))])
+        return np.array([-g[0] / max(abs(H[0, 0]), FLAT * max(1.0, abs(H[0, 0])))]), np.zeros(1)
     L = np.zeros((n, n))
     det = 1.0
     ok = True
@@ -205,7 +206,7 @@ def _descent_step(H, g):
         tr = 0.0
         for i in range(n):
             tr += H[i, i]
-        if det / tr ** (n - 1) >= 1e-10 * max(1.0, tr):
+        if det / tr ** (n - 1) >= FLAT * max(1.0, tr):
             y = np.zeros(n)
             for i in range(n):
                 s = g[i]
@@ -218,11 +219,13 @@ def _descent_step(H, g):
                 for k in range(i + 1, n):
                     s -= L[k, i] * x[k]
                 x[i] = s / L[i, i]
-            return -x
+            return -x, np.zeros(n)
     w, V = np.linalg.eigh(H)
     w = np.abs(w)
-    w = np.maximum(w, 1e-10 * max(1.0, w.max()))
-    return -(V @ ((V.T @ g) / w))
+    top = max(1.0, w.max())
+    c = -(V.T @ g) / np.maximum(w, 1e-16 * top)
+    flat = w < FLAT * top
+    return V @ np.where(flat, 0.0, c), V @ np.where(flat, c, 0.0)
 
 
 @njit(cache=True)
@@ -295,8 +298,15 @@ def newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale, tol
             break
         fi = np.flatnonzero(free)
         if fi.shape[0] > 0:
-            sf = _descent_step(np.ascontiguousarray(H[fi][:, fi]), g[fi])
-            step[fi] = sf
+            sf, flat = _descent_step(np.ascontiguousarray(H[fi][:, fi]), g[fi])
+            reach = np.max(np.abs(flat) / scale[fi])
+            cut = 0.25 / reach if reach > 0.25 else 1.0
+            for m in range(fi.shape[0]):
+                a, f = fi[m], flat[m]
+                if f != 0.0 and not periodic[a]:
+                    room = ((upper[a] if f > 0 else lower[a]) - u[a]) / f
+                    cut = min(cut, max(room, 0.0))
+            step[fi] = sf + cut * flat
             reach = np.max(np.abs(step) / scale)
             if reach > 0.25:
                 step = step * (0.25 / reach)
