@@ -80,10 +80,12 @@ def main(argv=None) -> int:
                        help="override simulation.duration (s)")
     run_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     study_p = sub.add_parser("study", help="run a study")
-    study_p.add_argument("which", choices=["speed-accuracy", "stability", "conditions"],
+    study_p.add_argument("which",
+                         choices=["speed-accuracy", "stability", "conditions", "roll"],
                          help="speed-accuracy: drake_dock against Drake's compliant contact; "
                               "stability: the five cases where methods fail; conditions: "
-                              "seeded conditions in the IDSS initial-contact box")
+                              "seeded conditions in the IDSS initial-contact box; roll: the "
+                              "coaxial approach over the whole relative-roll range")
     study_p.add_argument("scenario", nargs="?", default=None,
                          help="scenario YAML (default: the paper's example; speed-accuracy: "
                               "the paper's example and an off-nominal condition)")
@@ -173,6 +175,11 @@ def _study(args) -> int:
         from drake_dock.studies.conditions import run_conditions as run_plan
         from drake_dock.studies.conditions import summary_lines as lines
         from drake_dock.studies.conditions import write_conditions as write
+    elif args.which == "roll":
+        from drake_dock.studies.roll import RollPlan as Plan
+        from drake_dock.studies.roll import run_rolls as run_plan
+        from drake_dock.studies.roll import summary_lines as lines
+        from drake_dock.studies.roll import write_rolls as write
     elif args.which == "stability":
         from drake_dock.studies.stability import StabilityPlan as Plan
         from drake_dock.studies.stability import run_stability as run_plan

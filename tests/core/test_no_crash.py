@@ -214,24 +214,32 @@ def _circle_to_arc(circle, X1, arc, n=200001):
     return float(np.sqrt(axial ** 2 + radial ** 2).min())
 
 
+TIP_PAIRS = {int(p.name[-1]): p for p in COMPLETE if p.name.startswith("cc_Cring_Ttip")}
+SURFACE_PAIRS = {int(p.name[-1]): p for p in COMPLETE if p.name.startswith("cs_Cring_T")}
+
+
 @pytest.mark.parametrize("gap", [0.0196, 1e-3, 1e-5])
 def test_ring_nearly_coaxial_over_tip_arcs(gap):
     """A ring's inside circle over the other APDS's tip arcs, of the same radius (Rs = R -
     H cot(alpha1)), coaxial to 0-1e-6 rad: a valley of couples at nearly one distance, whose
     bottom is at an arc end (a tilt of 2e-10 rad at 19.6 mm made the Newton creep along it,
-    50 iterations short of the end). Both seeks converge to the closed-form distance."""
+    50 iterations short of the end). Both seeks converge to the closed-form distance, against
+    the tip arc and against the guide surface it bounds (nearest at its tip arc: the cone
+    falls away below it)."""
     rng = np.random.default_rng(int(gap * 1e6))
     yaw = math.radians(36.5)
     for tilt in (0.0, 1e-12, 1e-11, 1e-10, 2e-10, 1e-9, 1e-8, 1e-6):
         axis = rng.normal(size=3) * [1.0, 1.0, 0.0]
         R = rot_vec(tilt * axis / np.linalg.norm(axis)) @ rot_z(-yaw) @ R_MATCHED
         X_chaser = (R, np.array([*rng.normal(0.0, 1e-10, 2), G.H + gap]))
-        for pair in (p for p in COMPLETE if p.name.startswith("cc_Cring_Ttip")):
-            X1, X2 = _scene_poses(pair, X_chaser)
-            want = _circle_to_arc(pair.patch1, X1, pair.patch2)
-            P1, P2 = posed(pair.patch1, *X1), posed(pair.patch2, *X2)
-            for seek in (seek_couple, compiled_seek.seek_couple):
-                assert seek(P1, P2).distance == pytest.approx(want, abs=1e-12)
+        for k in (1, 2, 3):
+            arc = TIP_PAIRS[k].patch2
+            for pair in (TIP_PAIRS[k], SURFACE_PAIRS[k]):
+                X1, X2 = _scene_poses(pair, X_chaser)
+                want = _circle_to_arc(pair.patch1, X1, arc)
+                P1, P2 = posed(pair.patch1, *X1), posed(pair.patch2, *X2)
+                for seek in (seek_couple, compiled_seek.seek_couple):
+                    assert seek(P1, P2).distance == pytest.approx(want, abs=1e-12)
 
 
 def _plane_normal(curve):
