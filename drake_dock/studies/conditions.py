@@ -149,11 +149,12 @@ def run_condition(scenario, name: str, condition: dict) -> dict:
     return row
 
 
-def run_conditions(scenario, plan: ConditionsPlan, log=print) -> dict:
+def run_rows(scenario, plan, todo, log=print) -> dict:
+    """Runs the conditions ``todo`` [(name, condition)] on the scenario with the plan's contact
+    set (``plan.pairs``), logging each outcome: {"plan", "rows"}."""
     scenario = copy.deepcopy(scenario)
     scenario.contact.pairs = plan.pairs
     rows = []
-    todo = conditions(plan)
     for k, (name, cond) in enumerate(todo, 1):
         row = run_condition(scenario, name, cond)
         rows.append(row)
@@ -161,6 +162,10 @@ def run_conditions(scenario, plan: ConditionsPlan, log=print) -> dict:
             + (f", deepest interpenetration {row['penetration_m'] * 1e3:.3g} mm"
                if "penetration_m" in row else f" ({row['reason']})"))
     return {"plan": dataclasses.asdict(plan), "rows": rows}
+
+
+def run_conditions(scenario, plan: ConditionsPlan, log=print) -> dict:
+    return run_rows(scenario, plan, conditions(plan), log)
 
 
 def counts(rows) -> dict:
@@ -174,8 +179,8 @@ def summary_lines(result) -> list:
     rows = result["rows"]
     ran = [r for r in rows if "penetration_m" in r]
     deep = [r for r in ran if r["penetration_m"] > PENETRATION_LIMIT]
-    lines = [f"{len(rows)} conditions: " + ", ".join(f"{k} {v}"
-                                                     for k, v in sorted(counts(rows).items()))]
+    lines = [f"{len(rows)} runs: " + ", ".join(f"{k} {v}"
+                                               for k, v in sorted(counts(rows).items()))]
     if ran:
         each = [f"{k} check {max(r[f'penetration_{k}_m'] for r in ran) * 1e3:.3g} mm"
                 for k in ("analytic", "mesh") if all(f"penetration_{k}_m" in r for r in ran)]
@@ -219,15 +224,18 @@ def rows_csv(rows) -> str:
     return buf.getvalue()
 
 
+# Marker and colour of each outcome in the studies' figures.
+OUTCOME_STYLE = {"captured": ("o", "tab:green"), "rebound": ("s", "tab:blue"),
+                 "jammed": ("D", "tab:orange"), "timeout": ("v", "tab:purple"),
+                 "error": ("x", "tab:red")}
+
+
 def outcome_figure(rows, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    style = {"captured": ("o", "tab:green"), "rebound": ("s", "tab:blue"),
-             "jammed": ("D", "tab:orange"), "timeout": ("v", "tab:purple"),
-             "error": ("x", "tab:red")}
     fig, ax = plt.subplots(figsize=(6.4, 4.6), layout="constrained")
-    for outcome, (marker, color) in style.items():
+    for outcome, (marker, color) in OUTCOME_STYLE.items():
         sel = [r for r in rows if r["outcome"] == outcome]
         if not sel:
             continue
@@ -248,11 +256,17 @@ def outcome_figure(rows, path):
     plt.close(fig)
 
 
-def write_conditions(result, out_dir):
+def write_rows(result, out_dir, stem, figure):
+    """Writes ``stem``.csv (the rows), ``stem``.png (``figure(rows, path)``) and summary.json
+    into out_dir, all at once."""
     rows = result["rows"]
     with atomic_directory(out_dir) as tmp:
-        (tmp / "conditions.csv").write_text(rows_csv(rows))
-        outcome_figure(rows, tmp / "conditions.png")
+        (tmp / f"{stem}.csv").write_text(rows_csv(rows))
+        figure(rows, tmp / f"{stem}.png")
         (tmp / "summary.json").write_text(json.dumps(
             {"plan": result["plan"], "counts": counts(rows), "lines": summary_lines(result)},
             indent=2) + "\n")
+
+
+def write_conditions(result, out_dir):
+    write_rows(result, out_dir, "conditions", outcome_figure)

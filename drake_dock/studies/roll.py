@@ -11,14 +11,12 @@ beyond it (docs/model.md, "Tip on tip"). The grid is symmetric, with the range's
 """
 from __future__ import annotations
 
-import copy
 import dataclasses
-import json
 
 import numpy as np
 
-from drake_dock.docking.output import atomic_directory
-from drake_dock.studies.conditions import counts, rows_csv, run_condition, summary_lines
+from drake_dock.studies.conditions import (OUTCOME_STYLE, run_rows,  # noqa: F401
+                                           summary_lines, write_rows)
 
 
 @dataclasses.dataclass
@@ -46,17 +44,8 @@ def rolls(plan: RollPlan) -> list:
 
 
 def run_rolls(scenario, plan: RollPlan, log=print) -> dict:
-    scenario = copy.deepcopy(scenario)
-    scenario.contact.pairs = plan.pairs
-    rows = []
-    todo = rolls(plan)
-    for k, roll in enumerate(todo, 1):
-        row = run_condition(scenario, f"roll {roll:g}", {"target_yaw_deg": roll})
-        rows.append(row)
-        log(f"[{k}/{len(todo)}] roll {roll:g} deg: {row['outcome']}"
-            + (f", deepest interpenetration {row['penetration_m'] * 1e3:.3g} mm"
-               if "penetration_m" in row else f" ({row['reason']})"))
-    return {"plan": dataclasses.asdict(plan), "rows": rows}
+    return run_rows(scenario, plan,
+                    [(f"roll {r:g}", {"target_yaw_deg": r}) for r in rolls(plan)], log)
 
 
 def roll_figure(rows, path):
@@ -64,11 +53,8 @@ def roll_figure(rows, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    style = {"captured": ("o", "tab:green"), "rebound": ("s", "tab:blue"),
-             "jammed": ("D", "tab:orange"), "timeout": ("v", "tab:purple"),
-             "error": ("x", "tab:red")}
     fig, ax = plt.subplots(figsize=(6.4, 4.0), layout="constrained")
-    for outcome, (marker, color) in style.items():
+    for outcome, (marker, color) in OUTCOME_STYLE.items():
         sel = [r for r in rows if r["outcome"] == outcome]
         if sel:
             y = [r["capture_time_s"] if outcome == "captured" else 0.0 for r in sel]
@@ -83,10 +69,4 @@ def roll_figure(rows, path):
 
 
 def write_rolls(result, out_dir):
-    rows = result["rows"]
-    with atomic_directory(out_dir) as tmp:
-        (tmp / "roll.csv").write_text(rows_csv(rows))
-        roll_figure(rows, tmp / "roll.png")
-        (tmp / "summary.json").write_text(json.dumps(
-            {"plan": result["plan"], "counts": counts(rows), "lines": summary_lines(result)},
-            indent=2) + "\n")
+    write_rows(result, out_dir, "roll", roll_figure)

@@ -206,7 +206,8 @@ def _circle_to_arc(circle, X1, arc, n=200001):
     """Least distance of the posed circle X1 = (R, p) (`Circle`: radius, height) to the arc
     (in the target frame) by the point-to-circle closed form at n points of the arc and its
     ends."""
-    (R, p), nrm = X1, X1[0][:, 2]
+    R, p = X1
+    nrm = R[:, 2]
     centre = p + circle.height * nrm
     q = arc.position(np.linspace(arc.lower, arc.upper, n).reshape(-1, 1)) - centre
     axial = q @ nrm

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from drake_dock.core.patches import Circle, Cone
+from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.seeking import FLAT, _descent_step, _local_grids
 
 
@@ -40,8 +41,17 @@ def _eigen_parts(H, g):
     return V @ np.where(flat, 0.0, c), V @ np.where(flat, c, 0.0), flat
 
 
+def _python_step(H, g):
+    return tuple(np.array(a) for a in _descent_step(H.tolist(), g.tolist()))
+
+
+def _compiled_step(H, g):
+    return compiled_seek._descent_step(np.ascontiguousarray(H), g)
+
+
+@pytest.mark.parametrize("step", [_python_step, _compiled_step], ids=["python", "compiled"])
 @pytest.mark.parametrize("n", [1, 2, 3, 4])
-def test_descent_step_is_the_floored_eigen_step(n):
+def test_descent_step_is_the_floored_eigen_step(n, step):
     """The two parts of `_descent_step` (Cholesky where H is well conditioned) against the
     eigen-decomposition; the nearly singular Hessians have flat directions (but in 1-D, where
     the floor is FLAT |H|)."""
@@ -57,7 +67,7 @@ def test_descent_step_is_the_floored_eigen_step(n):
             Q, _ = np.linalg.qr(A)
             H = Q @ np.diag(np.logspace(0, -13, n)) @ Q.T
         g = rng.normal(size=n)
-        newton, flat = (np.array(a) for a in _descent_step(H.tolist(), g.tolist()))
+        newton, flat = step(H, g)
         if n == 1:
             want_newton = -g / max(abs(H[0, 0]), FLAT * max(1.0, abs(H[0, 0])))
             want_flat = np.zeros(1)
@@ -67,4 +77,6 @@ def test_descent_step_is_the_floored_eigen_step(n):
         for got, want in ((newton, want_newton), (flat, want_flat)):
             np.testing.assert_allclose(got, want, rtol=1e-7, atol=1e-12 * np.abs(want).max())
         assert newton @ g < 0.0 and flat @ g <= 0.0    # descent directions
+        if case % 3 == 0:        # the Newton step itself: H x = -g
+            np.testing.assert_allclose(H @ newton, -g, rtol=1e-9, atol=1e-12)
     assert flat_seen == (10 if n > 1 else 0)
