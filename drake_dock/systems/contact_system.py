@@ -68,7 +68,7 @@ from drake_dock.systems import witnesses
 from drake_dock.systems.contact_types import (COUPLE_FIELDS, COUPLE_OUTPUT_SIZE, COUPLE_SLICES,
                                               ContactModes, ContactOptions, ContactPair,
                                               Evaluation, Handover, PairState)
-from drake_dock.systems.evaluation import PlantEvaluator
+from drake_dock.systems.evaluation import PlantEvaluator, near_pairs
 from drake_dock.systems.memo import Memo
 from drake_dock.systems.outputs import CoupleRows
 from drake_dock.systems.profiling import Timing
@@ -203,15 +203,15 @@ class RigidContactSystem(LeafSystem):
         with self.timing.measure("contact_dynamics"):
             t, modes, inputs = context.get_time(), self.get_modes(context), self._inputs(context)
             x = context.get_continuous_state_vector().CopyToVector()
-            key = self.evaluator.key(t, x, modes, inputs)
+            near = near_pairs(modes)
+            key = self.evaluator.key(t, x, modes, inputs, near)
             value.set_value(self._evaluations.get(
-                key, lambda: self._evaluate(t, x, modes, inputs),
+                key, lambda: self._evaluate(t, x, modes, inputs, near),
                 refresh=lambda E: E if E.modes is modes else E.under(modes)))
 
-    def _evaluate(self, t, x, modes, inputs) -> Evaluation:
-        self.timing.count_tracked([p.name for p, st in zip(self.pairs, modes.pairs)
-                                   if st.mode != Mode.FAR])
-        return self.evaluator.evaluate(t, x, modes, inputs)
+    def _evaluate(self, t, x, modes, inputs, near) -> Evaluation:
+        self.timing.count_tracked([self.pairs[i].name for i in near])
+        return self.evaluator.evaluate(t, x, modes, inputs, near)
 
     def DoCalcTimeDerivatives(self, context, derivatives):
         derivatives.get_mutable_vector().SetFromVector(self._cache.Eval(context).xdot)

@@ -36,6 +36,14 @@ def frame_list(pairs):
     return frames, index
 
 
+def near_pairs(modes) -> tuple:
+    """The indices of the pairs that are not far under ``modes``, ascending: one pass over the
+    pairs per evaluation, which `PlantEvaluator.key`, `PlantEvaluator.evaluate` and the
+    tracked count share."""
+    FAR = Mode.FAR
+    return tuple(i for i, st in enumerate(modes.pairs) if st.mode != FAR)
+
+
 class PlantEvaluator:
     """The contact dynamics of ``pairs`` for a finalized continuous-time ``plant``. The state is
     x = [q, v, u*, energy integrals]; pair i's couple is u*[uoff[i]:uoff[i + 1]]. ``inputs``
@@ -70,6 +78,8 @@ class PlantEvaluator:
             kernel = TrackedCouples([(p.kind, p.patch1, p.patch2, f)
                                      for p, f in zip(self.pairs, self.fidx)])
             self.kernel = kernel if kernel.supported else None
+        # The pairs the kernel leaves to the Python path.
+        self._in_python = frozenset(self.kernel.python) if self.kernel else frozenset()
         # The constraint solve (Eq. 48-52) compiled, or in Python with options.compiled off.
         self.solver = None
         if options.compiled:
@@ -122,14 +132,15 @@ class PlantEvaluator:
                              couples=[p.name])
         return ev
 
-    def couples(self, t, u, poses, twists, modes):
-        """The couples of the pairs that are not far (`CoupleEval` or None per pair) and the
-        couples' rate u*' = Eq. (47) + drift_feedback x projection; `DriftError` as `couple`."""
+    def couples(self, t, u, poses, twists, modes, near):
+        """The couples of the pairs ``near`` that are not far (`CoupleEval` or None per pair)
+        and the couples' rate u*' = Eq. (47) + drift_feedback x projection; `DriftError` as
+        `couple`."""
         k, fb = len(self.pairs), self.options.drift_feedback
         evals = [None] * k
         udot = np.zeros(self.nu)
-        python = range(k) if self.kernel is None else self.kernel.python
-        near = [i for i in python if modes.pairs[i].mode != Mode.FAR]
+        tracked = near
+        near = near if self.kernel is None else [i for i in near if i in self._in_python]
         if near:
             # The couples work in plain floats: the frames' poses and twists converted once.
             fposes = [float_pose(X) for X in poses]
@@ -140,7 +151,8 @@ class PlantEvaluator:
                 udot[sl] = ev.udot + fb * ev.drift
         if self.kernel is None:
             return evals, udot
-        active = np.array([st.mode != Mode.FAR for st in modes.pairs], dtype=np.bool_)
+        active = np.zeros(k, dtype=np.bool_)
+        active[list(tracked)] = True
         active[self.kernel.python] = False
         if not active.any():
             return evals, udot
@@ -259,15 +271,16 @@ class PlantEvaluator:
                  for k in range(self.uoff[i], self.uoff[i + 1])], dtype=np.intp)
         return hit
 
-    def key(self, t, x, modes, inputs) -> tuple:
+    def key(self, t, x, modes, inputs, near=None) -> tuple:
         """Everything an evaluation depends on: time, the continuous state (the bodies' and the
         tracked couples' u*; a far pair's u* and its far-pair data are not used), the modes of
-        the pairs that are not far, and the inputs."""
+        the pairs that are not far (``near``, `near_pairs`), and the inputs."""
+        near = near_pairs(modes) if near is None else near
         x = x[:self.ie].copy()
-        sig = [(i, st.mode, st.sigma, None if st.slide_dir is None
-                else np.asarray(st.slide_dir, dtype=float).tobytes())
-               for i, st in enumerate(modes.pairs) if st.mode != Mode.FAR]
-        x[self._far_entries(tuple(s[0] for s in sig))] = 0.0
+        pairs = modes.pairs
+        sig = [(i, pairs[i].mode, pairs[i].sigma, None if pairs[i].slide_dir is None
+                else np.asarray(pairs[i].slide_dir, dtype=float).tobytes()) for i in near]
+        x[self._far_entries(near)] = 0.0
         generalized, wrenches = inputs
         key = [t, x.tobytes(), tuple(sig)]
         if generalized is not None:
@@ -275,17 +288,19 @@ class PlantEvaluator:
         key += [w.tobytes() for _, w in wrenches]
         return tuple(key)
 
-    def evaluate(self, t, x, modes, inputs) -> Evaluation:
-        """The evaluation at time t, state x, `ContactModes` modes and inputs."""
+    def evaluate(self, t, x, modes, inputs, near=None) -> Evaluation:
+        """The evaluation at time t, state x, `ContactModes` modes and inputs (``near``: the
+        pairs not far, `near_pairs`)."""
         self.evaluations += 1
+        near = near_pairs(modes) if near is None else near
         q, v, u = x[:self.nq], x[self.nq:self.nq + self.nv], x[self.nq + self.nv:self.ie]
         ctx = self.set_scratch(q, v)
         poses, twists = self.frame_kinematics(ctx)
         k = len(self.pairs)
-        evals, udot = self.couples(t, u, poses, twists, modes)
+        evals, udot = self.couples(t, u, poses, twists, modes, near)
         row_pairs, smodes, dirs = [], [], []
-        for i, st in enumerate(modes.pairs):
-            ev = evals[i]
+        for i in near:
+            st, ev = modes.pairs[i], evals[i]
             if st.mode.in_contact:
                 row_pairs.append(i)
                 if st.mode == Mode.STICKING:
