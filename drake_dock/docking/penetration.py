@@ -228,11 +228,11 @@ class _PetalWatch:
         w = self.s[flip] / (self.s[flip] - s[flip])
         (_, frac0, zeta0), (_, frac1, zeta1) = (petal_coordinates(g, Y[flip], k)
                                                 for Y in (self.X, X))
-        idx = flip[_over(g, frac0 + w * (frac1 - frac0), zeta0 + w * (zeta1 - zeta0))]
+        on = _over(g, frac0 + w * (frac1 - frac0), zeta0 + w * (zeta1 - zeta0))
+        idx = flip[on]
         if len(idx) and self.graze > 0.0:
-            w = (self.s[idx] / (self.s[idx] - s[idx]))[:, None]
             foot0 = foot_on_cone(g, self.X[idx], self.s[idx])
-            at = foot0 + w * (foot_on_cone(g, X[idx], s[idx]) - foot0)
+            at = foot0 + w[on][:, None] * (foot_on_cone(g, X[idx], s[idx]) - foot0)
             idx = idx[distance_to_polyline(at, self.edges[k]) > self.graze]
         return idx
 
