@@ -186,7 +186,8 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
             progress(t, t_end, progress_fraction(t, t_end, to_go, watch.d_start,
                                                  sp.capture_distance))
         modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
-        end = watch.update(t, d, any(st.mode.in_contact for st in modes.pairs), to_go)
+        in_contact = any(modes.pairs[i].mode.in_contact for i in modes.index().near)
+        end = watch.update(t, d, in_contact, to_go)
         if end is not None:
             ended.append(end)
             return EventStatus.ReachedTermination(dd.capture, end[0])

@@ -139,7 +139,7 @@ class RigidContactSystem(LeafSystem):
                              "input_work", "impact_loss"] + [n for n, _ in self.extra_powers]
         self.DeclareContinuousState(self.ie + 3 + len(self.extra_powers))
         self._mode_index = self.DeclareAbstractState(AbstractValue.Make(
-            ContactModes([PairState() for _ in pairs])))
+            ContactModes([PairState() for _ in pairs]).seal()))
         self._gf_port = self.DeclareVectorInputPort("generalized_force", self.nv)
         self._wrench_ports = {}
         for b in wrench_bodies:
@@ -261,27 +261,32 @@ class RigidContactSystem(LeafSystem):
 
     # ------------------------------------------------------------------ witnesses
     def DoGetWitnessFunctions(self, context):
-        return [self._w_far if i is None else self._w[i][kind]
-                for i, kind in witnesses.armed(self.get_modes(context).pairs,
-                                               self.evaluator.links.of_edge,
-                                               self.evaluator.side_pairs)]
+        return [self._w_far if i is None else self._w[i][kind] for i, kind in self._armed(context)]
+
+    def _armed(self, context) -> list:
+        """`witnesses.armed` for the context's modes, kept on their index when sealed."""
+        modes = self.get_modes(context)
+        derived = modes.index().derived
+        hit = derived.get("armed")
+        if hit is None:
+            hit = derived["armed"] = witnesses.armed(modes.pairs, self.evaluator.links.of_edge,
+                                                     self.evaluator.side_pairs)
+        return hit
 
     def witness_values(self, context) -> dict:
         """The values of the witnesses `DoGetWitnessFunctions` returns now, by description
         (used by `drake_dock.systems.stepping.WitnessApproach` to predict their zeros)."""
         return {FAR_WITNESS if i is None else f"{self.pairs[i].name} {kind}":
-                self._witness(context, i, kind)
-                for i, kind in witnesses.armed(self.get_modes(context).pairs,
-                                               self.evaluator.links.of_edge,
-                                               self.evaluator.side_pairs)}
+                self._witness(context, i, kind) for i, kind in self._armed(context)}
 
     def witness_rates(self, context) -> dict:
         """Time derivatives of the gap witnesses of the tracked couples, by description:
         g' = v_n (for `drake_dock.systems.stepping.WitnessApproach`)."""
         out = {}
         E = None
-        for i, st in enumerate(self.get_modes(context).pairs):
-            if st.mode == Mode.TRACKED:
+        modes = self.get_modes(context)
+        for i in modes.index().near:
+            if modes.pairs[i].mode == Mode.TRACKED:
                 E = E or self._cache.Eval(context)
                 out[f"{self.pairs[i].name} gap"] = E.evals[i].vn
         return out
@@ -326,9 +331,16 @@ class RigidContactSystem(LeafSystem):
         modes = self.get_modes(context)
         E = self._cache.Eval(context)
         early = self.options.reseek_early
-        if not any(st.mode == Mode.FAR and st.ref_X21 is not None
-                   and self.evaluator.bound(E, i, st) >= early * st.clearance
-                   for i, st in enumerate(modes.pairs)):
+        index = modes.index()
+        far = index.far
+        if not index.sought.any():
+            return EventStatus.DidNothing()
+        if E.modes is modes:        # E's own bounds, all far pairs' at once
+            self.evaluator.bound(E, int(far[0]), modes.pairs[far[0]])
+            bound = E.bound[far]
+        else:
+            bound = self.evaluator.far.bounds(far.tolist(), E.poses, modes.pairs)
+        if not (index.sought & (bound >= early * index.clearance)).any():
             return EventStatus.DidNothing()
         return self._on_event(context, None, state, early=early)
 

@@ -13,8 +13,8 @@ from drake_dock.core.hybrid import Mode
 from drake_dock.errors import InputError
 
 __all__ = ["COUPLE_FIELDS", "COUPLE_OUTPUT_SIZE", "COUPLE_SLICES", "ContactLaw", "ContactModes",
-           "ContactOptions", "ContactPair", "Evaluation", "Handover", "PairState",
-           "SurfaceEdge"]
+           "ContactOptions", "ContactPair", "Evaluation", "Handover", "ModesIndex",
+           "PairState", "SurfaceEdge"]
 
 # Layout of each couple's output port; "status" is the pair's `Mode` (0 far, 1 tracked,
 # 2 sliding, 3 sticking).
@@ -112,11 +112,18 @@ class PairState:
         """Enters TRACKED (from contact: the couple separates, or is left out of an impact)."""
         self.mode, self.slide_dir = Mode.TRACKED, None
 
+    def __setattr__(self, name, value):
+        if self.__dict__.get("_sealed"):
+            raise AttributeError(f"PairState.{name}: the state is sealed (held by a context, "
+                                 "`ContactModes.seal`); change a `ContactModes.working_copy`")
+        object.__setattr__(self, name, value)
+
     def copied(self) -> "PairState":
-        """A copy that an event may change: its arrays are replaced, never written in place,
-        so they are shared (`copy.copy` without its generic protocol)."""
+        """A copy that an event may change, never sealed: its arrays are replaced, never
+        written in place, so they are shared (`copy.copy` without its generic protocol)."""
         new = PairState.__new__(PairState)
         new.__dict__.update(self.__dict__)
+        new.__dict__.pop("_sealed", None)
         return new
 
 
@@ -135,12 +142,65 @@ class ContactModes:
     mode_changes: int = 0
 
     def __deepcopy__(self, memo):
-        """Copies that events may change: the pair states are copied (their arrays are
-        replaced, never written in place); the impact log's entries are never changed once
-        logged, so the log is copied as a list of the same entries (Drake clones the abstract
-        state at every event)."""
-        return ContactModes(copied_states(self.pairs), list(self.impacts),
-                            self.impact_loss, self.mode_changes)
+        """Copies (Drake clones the abstract state at every step and event). Sealed modes are
+        never changed, so their copy shares the pair states and the index, sealed. Otherwise
+        the pair states are copied (their arrays are replaced, never written in place). The
+        impact log's entries are never changed once logged, so the log is copied as a list of
+        the same entries."""
+        index = self.__dict__.get("_index")
+        if index is None:
+            return self.working_copy()
+        new = ContactModes(list(self.pairs), list(self.impacts), self.impact_loss,
+                           self.mode_changes)
+        new.__dict__["_index"] = index
+        return new
+
+    def working_copy(self) -> "ContactModes":
+        """A copy whose pair states an event may change (not sealed)."""
+        return ContactModes(copied_states(self.pairs), list(self.impacts), self.impact_loss,
+                            self.mode_changes)
+
+    def seal(self) -> "ContactModes":
+        """Marks these modes as final: a context holds them, and their pair states are never
+        changed again (a change raises). What the evaluations and witnesses read of them
+        (`index`) is then computed once, not in a pass over every pair at each evaluation."""
+        for st in self.pairs:
+            st.__dict__["_sealed"] = True
+        self.__dict__["_index"] = ModesIndex.of(self.pairs)
+        return self
+
+    def index(self) -> "ModesIndex":
+        """The `ModesIndex` of the pair states: kept when sealed, else computed now."""
+        return self.__dict__.get("_index") or ModesIndex.of(self.pairs)
+
+
+@dataclasses.dataclass(frozen=True)
+class ModesIndex:
+    """What the evaluations and witnesses read of the pairs' states, over the pairs at once:
+    the pairs not far (``near``, ascending) and the far ones (``far``) with their clearances,
+    their distances at the last seek and whether they were ever sought, and every pair's
+    sigma; ``derived`` keeps what
+    the contact system computes from these (the armed witnesses)."""
+
+    near: tuple
+    far: np.ndarray
+    clearance: np.ndarray
+    distance: np.ndarray
+    sought: np.ndarray
+    sigma: np.ndarray          # every pair's sigma
+    derived: dict
+
+    @staticmethod
+    def of(states) -> "ModesIndex":
+        FAR = Mode.FAR
+        far = [i for i, st in enumerate(states) if st.mode == FAR]
+        return ModesIndex(
+            tuple(i for i, st in enumerate(states) if st.mode != FAR),
+            np.array(far, dtype=np.intp),
+            np.array([states[i].clearance for i in far], dtype=float),
+            np.array([states[i].distance for i in far], dtype=float),
+            np.array([states[i].ref_X21 is not None for i in far], dtype=bool),
+            np.array([st.sigma for st in states], dtype=float), {})
 
 
 @dataclasses.dataclass

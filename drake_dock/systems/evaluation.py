@@ -40,8 +40,7 @@ def near_pairs(modes) -> tuple:
     """The indices of the pairs that are not far under ``modes``, ascending: one pass over the
     pairs per evaluation, which `PlantEvaluator.key`, `PlantEvaluator.evaluate` and the
     tracked count share."""
-    FAR = Mode.FAR
-    return tuple(i for i, st in enumerate(modes.pairs) if st.mode != FAR)
+    return modes.index().near
 
 
 class PlantEvaluator:
@@ -157,7 +156,7 @@ class PlantEvaluator:
         if not active.any():
             return evals, udot
         python_udot = udot
-        sigma = np.array([st.sigma for st in modes.pairs], dtype=float)
+        sigma = modes.index().sigma
         out, udot = self.kernel.evaluate(np.array([X[0] for X in poses]),
                                          np.array([X[1] for X in poses]),
                                          np.array([V[0] for V in twists]),
@@ -335,7 +334,6 @@ class PlantEvaluator:
             pairs = E.modes.pairs
             if pairs[i] is not st:      # not E's own state of pair i
                 return self.far.bound(i, E.poses, st)
-            idx = [k for k, sk in enumerate(pairs)
-                   if sk.mode == Mode.FAR and math.isnan(E.bound[k])]
-            E.bound[idx] = self.far.bounds(idx, E.poses, pairs)
+            index = E.modes.index()
+            E.bound[index.far] = self.far.bounds_of(index, pairs, E.poses)
         return E.bound[i]

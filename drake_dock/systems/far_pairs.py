@@ -91,17 +91,35 @@ class FarPairs:
                 if self._refs[i] is not ref:
                     self._refs[i] = ref
                     self._R0[i], self._p0[i] = ref
-        if not known:
-            return out
+        if known:
+            out[known] = self._stacked(np.array(ids, dtype=np.intp), self._R0[ids],
+                                       self._p0[ids], poses)
+        return out
+
+    def bounds_of(self, index, states, poses):
+        """Travel bounds of all far pairs of the `ModesIndex` ``index`` of ``states`` (inf for
+        a pair never sought), their reference poses stacked once per index."""
+        refs = index.derived.get("far_refs")
+        if refs is None:
+            sought = index.far[index.sought]
+            R0, p0 = np.zeros((len(sought), 3, 3)), np.zeros((len(sought), 3))
+            for k, i in enumerate(sought.tolist()):
+                R0[k], p0[k] = states[i].ref_X21
+            refs = index.derived["far_refs"] = (sought, R0, p0)
+        out = np.full(len(index.far), math.inf)
+        if len(refs[0]):
+            out[index.sought] = self._stacked(*refs, poses)
+        return out
+
+    def _stacked(self, ids, R0, p0, poses):
+        """`travel_bounds` of the pairs ``ids`` from their stacked reference poses."""
         fp = self._fp[ids]
         R21 = np.zeros((len(self.frame_pairs), 3, 3))
         p21 = np.zeros((len(self.frame_pairs), 3))
         for m in set(fp.tolist()):
             a, b = self.frame_pairs[m]
             R21[m], p21[m] = relative_pose(poses[a], poses[b])
-        out[known] = travel_bounds(R21[fp], p21[fp], self._R0[ids], self._p0[ids],
-                                   self.centres[ids], self.radii[ids])
-        return out
+        return travel_bounds(R21[fp], p21[fp], R0, p0, self.centres[ids], self.radii[ids])
 
     def bound(self, i, poses, state):
         """The travel bound of one far pair i in ``state``."""

@@ -51,22 +51,37 @@ class CoupleRows:
         if not len(far):
             return
         base = ev.nq + ev.nv
-        Y[far, S["gap"].start] = [states[i].distance - ev.bound(E, i, states[i]) for i in far]
+        if states is E.modes.pairs:                   # E's own bounds, all far ones at once
+            ev.bound(E, far[0], states[far[0]])
+            bound = E.bound[far]
+        else:
+            bound = ev.far.bounds(far, E.poses, states)
+        Y[far, S["gap"].start] = np.array([states[i].distance for i in far]) - bound
         at = self._u_entries(far)
-        Y[at[0], S["u"].start + at[1]] = x[base + at[2]]
-        r1, r2, a, b = [], [], [], []
-        for i in far:
-            u = x[base + ev.uoff[i]:base + ev.uoff[i + 1]]
-            p, q = self._points.get((i, u.tobytes()), lambda: self._far_points(i, u))
-            r1.append(p)
-            r2.append(q)
-            a.append(ev.fidx[i][0])
-            b.append(ev.fidx[i][1])
+        us = x[base + at[2]]
+        Y[at[0], S["u"].start + at[1]] = us
+        r1, r2, a, b = self._far_block(far, at, us)
         Rf = np.array([R for R, _ in E.poses])
         pf = np.array([o for _, o in E.poses])
         for col, r, f in ((S["p1"], r1, a), (S["p2"], r2, b)):
-            Y[far, col] = np.einsum("kij,kj->ki", Rf[f], np.array(r)) + pf[f]
+            Y[far, col] = np.einsum("kij,kj->ki", Rf[f], r) + pf[f]
         Y[far, S["frame"]] = _EYE
+
+    def _far_block(self, far, at, us):
+        """(points on patches 1, on patches 2 in their body frames (K, 3), frames 1, frames 2)
+        of the far pairs ``far`` at their couples' entries ``us``: one memo entry per far set
+        and couples, which change only when a pair is sought again."""
+        def compute():
+            r1, r2 = [], []
+            for i in far:
+                u = us[at[0] == i]
+                p, q = self._far_points(i, u)
+                r1.append(p)
+                r2.append(q)
+            fidx = np.array([self.ev.fidx[i] for i in far], dtype=np.intp).reshape(-1, 2)
+            return np.array(r1), np.array(r2), fidx[:, 0], fidx[:, 1]
+
+        return self._points.get((tuple(far), us.tobytes()), compute)
 
     def _u_entries(self, far):
         """(rows of Y, places in a row's u, places in u*) of the far pairs' u* entries."""

@@ -2,8 +2,6 @@
 `drake_dock.systems.contact_system`), with the decisions made by `drake_dock.core.hybrid`."""
 from __future__ import annotations
 
-import copy
-
 import numpy as np
 
 from drake_dock.core import handover, hybrid
@@ -40,7 +38,7 @@ class Transitions:
         returns (x, modes). ``current()`` gives the evaluation at (t, x, modes). Far pairs are
         sought again when their travel bound reaches ``early`` x their clearance."""
         ev, opt = self.ev, self.options
-        modes = copy.deepcopy(modes)
+        modes = modes.working_copy()
         modes.mode_changes += 1
         q = x[:ev.nq]
         v = x[ev.nq:ev.nq + ev.nv].copy()
@@ -55,12 +53,13 @@ class Transitions:
         #    pairs' order: the couples are evaluated and the hand-overs applied first, then the
         #    pairs are sought, then the carried clearances are set.
         couples, handed = self._handovers(modes.pairs, poses, twists, u)
+        far = [i for i, st in enumerate(modes.pairs) if st.mode == Mode.FAR]
+        travel = dict(zip(far, ev.far.bounds(far, poses, modes.pairs).tolist()))
         sought = []         # (pair, `seek`'s return) of each seek
         for i, st in enumerate(modes.pairs):
             if i in handed or i in handed.values():
                 continue
-            if initial or (st.mode == Mode.FAR
-                           and ev.far.bound(i, poses, st) >= early * st.clearance):
+            if initial or (st.mode == Mode.FAR and travel[i] >= early * st.clearance):
                 if not self.screen(i, poses, modes.pairs):
                     sought.append((i, self.seek(i, poses, modes.pairs, u, t, False, initial)))
                 continue
@@ -85,7 +84,7 @@ class Transitions:
         x_new[ev.nq:ev.nq + ev.nv] = v
         x_new[ev.nq + ev.nv:ev.ie] = u
         impacts.states_around(ev, modes, n_impacts, x, x_new)
-        return x_new, modes
+        return x_new, modes.seal()
 
     def _handovers(self, states, poses, twists, u) -> tuple[dict, dict]:
         """The couples of the pairs that are not far (written into u) and their hand-overs

@@ -103,15 +103,15 @@ def _cone(ev, E, st, i):
 def _clear(ev, E, st, i):
     """All far pairs' witness: the smallest clearance left, min (clearance - travel bound) (1
     if no pair is far); its event seeks again every far pair whose clearance is used up."""
-    pairs = E.modes.pairs
-    far = [k for k, sk in enumerate(pairs) if sk.mode == Mode.FAR]
-    if not far:
+    pairs, index = E.modes.pairs, E.modes.index()
+    far = index.far
+    if not len(far):
         return 1.0
     unknown = np.flatnonzero(np.isnan(E.bound[far]))
     if len(unknown):                        # fills every far pair's unknown bound at once
-        k = far[int(unknown[0])]
+        k = int(far[unknown[0]])
         ev.bound(E, k, pairs[k])
-    w = float(np.min(np.array([pairs[k].clearance for k in far]) - E.bound[far]))
+    w = float(np.min(index.clearance - E.bound[far]))
     return 1.0 if w == math.inf else w
 
 

@@ -3,7 +3,6 @@ frictionless off a plane's end onto the edge there (`disk_on_incline` with ``edg
 over the edge like a particle on a cylinder of radius r and leaves it at the closed-form angle
 cos(theta_c) = (2 + v0^2 / (g r)) / 3; the run between and after is checked against that closed
 form and energy conservation."""
-import copy
 import math
 
 import numpy as np
@@ -95,7 +94,7 @@ def _handover_event(edge_first):
     x = ctx.get_continuous_state_vector().CopyToVector()
     x[4] += 3e-3                                    # the disk's centre (q = [quaternion, p])
     ctx.get_mutable_continuous_state_vector().SetFromVector(x)
-    modes = copy.deepcopy(system.get_modes(ctx))
+    modes = system.get_modes(ctx).working_copy()
     names = [p.name for p in system.pairs]
     modes.pairs[names.index("rim_edge")].clearance = 0.0
     system.timing.reset()

@@ -1,0 +1,24 @@
+"""Sealed contact modes (`ContactModes.seal`) change nothing: second implementation, every
+`ModesIndex` read afresh from the pair states at each use. A complete-set run with far pairs
+sought again, impacts and sliding is bitwise the same."""
+import numpy as np
+
+from drake_dock.docking.scenario import load_scenario
+from drake_dock.docking.simulate import simulate
+from drake_dock.systems.contact_types import ContactModes, ModesIndex
+
+SCENE = "contact: {pairs: complete}\ninitial: {target_yaw_deg: -8.0}\nsimulation: {duration: 0.5}"
+
+
+def _run():
+    r = simulate(load_scenario(data=SCENE))
+    return r, (r.end_time, r.evaluations, r.mode_changes, len(r.impacts), np.array(r.record.x))
+
+
+def test_sealed_index_equals_the_pairs_read_afresh(monkeypatch):
+    kept, a = _run()
+    monkeypatch.setattr(ContactModes, "index", lambda self: ModesIndex.of(self.pairs))
+    fresh, b = _run()
+    assert kept.mode_changes > 5 and len(kept.impacts) > 0        # events happened
+    for x, y in zip(a, b):
+        assert np.array_equal(x, y)
