@@ -38,6 +38,7 @@ import dataclasses
 import math
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from drake_dock.docking.rotations import rot_vec
 
@@ -160,7 +161,50 @@ def distance_to_polyline(F, P):
                                for i in range(0, len(F), 64)])
     if len(F) == 0:
         return np.zeros(0)
-    j = np.argmin(((F[:, None, :] - P[None, :, :]) ** 2).sum(-1), axis=1)
+    return _beside(F, P, np.argmin(((F[:, None, :] - P[None, :, :]) ** 2).sum(-1), axis=1))
+
+
+_POLYLINES = {}
+
+
+def edge_polylines(g) -> dict:
+    """{petal k: its free edges (`free_edges`) as a `Polyline`}, kept per geometry."""
+    key = (g.R, g.H, g.alpha1, g.alpha2)
+    hit = _POLYLINES.get(key)
+    if hit is None:
+        if len(_POLYLINES) > 8:
+            _POLYLINES.clear()
+        hit = _POLYLINES[key] = {k: Polyline(P) for k, P in free_edges(g).items()}
+    return hit
+
+
+class Polyline:
+    """A polyline P (N, 3) with a k-d tree of its vertices: `distance_to_polyline`, the same
+    values, without its M x N distances. The nearest vertex is the brute force's (the least
+    squared distance, the first of equals): where the tree's two nearest are more than 1e-9
+    apart relatively, its nearest; else the vertices within that of the least distance,
+    compared as the brute force compares them."""
+
+    def __init__(self, P):
+        self.P = np.asarray(P, dtype=float)
+        self.tree = cKDTree(self.P)
+
+    def distance(self, F):
+        if len(F) == 0:
+            return np.zeros(0)
+        d, j = self.tree.query(F, k=2)
+        j = j[:, 0].copy()
+        close = np.flatnonzero(d[:, 1] <= d[:, 0] * (1.0 + 1e-9) + 1e-300)
+        if len(close):
+            balls = self.tree.query_ball_point(F[close], d[close, 0] * (1.0 + 1e-9) + 1e-300)
+            for m, c in zip(close, balls):
+                c = np.sort(np.asarray(c, dtype=np.intp))
+                j[m] = c[np.argmin(((F[m] - self.P[c]) ** 2).sum(-1))]
+        return _beside(F, self.P, j)
+
+
+def _beside(F, P, j):
+    """Distance of points F (M, 3) to the two segments of the polyline P beside vertex j (M,)."""
     best = np.full(len(F), np.inf)
     for a, b in ((np.maximum(j - 1, 0), j), (j, np.minimum(j + 1, len(P) - 1))):
         A, d = P[a], P[b] - P[a]
@@ -216,7 +260,7 @@ class _PetalWatch:
     or have crossed."""
 
     solids: tuple              # the three petals' names
-    edges: dict                # petal k: its free edges (`free_edges`)
+    edges: dict                # petal k: its free edges (`free_edges`) as a `Polyline`
     graze: float = 1e-6        # m: a crossing this close to a free edge passes round it
     X: np.ndarray = None
     s: np.ndarray = None
@@ -233,7 +277,7 @@ class _PetalWatch:
         if len(idx) and self.graze > 0.0:
             foot0 = foot_on_cone(g, self.X[idx], self.s[idx])
             at = foot0 + w[on][:, None] * (foot_on_cone(g, X[idx], s[idx]) - foot0)
-            idx = idx[distance_to_polyline(at, self.edges[k]) > self.graze]
+            idx = idx[self.edges[k].distance(at) > self.graze]
         return idx
 
     def step(self, g, X, s):
@@ -257,11 +301,54 @@ class _PetalWatch:
             held = np.flatnonzero(self.crossed[k - 1])
             _, frac, zeta = petal_coordinates(g, X[held], k)
             inside = held[_over(g, frac, zeta)]
-            off = distance_to_polyline(foot_on_cone(g, X_now[inside], s_now[inside]),
-                                       self.edges[k])
+            off = self.edges[k].distance(foot_on_cone(g, X_now[inside], s_now[inside]))
             depth = np.zeros(len(s))
             depth[inside] = np.minimum(np.abs(s_now[inside]), off)
             yield self.solids[k - 1], depth
+
+    def steps(self, g, X, s):
+        """`step` over a block of sub-steps, the rows of X (C, M, 3) and s (C, M); yields
+        (row, petal name, depth of each point). A row where no point changes side or lies on
+        the cone, after a row with none on it, and where no point has crossed, changes only
+        the last place: such rows are passed over, their last one kept."""
+        start = 0
+        if self.s is None:
+            for found in self.step(g, X[0], s[0]):
+                yield (0, *found)
+            start = 1
+        if start == len(s):
+            return
+        prev = np.concatenate([self.s[None], s[start:-1]])
+        on = (s[start:] == 0.0).any(axis=1)
+        busy = (np.sign(s[start:]) * np.sign(prev) < 0).any(axis=1) | on
+        busy[1:] |= on[:-1]
+        busy[0] |= bool((self.s == 0.0).any())
+        skipped = None
+        for c in range(start, len(s)):
+            if not busy[c - start] and not self.crossed.any():
+                skipped = c
+                continue
+            if skipped == c - 1:
+                self.X, self.s = X[skipped], s[skipped]
+            for found in self.step(g, X[c], s[c]):
+                yield (c, *found)
+        if skipped == len(s) - 1:
+            self.X, self.s = X[skipped], s[skipped]
+
+
+# Sub-steps taken at once by `deepest_penetration`.
+BLOCK = 64
+
+
+def _blocks(steps, size):
+    block = []
+    for step in steps:
+        block.append(step)
+        if len(block) == size:
+            yield block
+            block = []
+    if block:
+        yield block
 
 
 def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=1e-3,
@@ -276,25 +363,45 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
     1 mm travel; a real slicing of the plate is seen by the feature's points further in)."""
     feats = feature_points(g) if features is None else features
     reach = max(float(np.linalg.norm(X, axis=1).max()) for X in feats.values())
-    best = Penetration()
-    edges = free_edges(g)
+    best, rank = Penetration(), None
+    edges = edge_polylines(g)
     on_petals = {f: ~annulus_rim(g, X) for f, X in feats.items()}
     for a, b in ((0, 1), (1, 0)):
         R, p = relative_poses(R_WA, p_WA, a, b)
         watches = {f: _PetalWatch(tuple(f"{names[b]} petal {k}" for k in (1, 2, 3)), edges,
                                   graze) for f in feats if f.startswith(PETAL_FEATURES)}
-        for tt, Rab, pab in sub_steps(t, R, p, reach, max_travel):
-            for fname, X in feats.items():
-                Y = X @ Rab.T + pab
-                found = []
+        row0 = 0
+        for block in _blocks(sub_steps(t, R, p, reach, max_travel), BLOCK):
+            C = len(block)
+            Rz, pz = np.array([Rab[2] for _, Rab, _ in block]), np.array([q[2] for *_, q in block])
+            for f, (fname, X) in enumerate(feats.items()):
+                found = []                                  # (row, solid, depths)
                 if fname in watches:
-                    Yp = Y[on_petals[fname]]
-                    s = cone_distance(g, Yp)
-                    found = list(watches[fname].step(g, Yp, s))
+                    Y = np.stack([X @ Rab.T + pab for _, Rab, pab in block])
+                    Yp = Y[:, on_petals[fname]]
+                    s = cone_distance(g, Yp.reshape(-1, 3)).reshape(C, -1)
+                    found = list(watches[fname].steps(g, Yp, s))
+                    low = Y[:, :, 2].min(axis=1)
+                else:           # the ring's solid lies below its face: only rows reaching it
+                    low = (X @ Rz.T + pz).min(axis=0) - 1e-9
+                    Y = None
                 if fname.startswith(RING_FEATURES):
-                    found.append((f"{names[b]} ring", ring_depth_of(g, Y, ring_depth)))
-                for solid, depth in found:
+                    rows = np.flatnonzero(low < 0.0)
+                    if Y is None and len(rows):
+                        Y = np.stack([X @ block[c][1].T + block[c][2] for c in rows])
+                    elif len(rows):
+                        Y = Y[rows]
+                    if len(rows):
+                        depth = ring_depth_of(g, Y.reshape(-1, 3), ring_depth).reshape(
+                            len(rows), -1)
+                        found += [(c, f"{names[b]} ring", depth[m]) for m, c in enumerate(rows)]
+                for c, solid, depth in found:
+                    # The deepest; of equals, the first in the order (direction, sub-step,
+                    # feature, petals before the ring).
                     d = float(depth.max()) if len(depth) else 0.0
-                    if d > best.depth:
-                        best = Penetration(d, float(tt), f"{names[a]} {fname}", solid)
+                    key = (a, row0 + c, f, solid.endswith(" ring"))
+                    if d > best.depth or (d == best.depth and d > 0.0 and key < rank):
+                        best = Penetration(d, float(block[c][0]), f"{names[a]} {fname}", solid)
+                        rank = key
+            row0 += C
     return best
