@@ -16,7 +16,7 @@ class CoupleRows:
         self.ev = ev
         # Far pairs' points in their body frames, by (pair, u*): they change only when the
         # pair is sought again.
-        self._points = Memo(2 * len(ev.pairs))
+        self._points = Memo(4 * len(ev.pairs))
         self._entries = {}      # `_u_entries`, by the tuple of far pairs
 
     def fill(self, y, x, E, st, i):
@@ -70,12 +70,13 @@ class CoupleRows:
     def _far_block(self, far, at, us):
         """(points on patches 1, on patches 2 in their body frames (K, 3), frames 1, frames 2)
         of the far pairs ``far`` at their couples' entries ``us``: one memo entry per far set
-        and couples, which change only when a pair is sought again."""
+        and couples, which change only when a pair is sought again, from each pair's own
+        entry (by its couple) where that pair's couple did not change."""
         def compute():
             r1, r2 = [], []
             for i in far:
                 u = us[at[0] == i]
-                p, q = self._far_points(i, u)
+                p, q = self._points.get((i, u.tobytes()), lambda: self._far_points(i, u))
                 r1.append(p)
                 r2.append(q)
             fidx = np.array([self.ev.fidx[i] for i in far], dtype=np.intp).reshape(-1, 2)
