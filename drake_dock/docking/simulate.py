@@ -119,7 +119,7 @@ class _Recorder:
         cc.SetContinuousState(imp["x_plus"])
         after = ContactModes(copied_states(imp["pairs_plus"]), [], imp["impact_loss_plus"],
                              modes.mode_changes)
-        cc.get_mutable_abstract_state(contact._mode_index).set_value(after)
+        cc.get_mutable_abstract_state(contact._mode_index).set_value(after.seal())
         self._append(s, POST_IMPACT)
 
 

@@ -2,6 +2,7 @@
 the abstract state, one evaluation, and the layout of each couple's output port."""
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 
@@ -126,6 +127,18 @@ class PairState:
         new.__dict__.pop("_sealed", None)
         return new
 
+    __copy__ = copied
+
+    def __deepcopy__(self, memo):
+        """A copy, never sealed, of copied arrays."""
+        new = self.copied()
+        new.__dict__.update(copy.deepcopy(new.__dict__, memo))
+        return new
+
+    def __getstate__(self):
+        """Pickled unsealed: the seal belongs to the context that holds the state."""
+        return {k: v for k, v in self.__dict__.items() if k != "_sealed"}
+
 
 def copied_states(states) -> list:
     """`PairState.copied` of each of ``states``."""
@@ -134,12 +147,19 @@ def copied_states(states) -> list:
 
 @dataclasses.dataclass
 class ContactModes:
-    """The abstract state: per pair its `PairState`, and the impact log."""
+    """The abstract state: per pair its `PairState`, and the impact log. A context holds them
+    sealed (`seal`): then nothing of them changes, and a change raises."""
 
-    pairs: list
+    pairs: list                     # a tuple once sealed
     impacts: list = dataclasses.field(default_factory=list)   # dicts: t, couples, impulses
     impact_loss: float = 0.0
     mode_changes: int = 0
+
+    def __setattr__(self, name, value):
+        if "_index" in self.__dict__:
+            raise AttributeError(f"ContactModes.{name}: the modes are sealed (`seal`); change "
+                                 "a `working_copy`")
+        object.__setattr__(self, name, value)
 
     def __deepcopy__(self, memo):
         """Copies (Drake clones the abstract state at every step and event). Sealed modes are
@@ -150,10 +170,15 @@ class ContactModes:
         index = self.__dict__.get("_index")
         if index is None:
             return self.working_copy()
-        new = ContactModes(list(self.pairs), list(self.impacts), self.impact_loss,
-                           self.mode_changes)
+        new = ContactModes(self.pairs, list(self.impacts), self.impact_loss, self.mode_changes)
         new.__dict__["_index"] = index
         return new
+
+    def __getstate__(self):
+        """Pickled unsealed, the pair states as a list (`PairState.__getstate__`)."""
+        state = {k: v for k, v in self.__dict__.items() if k != "_index"}
+        state["pairs"] = list(self.pairs)
+        return state
 
     def working_copy(self) -> "ContactModes":
         """A copy whose pair states an event may change (not sealed)."""
@@ -161,9 +186,11 @@ class ContactModes:
                             self.mode_changes)
 
     def seal(self) -> "ContactModes":
-        """Marks these modes as final: a context holds them, and their pair states are never
-        changed again (a change raises). What the evaluations and witnesses read of them
-        (`index`) is then computed once, not in a pass over every pair at each evaluation."""
+        """Marks these modes as final: a context holds them, and neither they nor their pair
+        states change again (a change raises; the pairs become a tuple). What the evaluations
+        and witnesses read of them (`index`) is then computed once, not in a pass over every
+        pair at each evaluation."""
+        self.pairs = tuple(self.pairs)
         for st in self.pairs:
             st.__dict__["_sealed"] = True
         self.__dict__["_index"] = ModesIndex.of(self.pairs)
@@ -171,23 +198,30 @@ class ContactModes:
 
     def index(self) -> "ModesIndex":
         """The `ModesIndex` of the pair states: kept when sealed, else computed now."""
-        return self.__dict__.get("_index") or ModesIndex.of(self.pairs)
+        index = self.__dict__.get("_index")
+        return ModesIndex.of(self.pairs) if index is None else index
 
 
-@dataclasses.dataclass(frozen=True)
+def _read_only(a):
+    a.flags.writeable = False
+    return a
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
 class ModesIndex:
     """What the evaluations and witnesses read of the pairs' states, over the pairs at once:
     the pairs not far (``near``, ascending) and the far ones (``far``) with their clearances,
-    their distances at the last seek and whether they were ever sought, and every pair's
-    sigma; ``derived`` keeps what
-    the contact system computes from these (the armed witnesses)."""
+    their distances at the last seek and whether they were ever sought (read-only arrays), and
+    every pair's sigma (writable: the compiled kernel takes one signature); ``derived`` keeps
+    what the contact system computes from these (the armed witnesses, the far pairs' stacked
+    reference poses)."""
 
     near: tuple
     far: np.ndarray
     clearance: np.ndarray
     distance: np.ndarray
     sought: np.ndarray
-    sigma: np.ndarray          # every pair's sigma
+    sigma: np.ndarray
     derived: dict
 
     @staticmethod
@@ -196,10 +230,10 @@ class ModesIndex:
         far = [i for i, st in enumerate(states) if st.mode == FAR]
         return ModesIndex(
             tuple(i for i, st in enumerate(states) if st.mode != FAR),
-            np.array(far, dtype=np.intp),
-            np.array([states[i].clearance for i in far], dtype=float),
-            np.array([states[i].distance for i in far], dtype=float),
-            np.array([states[i].ref_X21 is not None for i in far], dtype=bool),
+            _read_only(np.array(far, dtype=np.intp)),
+            _read_only(np.array([states[i].clearance for i in far], dtype=float)),
+            _read_only(np.array([states[i].distance for i in far], dtype=float)),
+            _read_only(np.array([states[i].ref_X21 is not None for i in far], dtype=bool)),
             np.array([st.sigma for st in states], dtype=float), {})
 
 

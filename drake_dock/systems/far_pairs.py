@@ -105,6 +105,7 @@ class FarPairs:
             R0, p0 = np.zeros((len(sought), 3, 3)), np.zeros((len(sought), 3))
             for k, i in enumerate(sought.tolist()):
                 R0[k], p0[k] = states[i].ref_X21
+            R0.flags.writeable = p0.flags.writeable = False
             refs = index.derived["far_refs"] = (sought, R0, p0)
         out = np.full(len(index.far), math.inf)
         if len(refs[0]):

@@ -29,5 +29,14 @@ def test_the_table_is_the_couple_ports():
             tol = 4 * np.spacing(np.abs(port).max()) if table[i][0] == 0 else 0.0
             np.testing.assert_allclose(table[i], port, rtol=0, atol=tol, err_msg=p.name)
         modes_seen |= set(table[:, 0].astype(int).tolist())
+        # The far rows from pair states that are not the evaluation's own list (a context
+        # whose modes are not those of its cached evaluation): the travel bounds from each
+        # state's own reference pose.
+        E = dd.contact._cache.Eval(ctx)
+        far = [i for i, c in enumerate(E.evals) if c is None]
+        Y = np.zeros_like(table)
+        x = ctx.get_continuous_state_vector().CopyToVector()
+        dd.contact._rows.fill_far(Y, x, E, list(E.modes.pairs), far)
+        np.testing.assert_array_equal(Y[far], table[far])
     # Far rows and at least one couple that is tracked or in contact were compared.
     assert 0 in modes_seen and len(modes_seen) > 1

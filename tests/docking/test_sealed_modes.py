@@ -12,7 +12,8 @@ SCENE = "contact: {pairs: complete}\ninitial: {target_yaw_deg: -8.0}\nsimulation
 
 def _run():
     r = simulate(load_scenario(data=SCENE))
-    return r, (r.end_time, r.evaluations, r.mode_changes, len(r.impacts), np.array(r.record.x))
+    return r, (r.end_time, r.evaluations, r.mode_changes, len(r.impacts), np.array(r.record.x),
+               np.array(r.record.couples))
 
 
 def test_sealed_index_equals_the_pairs_read_afresh(monkeypatch):

@@ -2,6 +2,7 @@
 is computed once, copies share the pair states, and a change raises instead of going unseen."""
 import copy
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -49,6 +50,26 @@ def test_sealed_modes_are_shared_by_copies_and_refuse_changes():
     assert modes.index().near == (1,)
     again = copy.deepcopy(work)                        # an unsealed copy is a deep one
     assert again.pairs[0] is not work.pairs[0] and again.pairs[0] == work.pairs[0]
+    with pytest.raises(TypeError):                     # sealed pairs are a tuple
+        clone.pairs[0] = PairState(Mode.TRACKED)
+    with pytest.raises(AttributeError, match="sealed"):
+        clone.mode_changes = 3
+    with pytest.raises(ValueError):                    # and the index's arrays read-only
+        modes.index().far[0] = 1
+
+
+def test_a_single_state_copied_or_pickled_is_not_sealed():
+    """Only the context's modes are sealed: a state copied by any means, or modes pickled,
+    can be changed, and their index is read afresh."""
+    modes = ContactModes([PairState(Mode.FAR, ref_X21=(np.eye(3), np.zeros(3))),
+                          PairState(Mode.TRACKED)]).seal()
+    for st in (copy.copy(modes.pairs[0]), copy.deepcopy(modes.pairs[0]),
+               pickle.loads(pickle.dumps(modes.pairs[0]))):
+        st.mode = Mode.TRACKED
+        assert modes.pairs[0].mode == Mode.FAR
+    back = pickle.loads(pickle.dumps(modes))
+    back.pairs[0].mode = Mode.SLIDING
+    assert back.index().near == (0, 1) and modes.index().near == (1,)
 
 
 def test_far_bounds_from_the_index_equal_the_pair_by_pair_ones():
