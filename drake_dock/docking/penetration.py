@@ -107,12 +107,23 @@ def petal_coordinates(g, X, k):
     (positive away from the axis), the foot's fraction across the petal (0 and 1 on its guide
     sides) and the foot's height zeta. The foot is over the plate for 0 <= fraction <= 1 and
     0 <= zeta <= H."""
+    s, fractions, zeta_f = petal_places(g, X, (k,))
+    return s, fractions[0], zeta_f
+
+
+def petal_places(g, X, petals=(1, 2, 3)):
+    """`petal_coordinates` for several petals at once: (s, [fraction across each petal],
+    zeta)."""
     s = cone_distance(g, X)
     zeta_f = X[:, 2] - s * math.cos(g.alpha1)
     inset = _inset(g, np.clip(zeta_f, 0.0, g.H))
-    phi = (2 * k - 2) * math.pi / 3
-    dth = np.mod(np.arctan2(X[:, 1], X[:, 0]) - phi + math.pi, 2 * math.pi) - math.pi
-    return s, (dth - inset) / (math.pi / 3 - 2 * inset), zeta_f
+    theta = np.arctan2(X[:, 1], X[:, 0])
+    fractions = []
+    for k in petals:
+        phi = (2 * k - 2) * math.pi / 3
+        dth = np.mod(theta - phi + math.pi, 2 * math.pi) - math.pi
+        fractions.append((dth - inset) / (math.pi / 3 - 2 * inset))
+    return s, fractions, zeta_f
 
 
 def _over(g, frac, zeta_f, tol=1e-9):
@@ -266,19 +277,21 @@ class _PetalWatch:
     s: np.ndarray = None
     crossed: np.ndarray = None  # (3, M)
 
-    def _crossings(self, g, k, X, s, flip):
-        """Of the points ``flip`` that changed side, those whose crossing (s = 0, linearly
-        between the sub-steps) lies on petal k, more than `graze` from its free edges."""
+    def _crossings(self, g, X, s, flip):
+        """Per petal k = 1, 2, 3: of the points ``flip`` that changed side, those whose
+        crossing (s = 0, linearly between the sub-steps) lies on petal k, more than `graze`
+        from its free edges."""
         w = self.s[flip] / (self.s[flip] - s[flip])
-        (_, frac0, zeta0), (_, frac1, zeta1) = (petal_coordinates(g, Y[flip], k)
-                                                for Y in (self.X, X))
-        on = _over(g, frac0 + w * (frac1 - frac0), zeta0 + w * (zeta1 - zeta0))
-        idx = flip[on]
-        if len(idx) and self.graze > 0.0:
-            foot0 = foot_on_cone(g, self.X[idx], self.s[idx])
-            at = foot0 + w[on][:, None] * (foot_on_cone(g, X[idx], s[idx]) - foot0)
-            idx = idx[self.edges[k].distance(at) > self.graze]
-        return idx
+        (_, fr0, zeta0), (_, fr1, zeta1) = (petal_places(g, Y[flip]) for Y in (self.X, X))
+        for k in (1, 2, 3):
+            frac0, frac1 = fr0[k - 1], fr1[k - 1]
+            on = _over(g, frac0 + w * (frac1 - frac0), zeta0 + w * (zeta1 - zeta0))
+            idx = flip[on]
+            if len(idx) and self.graze > 0.0:
+                foot0 = foot_on_cone(g, self.X[idx], self.s[idx])
+                at = foot0 + w[on][:, None] * (foot_on_cone(g, X[idx], s[idx]) - foot0)
+                idx = idx[self.edges[k].distance(at) > self.graze]
+            yield k, idx
 
     def step(self, g, X, s):
         """Updates with the sub-step's points X and their cone distances s (`cone_distance`);
@@ -288,8 +301,7 @@ class _PetalWatch:
             self.crossed = np.zeros((3, len(s)), dtype=bool)
         else:
             flip = np.flatnonzero(np.sign(s) * np.sign(self.s) < 0)
-            for k in (1, 2, 3) if len(flip) else ():
-                idx = self._crossings(g, k, X, s, flip)
+            for k, idx in self._crossings(g, X, s, flip) if len(flip) else ():
                 self.crossed[k - 1, idx] = ~self.crossed[k - 1, idx]
             # A point exactly on the cone (s = 0) keeps its last side: the crossing is seen
             # at the next sub-step off the cone.
