@@ -1,0 +1,76 @@
+"""What the placement (`initial_state`: the first contact of the scenario's contact set on a
+straight approach, the consistent aim with a lateral velocity, and the independent check of the
+path down to it) costs: the paper example with `complete`, and the first ``--conditions``
+random conditions of `drake-dock study conditions` (seed 2026, inside the IDSS box). Per
+placement it prints the wall time, the first-contact searches it ran (its memo's hits not
+counted) and their time, and the path check's time; then one search alone on each final
+approach (the searches' memo cleared); then the medians. A first placement loads the
+compiled kernels and is not counted.
+
+    python bench/placement.py [--conditions 12]
+"""
+import argparse
+import time
+from unittest import mock
+
+import numpy as np
+
+from drake_dock.docking import path_check, scene
+from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
+
+
+class _Timed:
+    """Wraps f: its calls and their wall time."""
+
+    def __init__(self, f):
+        self.f, self.calls, self.wall = f, 0, 0.0
+
+    def __call__(self, *args, **kwargs):
+        t0 = time.perf_counter()
+        try:
+            return self.f(*args, **kwargs)
+        finally:
+            self.calls += 1
+            self.wall += time.perf_counter() - t0
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--conditions", type=int, default=12)
+    args = ap.parse_args(argv)
+    base = load_scenario(PAPER_EXAMPLE)
+    base.contact.pairs = "complete"
+    plan = conditions(ConditionsPlan())
+    scene.initial_state(with_condition(base, plan[0][1]))            # kernels loaded
+    cases = [("paper example", base)] + [(n, with_condition(base, c))
+                                         for n, c in plan[1:1 + args.conditions]]
+    totals, checks, alone = [], [], []
+    for name, s in cases:
+        cached = scene._first_contact
+        cached.cache_clear()
+        search, check = _Timed(cached), _Timed(path_check._crossing)
+        with mock.patch.object(scene, "_first_contact", search), \
+                mock.patch.object(path_check, "_crossing", check):
+            t0 = time.perf_counter()
+            scene.initial_state(s)
+            total = time.perf_counter() - t0
+        searches = cached.cache_info().misses          # the memo's hits cost nothing
+        approach = scene.contact_approach(s)[0]
+        scene._first_contact.cache_clear()
+        t0 = time.perf_counter()
+        scene.first_contact_or_faces(s.geometry, approach, s.contact.pairs)
+        one = time.perf_counter() - t0
+        totals.append(total)
+        checks.append(check.wall)
+        alone.append(one)
+        print(f"{name}: placement {1e3 * total:.0f} ms; {searches} searches "
+              f"{1e3 * search.wall:.0f} ms; path check {1e3 * check.wall:.0f} ms; one search "
+              f"alone {1e3 * one:.0f} ms", flush=True)
+    print(f"median over {len(cases)}: placement {1e3 * np.median(totals):.0f} ms (fastest "
+          f"{1e3 * min(totals):.0f}, slowest {1e3 * max(totals):.0f}); path check "
+          f"{1e3 * np.median(checks):.0f} ms; one search {1e3 * np.median(alone):.0f} ms")
+
+
+if __name__ == "__main__":
+    main()
