@@ -197,7 +197,8 @@ class Polyline:
     compared as the brute force compares them."""
 
     def __init__(self, P):
-        self.P = np.asarray(P, dtype=float)
+        self.P = np.array(P, dtype=float)
+        self.P.flags.writeable = False          # the tree keeps it
         self.tree = cKDTree(self.P)
 
     def distance(self, F):
