@@ -37,9 +37,9 @@ def frame_list(pairs):
 
 
 def near_pairs(modes) -> tuple:
-    """The indices of the pairs that are not far under ``modes``, ascending: one pass over the
-    pairs per evaluation, which `PlantEvaluator.key`, `PlantEvaluator.evaluate` and the
-    tracked count share."""
+    """The indices of the pairs that are not far under ``modes``, ascending (`ModesIndex`, kept
+    on sealed modes), which `PlantEvaluator.key`, `PlantEvaluator.evaluate` and the tracked
+    count share."""
     return modes.index().near
 
 

@@ -51,12 +51,13 @@ class CoupleRows:
         if not len(far):
             return
         base = ev.nq + ev.nv
-        if states is E.modes.pairs:                   # E's own bounds, all far ones at once
+        if states is E.modes.pairs:     # E's own far pairs (its index's), all bounds at once
             ev.bound(E, far[0], states[far[0]])
-            bound = E.bound[far]
+            distance, bound = E.modes.index().distance, E.bound[far]
         else:
+            distance = np.array([states[i].distance for i in far])
             bound = ev.far.bounds(far, E.poses, states)
-        Y[far, S["gap"].start] = np.array([states[i].distance for i in far]) - bound
+        Y[far, S["gap"].start] = distance - bound
         at = self._u_entries(far)
         us = x[base + at[2]]
         Y[at[0], S["u"].start + at[1]] = us
