@@ -15,7 +15,7 @@ from unittest import mock
 
 import numpy as np
 
-from drake_dock.docking import path_check, scene
+from drake_dock.docking import path_check, scene, search
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
 
@@ -47,17 +47,17 @@ def main(argv=None):
                                          for n, c in plan[1:1 + args.conditions]]
     totals, checks, alone = [], [], []
     for name, s in cases:
-        cached = scene._first_contact
+        cached = search._first_contact
         cached.cache_clear()
-        search, check = _Timed(cached), _Timed(path_check._crossing)
-        with mock.patch.object(scene, "_first_contact", search), \
+        timed, check = _Timed(cached), _Timed(path_check._crossing)
+        with mock.patch.object(search, "_first_contact", timed), \
                 mock.patch.object(path_check, "_crossing", check):
             t0 = time.perf_counter()
             scene.initial_state(s)
             total = time.perf_counter() - t0
         searches = cached.cache_info().misses          # the memo's hits cost nothing
         approach = scene.contact_approach(s)[0]
-        scene._first_contact.cache_clear()
+        search._first_contact.cache_clear()
         t0 = time.perf_counter()
         scene.first_contact_or_faces(s.geometry, approach, s.contact.pairs)
         one = time.perf_counter() - t0
@@ -65,7 +65,7 @@ def main(argv=None):
         checks.append(check.wall)
         alone.append(one)
         print(f"{name}: placement {1e3 * total:.0f} ms; {searches} searches "
-              f"{1e3 * search.wall:.0f} ms; path check {1e3 * check.wall:.0f} ms; one search "
+              f"{1e3 * timed.wall:.0f} ms; path check {1e3 * check.wall:.0f} ms; one search "
               f"alone {1e3 * one:.0f} ms", flush=True)
     print(f"median over {len(cases)}: placement {1e3 * np.median(totals):.0f} ms (fastest "
           f"{1e3 * min(totals):.0f}, slowest {1e3 * max(totals):.0f}); path check "

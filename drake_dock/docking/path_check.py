@@ -33,7 +33,7 @@ def _crossing(g: ApdsGeometry, approach, lam0: float, lam1: float):
     eye, zero = np.eye(3), np.zeros(3)
     return deepest_penetration(g, np.array([0.0, 1.0]), np.array([[eye, R0], [eye, R1]]),
                                np.array([[zero, p0], [zero, p1]]), ("target", "chaser"),
-                               graze=FREE_APPROACH_TOL)
+                               graze=FREE_APPROACH_TOL, sparse=True)
 
 
 def check_free_approach(g: ApdsGeometry, approach, which: str, lam0: float):

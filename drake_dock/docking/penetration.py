@@ -277,22 +277,29 @@ class _PetalWatch:
     X: np.ndarray = None
     s: np.ndarray = None
     crossed: np.ndarray = None  # (3, M)
+    sparse: bool = False        # `steps`: find the rows to step first (`deepest_penetration`)
 
     def _crossings(self, g, X, s, flip):
         """Per petal k = 1, 2, 3: of the points ``flip`` that changed side, those whose
         crossing (s = 0, linearly between the sub-steps) lies on petal k, more than `graze`
         from its free edges."""
-        w = self.s[flip] / (self.s[flip] - s[flip])
-        (_, fr0, zeta0), (_, fr1, zeta1) = (petal_places(g, Y[flip]) for Y in (self.X, X))
+        on = self._on_petals(g, self.X[flip], self.s[flip], X[flip], s[flip])
         for k in (1, 2, 3):
-            frac0, frac1 = fr0[k - 1], fr1[k - 1]
-            on = _over(g, frac0 + w * (frac1 - frac0), zeta0 + w * (zeta1 - zeta0))
-            idx = flip[on]
+            yield k, flip[on[k - 1]]
+
+    def _on_petals(self, g, X0, s0, X1, s1):
+        """(3, M): whether the crossing of each point from (X0, s0) to (X1, s1) (opposite
+        sides) lies on petal k, more than `graze` from its free edges."""
+        w, over = _crossing_over(g, X0, s0, X1, s1)
+        out = np.zeros((3, len(s0)), dtype=bool)
+        for k in (1, 2, 3):
+            idx = np.flatnonzero(over[k - 1])
             if len(idx) and self.graze > 0.0:
-                foot0 = foot_on_cone(g, self.X[idx], self.s[idx])
-                at = foot0 + w[on][:, None] * (foot_on_cone(g, X[idx], s[idx]) - foot0)
+                foot0 = foot_on_cone(g, X0[idx], s0[idx])
+                at = foot0 + w[idx][:, None] * (foot_on_cone(g, X1[idx], s1[idx]) - foot0)
                 idx = idx[self.edges[k].distance(at) > self.graze]
-            yield k, idx
+            out[k - 1, idx] = True
+        return out
 
     def step(self, g, X, s):
         """Updates with the sub-step's points X and their cone distances s (`cone_distance`);
@@ -333,7 +340,16 @@ class _PetalWatch:
             return
         prev = np.concatenate([self.s[None], s[start:-1]])
         on = (s[start:] == 0.0).any(axis=1)
-        busy = (np.sign(s[start:]) * np.sign(prev) < 0).any(axis=1) | on
+        busy = on.copy()
+        if self.sparse and not self.crossed.any():
+            # A row is stepped where a crossing lies over a petal (`_over`), near its free
+            # edges or not.
+            X_prev = np.concatenate([self.X[None], X[start:-1]])
+            rows, points = np.nonzero(_flips(g, X_prev, prev, X[start:], s[start:]))
+            busy[rows[_crosses_over(g, X_prev[rows, points], prev[rows, points],
+                                    X[start:][rows, points], s[start:][rows, points])]] = True
+        else:
+            busy |= (np.sign(s[start:]) * np.sign(prev) < 0).any(axis=1)
         busy[1:] |= on[:-1]
         busy[0] |= bool((self.s == 0.0).any())
         skipped = None
@@ -347,6 +363,31 @@ class _PetalWatch:
                 yield (c, *found)
         if skipped == len(s) - 1:
             self.X, self.s = X[skipped], s[skipped]
+
+
+def _crossing_over(g, X0, s0, X1, s1):
+    """For points that cross the cone from (X0, s0) to (X1, s1): the crossing's weight w
+    (linear between the two) and, per petal k = 1, 2, 3, whether it lies over the petal."""
+    w = s0 / (s0 - s1)
+    (_, fr0, zeta0), (_, fr1, zeta1) = petal_places(g, X0), petal_places(g, X1)
+    zeta = zeta0 + w * (zeta1 - zeta0)
+    return w, [_over(g, f0 + w * (f1 - f0), zeta) for f0, f1 in zip(fr0, fr1)]
+
+
+def _crosses_over(g, X0, s0, X1, s1):
+    """Whether each crossing (`_crossing_over`) lies over some petal."""
+    over = _crossing_over(g, X0, s0, X1, s1)[1]
+    return over[0] | over[1] | over[2]
+
+
+def _flips(g, X0, s0, X1, s1, margin=1e-6):
+    """The points that change side of the cone from (X0, s0) to (X1, s1) at a height that can
+    lie on a petal: the crossing, linear between the two, within ``margin`` of 0 <= z <= H
+    (there z is the foot's zeta, which `_over` bounds to 1e-9)."""
+    flip = np.sign(s1) * np.sign(s0) < 0
+    w = s0 / np.where(flip, s0 - s1, 1.0)
+    z = X0[..., 2] + w * (X1[..., 2] - X0[..., 2])
+    return flip & (z > -margin) & (z < g.H + margin)
 
 
 # Sub-steps taken at once by `deepest_penetration`.
@@ -365,7 +406,7 @@ def _blocks(steps, size):
 
 
 def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=1e-3,
-                        features=None, graze=1e-6) -> Penetration:
+                        features=None, graze=1e-6, sparse=False) -> Penetration:
     """The deepest interpenetration of the two APDS over the samples t (N,) with their frames'
     poses R_WA (N, 2, 3, 3), p_WA (N, 2, 3) (the timeseries fields), names the two APDS names;
     ``features`` replaces `feature_points` (a subset, for tests). A point crosses a petal where
@@ -373,7 +414,10 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
     an edge and passes round it: an edge in contact with a petal's edge holds the two at
     distance 0, so each of its points that the contact slides past passes exactly through
     the other edge (the default, 1 um, is above the sub-steps' interpolation error, 0.1 um at
-    1 mm travel; a real slicing of the plate is seen by the feature's points further in)."""
+    1 mm travel; a real slicing of the plate is seen by the feature's points further in).
+    With ``sparse`` (a path on which few sub-steps cross a petal: an approach, not a contact
+    sliding on one) the sub-steps where a crossing lies over a petal are found for a whole
+    block at once and only those are stepped; the result is the same."""
     feats = feature_points(g) if features is None else features
     reach = max(float(np.linalg.norm(X, axis=1).max()) for X in feats.values())
     best, rank = Penetration(), None
@@ -382,7 +426,8 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
     for a, b in ((0, 1), (1, 0)):
         R, p = relative_poses(R_WA, p_WA, a, b)
         watches = {f: _PetalWatch(tuple(f"{names[b]} petal {k}" for k in (1, 2, 3)), edges,
-                                  graze) for f in feats if f.startswith(PETAL_FEATURES)}
+                                  graze, sparse=sparse)
+                   for f in feats if f.startswith(PETAL_FEATURES)}
         row0 = 0
         for block in _blocks(sub_steps(t, R, p, reach, max_travel), BLOCK):
             C = len(block)

@@ -1,11 +1,13 @@
 """The interpenetration check's shortcuts against its plain form. `Polyline.distance` (a k-d
 tree) against the brute-force `distance_to_polyline`; `deepest_penetration` (sub-steps in
 blocks, rows where nothing changes side passed over, the ring's solid checked only in rows
-that reach below its face, the three petals' places at once) against a loop over every
+that reach below its face, the three petals' places at once; with and without ``sparse``,
+the rows with a crossing over a petal found for a block at once) against a loop over every
 sub-step, feature and petal written here, with its own petal places and the brute-force edge
 distance. Both exactly, on paths that cross petals, graze their edges, overlap the rings,
-stop a point exactly on the cone at a block's edge, tie depths, and turn a point into a gap
-between petals over passed-over rows before it drops through the cone."""
+stop a point exactly on the cone at a block's edge, tie depths, turn a point into a gap
+between petals over passed-over rows before it drops through the cone, and cross the cone
+next to the tip height."""
 import dataclasses
 import math
 
@@ -101,9 +103,12 @@ def _plain(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=1e-3, feature
 
 
 def _same(g, *args, **kwargs):
-    got = pen.deepest_penetration(g, *args, **kwargs)
+    """The check, with and without ``sparse`` (the rows to step found first), equals the
+    plain loop."""
     want = _plain(g, *args, **kwargs)
-    assert dataclasses.astuple(got) == dataclasses.astuple(want)
+    for sparse in (False, True):
+        got = pen.deepest_penetration(g, *args, sparse=sparse, **kwargs)
+        assert dataclasses.astuple(got) == dataclasses.astuple(want), sparse
     return got
 
 
@@ -204,3 +209,15 @@ def test_polyline_distance_equals_the_brute_force(geom):
         mid = 0.5 * (P[:-1] + P[1:])[rng.integers(0, len(P) - 1, 50)]     # equal distances
         F = np.concatenate([near, far, on, ends, mid])
         assert np.array_equal(line.distance(F), pen.distance_to_polyline(F, P))
+
+
+@pytest.mark.parametrize("z", [5e-4, -5e-4])
+def test_a_point_crossing_the_cone_next_to_the_tip_height(geom, z):
+    """A point over petal 1 pushed sideways through the cone 0.5 mm below the petal's tip
+    height, where it crosses the plate, and 0.5 mm above it, where it passes over the tip."""
+    th, zp = math.radians(30.0), geom.H - z
+    r = geom.R - zp / math.tan(geom.alpha1) + 2e-3
+    P = np.array([[r * math.cos(th), r * math.sin(th), zp]])
+    found = _same(geom, *_moved([0.0] * 3, [0.0, 0.002, 0.004]), NAMES,
+                  features={"guide side 1": P})
+    assert (found.depth > 1e-4) == (z > 0)

@@ -5,12 +5,14 @@ between). The
 search seeks a pair only in the steps its covers can touch; the travel, the closing pairs and
 the typed error are the scan's, bit for bit. Independently, the path down to the first
 contact is clear by the interpenetration check (`drake_dock.docking.penetration`)."""
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 from scipy.optimize import brentq
 
+from drake_dock.docking import search
 from drake_dock.docking.apds import ApdsGeometry
 from drake_dock.docking.scene import (MARCH_SUBSTEPS, Approach, apds_pairs, first_contact,
                                       first_contact_seeks, march_root, seek_gaps, signed_gaps,
@@ -319,3 +321,35 @@ def test_the_path_to_a_random_first_contact_is_clear(seed):
     g = ApdsGeometry()
     approach = _random_approach(np.random.default_rng(seed))
     assert _path_depth(g, approach, first_contact(g, approach, which="complete")[0]) < 1e-6
+
+
+@pytest.mark.parametrize("seed", [0, 14, 32])
+def test_lockstep_marches_find_the_full_marches_closings(seed):
+    """On the first contact's step of approaches where marches close, the lockstep marches
+    (`_Gaps.marches`, stopped once a march's next sub-step starts 1e-9 below the best closing)
+    against each march run over the whole step alone (`march_root`): with no closing known,
+    with the best given at the first contact, and with one given below every march's
+    closing, the closings within 1e-9 of the first contact are found, each equal."""
+    g = ApdsGeometry()
+    approach = _random_approach(np.random.default_rng(seed))
+    lam_c = first_contact(g, approach, which="complete")[0]
+    pairs = search.search_pairs(dataclasses.astuple(g), "complete")
+    grid = travel_grid(g, approach)
+    k = max(i for i in range(len(grid) - 1) if grid[i] >= lam_c)
+    touch = search.touch_steps(pairs, approach, grid)
+    gaps = search._Gaps(pairs, approach, grid)
+    marched = [j for j in np.flatnonzero(touch[:, k])
+               if not (0 < gaps.gap(j, k) < np.inf and gaps.gap(j, k + 1) <= 0)
+               and abs(gaps.distance(j, k)) < grid[k] - grid[k + 1]]
+    full = {}
+    for j in marched:
+        lam = march_root(pairs[j], approach, grid[k], gaps.at[(j, k)], grid[k + 1],
+                         (grid[k] - grid[k + 1]) / MARCH_SUBSTEPS, 1e-13)[0]
+        if lam is not None:
+            full[j] = lam
+    assert full and max(full.values()) == lam_c
+    must = {j for j, lam in full.items() if lam >= lam_c - 1e-9}
+    for best in (None, lam_c, min(full.values()) - 1e-4):
+        found = search._Gaps(pairs, approach, grid).marches(marched, k, 1e-13, best)
+        assert must <= set(found)
+        assert all(found[j] == full[j] for j in found)
