@@ -256,11 +256,13 @@ def sub_steps(t, R, p, reach, max_travel):
     ``reach`` of the origin more than ``max_travel``."""
     yield t[0], R[0], p[0]
     for n in range(1, len(t)):
-        r = _rotvec(R[n - 1].T @ R[n])
+        R0 = R[n - 1]
+        turned = not np.array_equal(R0, R[n])       # else the sub-steps keep R0 (one object)
+        r = _rotvec(R0.T @ R[n]) if turned else np.zeros(3)
         travel = np.linalg.norm(p[n] - p[n - 1]) + np.linalg.norm(r) * reach
         m = max(1, int(math.ceil(travel / max_travel)))
         for f in np.arange(1, m + 1) / m:
-            yield (t[n - 1] + (t[n] - t[n - 1]) * f, R[n - 1] @ rot_vec(f * r),
+            yield (t[n - 1] + (t[n] - t[n - 1]) * f, R0 @ rot_vec(f * r) if turned else R0,
                    p[n - 1] + f * (p[n] - p[n - 1]))
 
 
@@ -385,9 +387,11 @@ def _flips(g, X0, s0, X1, s1, margin=1e-6):
     lie on a petal: the crossing, linear between the two, within ``margin`` of 0 <= z <= H
     (there z is the foot's zeta, which `_over` bounds to 1e-9)."""
     flip = np.sign(s1) * np.sign(s0) < 0
-    w = s0 / np.where(flip, s0 - s1, 1.0)
-    z = X0[..., 2] + w * (X1[..., 2] - X0[..., 2])
-    return flip & (z > -margin) & (z < g.H + margin)
+    at = np.nonzero(flip)
+    w = s0[at] / (s0[at] - s1[at])
+    z = X0[at][:, 2] + w * (X1[at][:, 2] - X0[at][:, 2])
+    flip[at] = (z > -margin) & (z < g.H + margin)
+    return flip
 
 
 # Sub-steps taken at once by `deepest_penetration`.
@@ -435,7 +439,10 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
             for f, (fname, X) in enumerate(feats.items()):
                 found = []                                  # (row, solid, depths)
                 if fname in watches:
-                    Y = np.stack([X @ Rab.T + pab for _, Rab, pab in block])
+                    if all(Rab is block[0][1] for _, Rab, _ in block):     # a translation
+                        Y = (X @ block[0][1].T)[None] + np.array([q for *_, q in block])[:, None]
+                    else:
+                        Y = np.stack([X @ Rab.T + pab for _, Rab, pab in block])
                     Yp = Y[:, on_petals[fname]]
                     s = cone_distance(g, Yp.reshape(-1, 3)).reshape(C, -1)
                     found = list(watches[fname].steps(g, Yp, s))
