@@ -254,9 +254,9 @@ def relative_poses(R_WA, p_WA, a, b):
 def sub_steps(t, R, p, reach, max_travel):
     """(t, R, p) at the first sample, then sub-steps between samples that move no point within
     ``reach`` of the origin more than ``max_travel``."""
-    yield t[0], R[0], p[0]
+    R0 = R[0]
+    yield t[0], R0, p[0]
     for n in range(1, len(t)):
-        R0 = R[n - 1]
         turned = not np.array_equal(R0, R[n])       # else the sub-steps keep R0 (one object)
         r = _rotvec(R0.T @ R[n]) if turned else np.zeros(3)
         travel = np.linalg.norm(p[n] - p[n - 1]) + np.linalg.norm(r) * reach
@@ -264,6 +264,7 @@ def sub_steps(t, R, p, reach, max_travel):
         for f in np.arange(1, m + 1) / m:
             yield (t[n - 1] + (t[n] - t[n - 1]) * f, R0 @ rot_vec(f * r) if turned else R0,
                    p[n - 1] + f * (p[n] - p[n - 1]))
+        R0 = R[n] if turned else R0
 
 
 @dataclasses.dataclass

@@ -223,7 +223,7 @@ class _Gaps:
         at ``best`` (or found by a march), a march whose next sub-step starts below
         best - 1e-9 cannot add to the closing pairs (`_first_contact`) and stops. Returns
         {j: lam} of the closings found; a march that ends without one leaves its side at
-        grid[k + 1]."""
+        grid[k + 1] (a stopped one leaves none: the search ends on this step)."""
         hi, lo = self.grid[k], self.grid[k + 1]
         runs, heap, roots, taken = {}, [], {}, dict.fromkeys(js, 0)
         for j in js:

@@ -221,3 +221,31 @@ def test_a_point_crossing_the_cone_next_to_the_tip_height(geom, z):
     found = _same(geom, *_moved([0.0] * 3, [0.0, 0.002, 0.004]), NAMES,
                   features={"guide side 1": P})
     assert (found.depth > 1e-4) == (z > 0)
+
+
+@pytest.mark.parametrize("quiet", [0, 63])
+def test_a_crossing_just_inside_a_side_edge_turned_into_the_gap(geom, quiet):
+    """A point 0.5 mm off petal 1, 3 deg inside guide side 1, held for ``quiet`` rows, then
+    in one sub-step turned 7 deg into the gap while it drops 4 mm, and turned back: it crosses
+    the cone over the plate near the start of that sub-step (the crossing, interpolated from
+    the sub-step's two places, lies over the petal, the end does not)."""
+    z = 0.1
+    th = float(pen._inset(geom, np.array([z]))[0]) + math.radians(3.0)
+    r = geom.R - z / math.tan(geom.alpha1) + 0.5e-3 / math.sin(geom.alpha1)
+    X = np.array([[r * math.cos(th), r * math.sin(th), z]])
+    turn = [0.0] * (quiet + 1) + [math.radians(-7.0), 0.0]
+    heights = [0.0] * (quiet + 1) + [-0.004, -0.004]
+    found = _same(geom, *_moved(heights, turn=turn), NAMES, features={"guide side 1": X},
+                  max_travel=10.0)
+    assert found.depth > 1e-3
+
+
+def test_a_crossing_at_the_tip_height_within_the_plates_tolerance(geom):
+    """A point pushed through the cone 5e-10 m above the tip height (over the plate by its
+    1e-9 tolerance, `_over`), then lowered 5 mm."""
+    th, z = math.radians(30.0), geom.H + 5e-10
+    r = geom.R - z / math.tan(geom.alpha1) + 1e-3
+    X = np.array([[r * math.cos(th), r * math.sin(th), z]])
+    found = _same(geom, *_moved([0.0, 0.0, -0.005], [0.0, -0.004, -0.004]), NAMES,
+                  features={"guide side 1": X}, graze=0.0)
+    assert found.depth > 1e-3

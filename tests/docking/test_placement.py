@@ -328,8 +328,9 @@ def test_lockstep_marches_find_the_full_marches_closings(seed):
     """On the first contact's step of approaches where marches close, the lockstep marches
     (`_Gaps.marches`, stopped once a march's next sub-step starts 1e-9 below the best closing)
     against each march run over the whole step alone (`march_root`): with no closing known,
-    with the best given at the first contact, and with one given below every march's
-    closing, the closings within 1e-9 of the first contact are found, each equal."""
+    with the best given at the first contact or 5e-10 above it, and with one given below
+    every march's closing, the closings within 1e-9 of the first contact are found, each
+    equal, in no more seeks."""
     g = ApdsGeometry()
     approach = _random_approach(np.random.default_rng(seed))
     lam_c = first_contact(g, approach, which="complete")[0]
@@ -341,15 +342,18 @@ def test_lockstep_marches_find_the_full_marches_closings(seed):
     marched = [j for j in np.flatnonzero(touch[:, k])
                if not (0 < gaps.gap(j, k) < np.inf and gaps.gap(j, k + 1) <= 0)
                and abs(gaps.distance(j, k)) < grid[k] - grid[k + 1]]
-    full = {}
+    full, full_seeks = {}, 0
     for j in marched:
-        lam = march_root(pairs[j], approach, grid[k], gaps.at[(j, k)], grid[k + 1],
-                         (grid[k] - grid[k + 1]) / MARCH_SUBSTEPS, 1e-13)[0]
+        lam, _, seeks = march_root(pairs[j], approach, grid[k], gaps.at[(j, k)], grid[k + 1],
+                                   (grid[k] - grid[k + 1]) / MARCH_SUBSTEPS, 1e-13)
+        full_seeks += seeks
         if lam is not None:
             full[j] = lam
     assert full and max(full.values()) == lam_c
     must = {j for j, lam in full.items() if lam >= lam_c - 1e-9}
-    for best in (None, lam_c, min(full.values()) - 1e-4):
-        found = search._Gaps(pairs, approach, grid).marches(marched, k, 1e-13, best)
+    for best in (None, lam_c, lam_c + 5e-10, min(full.values()) - 1e-4):
+        lockstep = search._Gaps(pairs, approach, grid)
+        found = lockstep.marches(marched, k, 1e-13, best)
         assert must <= set(found)
         assert all(found[j] == full[j] for j in found)
+        assert lockstep.seeks - sum(1 for key in lockstep.at if key[1] == k) <= full_seeks
