@@ -295,9 +295,13 @@ def march_steps(pair, approach, hi, start, lo, floor, xtol):
             return root, None, seeks + more
         if np.isfinite(g) and g > TOUCH_GAP and np.isfinite(g2):
             if g2 <= 0 and abs(d2) > TOUCH_GAP:
+                calls = []
+
                 def f(x, ref=ref):
+                    calls.append(x)
                     return _seek(pair, approach, x, ref)[0]
-                return brentq(f, nxt, lam, xtol=xtol, rtol=1e-15), None, seeks
+                root = brentq(f, nxt, lam, xtol=xtol, rtol=1e-15)
+                return root, None, seeks + len(calls)
             if abs(d2) <= TOUCH_GAP:
                 root, more = _touch(pair, approach, lam, nxt, ref)
                 return root, None, seeks + more
