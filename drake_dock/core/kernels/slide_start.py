@@ -61,8 +61,15 @@ def _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, th, ome
     if st != OK:
         return st, 0.0
     accelerations(W, bias, vdot, gdd, at)
+    return OK, _slip_angle(dirs, at, i)
+
+
+@njit(cache=True)
+def _slip_angle(dirs, at, i):
+    """`constraints.slip_angle` of couple i: the angle from its direction to its tangential
+    acceleration."""
     s0, s1, a0_, a1 = dirs[i, 0], dirs[i, 1], at[i, 0], at[i, 1]
-    return OK, math.atan2(s0 * a1 - s1 * a0_, s0 * a0_ + s1 * a1)
+    return math.atan2(s0 * a1 - s1 * a0_, s0 * a0_ + s1 * a1)
 
 
 @njit(cache=True)
@@ -80,9 +87,8 @@ def _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting,
     accelerations(W, bias, vdot, gdd, at)
     for c in range(2):
         i = starting[c]
-        s0, s1, a0_, a1 = dirs[i, 0], dirs[i, 1], at[i, 0], at[i, 1]
-        r[c] = (math.atan2(s0 * a1 - s1 * a0_, s0 * a0_ + s1 * a1) if angle
-                else s0 * a1 - s1 * a0_)
+        r[c] = (_slip_angle(dirs, at, i) if angle
+                else dirs[i, 0] * at[i, 1] - dirs[i, 1] * at[i, 0])
     return OK
 
 
