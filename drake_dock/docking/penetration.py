@@ -40,6 +40,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
+from drake_dock.docking.cone_reach import watched_on_translation
 from drake_dock.docking.rotations import rot_vec
 
 PETAL_FEATURES = ("ring inside circle", "guide side", "petal")     # name prefixes
@@ -355,15 +356,16 @@ class _PetalWatch:
             busy |= (np.sign(s[start:]) * np.sign(prev) < 0).any(axis=1)
         busy[1:] |= on[:-1]
         busy[0] |= bool((self.s == 0.0).any())
-        skipped = None
+        skipped, held = None, self.crossed.any()
         for c in range(start, len(s)):
-            if not busy[c - start] and not self.crossed.any():
+            if not busy[c - start] and not held:
                 skipped = c
                 continue
             if skipped == c - 1:
                 self.X, self.s = X[skipped], s[skipped]
             for found in self.step(g, X[c], s[c]):
                 yield (c, *found)
+            held = self.crossed.any()
         if skipped == len(s) - 1:
             self.X, self.s = X[skipped], s[skipped]
 
@@ -422,7 +424,9 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
     1 mm travel; a real slicing of the plate is seen by the feature's points further in).
     With ``sparse`` (a path on which few sub-steps cross a petal: an approach, not a contact
     sliding on one) the sub-steps where a crossing lies over a petal are found for a whole
-    block at once and only those are stepped; the result is the same."""
+    block at once and only those are stepped; on a translation (one rotation at every
+    sample) only the points whose path can cross a petal's plate are watched
+    (`drake_dock.docking.cone_reach`). The result is the same."""
     feats = feature_points(g) if features is None else features
     reach = max(float(np.linalg.norm(X, axis=1).max()) for X in feats.values())
     best, rank = Penetration(), None
@@ -433,13 +437,30 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
         watches = {f: _PetalWatch(tuple(f"{names[b]} petal {k}" for k in (1, 2, 3)), edges,
                                   graze, sparse=sparse)
                    for f in feats if f.startswith(PETAL_FEATURES)}
+        moved = {}      # a translation: {feature: (X R^T, the watched points that can cross)}
+        if sparse and all(np.array_equal(R[0], R_n) for R_n in R[1:]):
+            for fname, X in feats.items():
+                XR = X @ R[0].T
+                Xw = XR[on_petals[fname]] if fname in watches else XR[:0]
+                if len(Xw):
+                    Xw = Xw[watched_on_translation(g, Xw, p, max_travel)]
+                moved[fname] = XR, Xw
         row0 = 0
         for block in _blocks(sub_steps(t, R, p, reach, max_travel), BLOCK):
             C = len(block)
             Rz, pz = np.array([Rab[2] for _, Rab, _ in block]), np.array([q[2] for *_, q in block])
             for f, (fname, X) in enumerate(feats.items()):
                 found = []                                  # (row, solid, depths)
-                if fname in watches:
+                Y = None
+                if fname in moved:          # the same sums as below, on fewer points
+                    XR, Xw = moved[fname]
+                    shift = np.array([q for *_, q in block])
+                    if len(Xw):
+                        Yp = Xw[None] + shift[:, None]
+                        s = cone_distance(g, Yp.reshape(-1, 3)).reshape(C, -1)
+                        found = list(watches[fname].steps(g, Yp, s))
+                    low = XR[:, 2].min() + shift[:, 2] - 1e-9
+                elif fname in watches:
                     if all(Rab is block[0][1] for _, Rab, _ in block):     # a translation
                         Y = (X @ block[0][1].T)[None] + np.array([q for *_, q in block])[:, None]
                     else:
@@ -450,7 +471,6 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
                     low = Y[:, :, 2].min(axis=1)
                 else:           # the ring's solid lies below its face: only rows reaching it
                     low = (X @ Rz.T + pz).min(axis=0) - 1e-9
-                    Y = None
                 if fname.startswith(RING_FEATURES):
                     rows = np.flatnonzero(low < 0.0)
                     if Y is None and len(rows):

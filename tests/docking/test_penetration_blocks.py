@@ -14,7 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from drake_dock.docking import penetration as pen
+from drake_dock.docking import cone_reach, penetration as pen
 from drake_dock.docking.rotations import rot_vec
 from drake_dock.docking.scene import Approach
 
@@ -142,6 +142,18 @@ def test_an_approach_through_the_petals(geom):
     heights = np.linspace(1.2 * geom.H, 0.5 * geom.H, 4)
     found = _same(geom, *_approach(7.0, 0.0, 0.0, heights), NAMES, graze=1e-6)
     assert found.depth > 1e-3                            # the path does cross a petal
+
+
+def test_a_slanted_approach_through_the_petals(geom):
+    """A translation down and sideways: with ``sparse`` only the points whose path can cross
+    a petal are watched (`cone_reach`), most of them are not, and the result is the same."""
+    t, R, p = _approach(3.0, 0.02, 0.03, [0.5 * geom.H, 0.3 * geom.H, 0.2 * geom.H])
+    p[:, 1, :2] += np.array([[0.0, 0.0], [-0.012, 0.005], [-0.02, 0.008]])
+    X = np.concatenate([v for k, v in pen.feature_points(geom).items()
+                        if k.startswith(pen.PETAL_FEATURES)])
+    kept = cone_reach.watched_on_translation(geom, X @ R[0, 1].T, p[:, 1], 1e-3)   # chaser's
+    assert 0 < kept.sum() < 0.5 * len(X)
+    assert _same(geom, t, R, p, NAMES, graze=1e-6).depth > 1e-3
 
 
 def test_an_approach_through_the_rings(geom):
