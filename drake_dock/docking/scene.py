@@ -150,56 +150,19 @@ def _consistent_height(mismatch, s_max, cells=46):
     grid of ``cells`` intervals. The first contact h_c jumps where it passes from one pair or
     feature to another, so the bracket may close on a jump instead of a root: the path at the
     jump is taken, and the ring centre at first contact then misses the offset by
-    |mismatch(s)| |v_lateral| / chaser_speed (`InitialState.contact_offset`). A jump is seen
-    before the bracket closes (`_Jumps`) and not bisected further. None where no grid interval
-    changes sign."""
-    mismatch = _Jumps(mismatch)
+    |mismatch(s)| |v_lateral| / chaser_speed (`InitialState.contact_offset`). None where no
+    grid interval changes sign."""
     try:
-        try:
-            return brentq(mismatch, 0.0, s_max, xtol=1e-10)
-        except ValueError:                              # no sign change over the range
-            pass
-        grid = np.linspace(0.0, s_max, cells + 1)
-        f_above = mismatch(grid[cells])                 # scanned from the top, evaluated lazily
-        for k in range(cells - 1, -1, -1):
-            f_k = mismatch(grid[k])
-            if f_k == 0.0:
-                return float(grid[k])
-            if f_k * f_above < 0:
-                return brentq(mismatch, grid[k], grid[k + 1], xtol=1e-10)
-            f_above = f_k
-        return None
-    except _Jump as jump:
-        return jump.s
-
-
-# Two mismatches of opposite signs closer than JUMP_WIDTH (m) and differing by more than
-# JUMP_RATE times their distance lie across a jump of the first contact (`_Jumps`).
-JUMP_WIDTH = 1e-4
-JUMP_RATE = 100.0
-
-
-class _Jump(Exception):
-    def __init__(self, s):
-        super().__init__(s)
-        self.s = s
-
-
-class _Jumps:
-    """``mismatch`` (s -> h_c(aim(s)) - s) with its values kept: where a value and an earlier one
-    of the opposite sign lie closer than `JUMP_WIDTH` and differ by more than `JUMP_RATE` times
-    their distance, the first contact jumps between them (its height changes by more than
-    JUMP_RATE times the aim's travel), and raises `_Jump` with the one of the two of least
-    |mismatch|. The bracket would close on that jump by bisection to 1e-10 m, about 20
-    searches more; a root is never that steep (a rate below JUMP_RATE)."""
-
-    def __init__(self, mismatch):
-        self.mismatch, self.seen = mismatch, []
-
-    def __call__(self, s):
-        f = self.mismatch(s)
-        for s2, f2 in self.seen:
-            if f * f2 < 0 and abs(s - s2) < JUMP_WIDTH and abs(f - f2) > JUMP_RATE * abs(s - s2):
-                raise _Jump(s if abs(f) <= abs(f2) else s2)
-        self.seen.append((s, f))
-        return f
+        return brentq(mismatch, 0.0, s_max, xtol=1e-10)
+    except ValueError:                                  # no sign change over the range
+        pass
+    grid = np.linspace(0.0, s_max, cells + 1)
+    f_above = mismatch(grid[cells])                     # scanned from the top, evaluated lazily
+    for k in range(cells - 1, -1, -1):
+        f_k = mismatch(grid[k])
+        if f_k == 0.0:
+            return float(grid[k])
+        if f_k * f_above < 0:
+            return brentq(mismatch, grid[k], grid[k + 1], xtol=1e-10)
+        f_above = f_k
+    return None

@@ -223,59 +223,13 @@ def test_the_fixed_point_is_a_root_or_the_jump_the_bracket_closes_on():
     """`_consistent_height` on hand-made mismatches: a root where there is one (to xtol), the
     jump where the function jumps across zero, the largest sign change of the grid where the
     whole range has none, and None where nothing changes sign."""
-    from drake_dock.docking.scene import JUMP_WIDTH, _consistent_height
+    from drake_dock.docking.scene import _consistent_height
     assert _consistent_height(lambda s: 0.3 - 2.0 * s, 0.45) == pytest.approx(0.15, abs=1e-9)
     jump = _consistent_height(lambda s: 0.1 if s < 0.2 else -0.05, 0.45)
-    assert 0.2 <= jump < 0.2 + JUMP_WIDTH                  # the side of least |mismatch|
+    assert jump == pytest.approx(0.2, abs=1e-9)
     inner = _consistent_height(lambda s: (s - 0.1) * (s - 0.3), 0.45)   # + - + over the range
     assert inner == pytest.approx(0.3, abs=1e-9)
     assert _consistent_height(lambda s: 1.0 + s, 0.45) is None
-
-
-@pytest.mark.parametrize("rate", [1.0, 30.0, 99.0])
-def test_a_root_less_steep_than_the_jump_rate_is_brentqs(rate):
-    """A root of slope below `JUMP_RATE`, straight or curved: the same bits as brentq alone."""
-    from drake_dock.docking.scene import _consistent_height
-    for mismatch in (lambda s: rate * (0.17 - s), lambda s: math.tanh(rate * (0.23 - s))):
-        assert _consistent_height(mismatch, 0.45) == brentq(mismatch, 0.0, 0.45, xtol=1e-10)
-
-
-def test_a_jump_is_seen_only_across_zero_and_only_when_narrow_and_steep():
-    """`_Jumps` on values set by hand: a step that keeps its sign, a change of sign wider than
-    `JUMP_WIDTH` or less steep than `JUMP_RATE`, and one that is a jump."""
-    from drake_dock.docking.scene import JUMP_RATE, JUMP_WIDTH, _Jump, _Jumps
-    w = 0.5 * JUMP_WIDTH
-    values = {0.1: 1.0, 0.1 + 1e-6: 0.5, 0.2: -0.2 * JUMP_RATE * w, 0.2 + w: 0.6 * JUMP_RATE * w,
-              0.3: 0.3, 0.3 + 2 * JUMP_WIDTH: -0.3}
-    watch = _Jumps(values.__getitem__)
-    for s in values:
-        watch(s)                                        # none of them is a jump
-    with pytest.raises(_Jump) as jump:
-        watch.seen = [(0.2, -1.0)]
-        values[0.2 + 1e-6] = 0.5
-        watch(0.2 + 1e-6)
-    assert jump.value.s == 0.2 + 1e-6                   # |0.5| < |-1.0|
-
-
-@pytest.mark.parametrize("size", [1e-3, 3e-2])
-def test_a_jump_is_left_when_its_bracket_is_narrower_than_the_jump_allows(size):
-    """A jump of ``size`` across zero at s = 0.3 (the mismatch's slope -1 on either side, as a
-    first contact that does not move with the aim): the bracket closes on it to within
-    size / JUMP_RATE, not 1e-10 m, in fewer evaluations than brentq to 1e-10 m takes; the side
-    returned is the one of least |mismatch|."""
-    from drake_dock.docking.scene import JUMP_RATE, _consistent_height
-    calls = []
-
-    def mismatch(s):
-        calls.append(s)
-        return (0.3 - s) + (0.25 * size if s < 0.3 else -0.75 * size)
-
-    got = _consistent_height(mismatch, 0.45)
-    n = len(calls)
-    calls.clear()
-    brentq(mismatch, 0.0, 0.45, xtol=1e-10)
-    assert 0.3 - 0.25 * size <= got < 0.3 + size / JUMP_RATE and n < len(calls) - 5
-    assert mismatch(got) > 0                                    # |0.25 size| < |-0.75 size|
 
 
 def _eager_grid_height(mismatch, s_max, cells=46):
