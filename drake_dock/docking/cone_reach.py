@@ -60,9 +60,11 @@ def may_cross(g, A, D, margin, tol=REACH_TOL):
 def watched_on_translation(g, XR, p, max_travel):
     """Which of the points XR (M, 3) of one APDS, posed in the other's frame at the samples n by
     the translations p[n] (N, 3), can cross a petal's plate between two sub-steps. A crossing
-    lies linearly between two sub-steps at most ``max_travel`` apart, so within 2 max_travel of
-    a height where the point's path meets the cone (s is 1-Lipschitz): the band is widened by
-    that."""
+    is interpolated on the chord between two sub-steps at most ``max_travel`` apart, where the
+    interpolated foot's height is the chord's; the path changes side of the cone on that
+    chord, so the crossing's height lies within max_travel of a height where the path meets
+    the cone (a point held exactly on the cone keeps its last place, and the sub-steps it is
+    held at lie on the cone too). The band is widened by 2 max_travel."""
     keep = np.zeros(len(XR), dtype=bool)
     for n in range(1, len(p)):
         keep |= may_cross(g, XR + p[n - 1], np.broadcast_to(p[n] - p[n - 1], XR.shape).copy(),

@@ -156,6 +156,33 @@ def test_a_slanted_approach_through_the_petals(geom):
     assert _same(geom, t, R, p, NAMES, graze=1e-6).depth > 1e-3
 
 
+def test_a_point_moved_sideways_then_down_through_a_petal(geom):
+    """Two segments of a translation in different directions (sideways along x, then down):
+    each is tested for the cone on its own, and the crossing of the second is kept."""
+    th, z = math.radians(30.0), 0.1
+    r = geom.R - z / math.tan(geom.alpha1) + 2e-3 / math.sin(geom.alpha1)
+    P = np.array([[r * math.cos(th), r * math.sin(th), z]])
+    found = _same(geom, *_moved([0.0, 0.0, -0.01], [0.0, 0.004, 0.004]), NAMES,
+                  features={"guide side 1": P})
+    assert found.depth > 2e-3
+
+
+def test_a_crossing_above_the_tip_height_reached_within_a_long_sub_step(geom):
+    """Sub-steps of 6.65 mm: a point crosses the cone 5 um above the tip height on its path,
+    and the crossing interpolated between the two sub-steps around it lies over the plate,
+    65 um deep: the points watched on a translation are those whose path meets the cone
+    within 2 max_travel of the petals' heights."""
+    th, z = math.radians(30.0), geom.H + 5e-6
+    r = geom.R - z / math.tan(geom.alpha1)
+    P0 = np.array([r * math.cos(th), r * math.sin(th), z])
+    D = 6.65e-3 * np.array([-math.sin(th), math.cos(th), 0.0]) + np.array([0.0, 0.0, -1.7e-4])
+    t, R, p = np.array([0.0, 1.0]), np.tile(np.eye(3), (2, 2, 1, 1)), np.zeros((2, 2, 3))
+    p[1, 1] = -D
+    found = _same(geom, t, R, p, NAMES, features={"guide side 1": (P0 - 0.3 * D)[None]},
+                  max_travel=7e-3, graze=0.0)
+    assert found.depth > 5e-5
+
+
 def test_an_approach_through_the_rings(geom):
     found = _same(geom, *_approach(30.0, 0.03, 0.02, np.linspace(0.06, -0.03, 3), 0.02),
                   NAMES, graze=0.0)
