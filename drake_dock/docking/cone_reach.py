@@ -15,8 +15,10 @@ import numpy as np
 REACH_TOL = 1e-7
 
 
-def _cone_distance(g, Y):
-    return (np.hypot(Y[:, 0], Y[:, 1]) - g.R) * math.sin(g.alpha1) + Y[:, 2] * math.cos(g.alpha1)
+def cone_distance(g, X):
+    """Signed distance s of points X (M, 3) to the cone of Eq. (12), positive away from the
+    axis: the same for the three petals."""
+    return (np.hypot(X[:, 0], X[:, 1]) - g.R) * math.sin(g.alpha1) + X[:, 2] * math.cos(g.alpha1)
 
 
 def cone_extremes(g, A, D, lo, hi):
@@ -26,7 +28,7 @@ def cone_extremes(g, A, D, lo, hi):
     t = -sign(c) |c| h / sqrt(|Q|^2 (sin^2(alpha1) |Q|^2 - c^2)); where sin^2(alpha1) |Q|^2
     <= c^2 the norm's slope cannot cancel c and s is monotone."""
     sa, ca = math.sin(g.alpha1), math.cos(g.alpha1)
-    s_lo, s_hi = (_cone_distance(g, A + f[:, None] * D) for f in (lo, hi))
+    s_lo, s_hi = (cone_distance(g, A + f[:, None] * D) for f in (lo, hi))
     least = np.minimum(s_lo, s_hi)
     Q2 = (D[:, :2] ** 2).sum(axis=1)
     c = D[:, 2] * ca
@@ -37,7 +39,7 @@ def cone_extremes(g, A, D, lo, hi):
         h = np.hypot(*(A_t[:, :2] + f0[:, None] * D_t[:, :2]).T)
         t = -np.sign(c_t) * np.abs(c_t) * h / np.sqrt(Q2_t * (sa * sa * Q2_t - c_t * c_t))
         f = np.clip(f0 + t, lo[turn], hi[turn])
-        least[turn] = np.minimum(least[turn], _cone_distance(g, A_t + f[:, None] * D_t))
+        least[turn] = np.minimum(least[turn], cone_distance(g, A_t + f[:, None] * D_t))
     return least, np.maximum(s_lo, s_hi)
 
 

@@ -40,7 +40,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from drake_dock.docking.cone_reach import watched_on_translation
+from drake_dock.docking.cone_reach import cone_distance, watched_on_translation
 from drake_dock.docking.rotations import rot_vec
 
 PETAL_FEATURES = ("ring inside circle", "guide side", "petal")     # name prefixes
@@ -95,12 +95,6 @@ def feature_points(g, *, n_circle=1440, n_side=80, n_arc=60, n_face=9):
         out[f"petal {k} tip arc"] = np.stack([r_tip * np.cos(t), r_tip * np.sin(t),
                                               np.full_like(t, g.H)], -1)
     return out
-
-
-def cone_distance(g, X):
-    """Signed distance s of points X (M, 3) to the cone of Eq. (12), positive away from the
-    axis: the same for the three petals."""
-    return (np.hypot(X[:, 0], X[:, 1]) - g.R) * math.sin(g.alpha1) + X[:, 2] * math.cos(g.alpha1)
 
 
 def petal_coordinates(g, X, k):
