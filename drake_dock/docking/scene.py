@@ -85,11 +85,12 @@ def initial_state(scenario) -> InitialState:
 def contact_approach(scenario):
     """The scenario's straight approach and its first contact: (Approach, lam_c, closing
     pairs of the scenario's contact set; lam_c = 0 and none where no pair closes and the ring
-    faces meet first). The lateral offset is the ring centre's at first
-    contact. With a lateral velocity
-    the aim point (where the path meets the target's ring-face plane) is
+    faces meet first). The lateral offset is the ring centre's at first contact. With a
+    lateral velocity the aim point (where the path meets the target's ring-face plane) is
     aim = offset + s v_lateral / chaser_speed, where s, the ring-face distance at contact, solves
-    s = h_c(aim(s)) (brentq to 1e-10 m; `_consistent_height`)."""
+    s = h_c(aim(s)). Its first try is `_axial_height`, the highest s any solution can have,
+    taken where |h_c(aim(s)) - s| <= `AIM_TOL`; otherwise brentq to 1e-10 m
+    (`_consistent_height`)."""
     ic = scenario.initial
     g = scenario.geometry
     which = scenario.contact.pairs
@@ -109,7 +110,9 @@ def contact_approach(scenario):
 
     s = 0.0
     if slope.any():
-        s = _consistent_height(mismatch, 2.0 * g.H + 0.05)
+        s = _axial_height(g, Approach(yaw, tilt, tuple(offset.tolist())), which)
+        if not abs(mismatch(s)) <= AIM_TOL:
+            s = _consistent_height(mismatch, 2.0 * g.H + 0.05)
         if s is None:
             raise NoPairCloses(
                 f"no straight approach at initial.lateral_velocity {ic.lateral_velocity} m/s "
@@ -123,6 +126,19 @@ def contact_approach(scenario):
         check_path_to_contact(g, a, travel_grid(g, a)[0], lam_c,
                               line=not _isolated(g, a, lam_c, closing))
     return a, lam_c, closing
+
+
+# The consistent aim's tolerance on h_c(aim(s)) - s (m; `contact_approach`): brentq's xtol.
+AIM_TOL = 1e-10
+
+
+def _axial_height(g: ApdsGeometry, axial: Approach, which) -> float:
+    """The ring-face distance at which the chaser, lowered along the docking axis with its ring
+    centre over the offset (``axial``), first touches the target APDS (0 where the faces meet
+    first). Above it the chaser touches nothing there, so no straight approach can have its
+    first contact with the ring centre at the offset higher up: where the approach through
+    this pose first touches at it, it is the highest solution of the consistent aim."""
+    return axial.height(first_contact_or_faces(g, axial, which)[0])
 
 
 def _isolated(g: ApdsGeometry, approach: Approach, lam: float, names) -> bool:

@@ -1,0 +1,66 @@
+"""The consistent aim of a lateral approach (`contact_approach`): the straight path whose first
+contact has the chaser's ring centre at `initial.lateral_offset`. Where several paths do, the
+placement takes the highest: the one whose contact is where the chaser, lowered along the axis
+over the offset, first touches. Checked against the full scan of every pair (the first
+contact), the independent interpenetration check (nothing is crossed above it on the axis)
+and the whole-range bracket, which finds another, lower solution."""
+import math
+
+import numpy as np
+import pytest
+
+from drake_dock.docking.penetration import deepest_penetration
+from drake_dock.docking.scenario import load_scenario
+from drake_dock.docking.scene import (Approach, _consistent_height, contact_approach,
+                                      first_contact_or_faces, travel_grid)
+from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
+from tests.docking.test_placement import full_scan
+
+
+def _condition(name):
+    base = load_scenario()
+    base.contact.pairs = "complete"
+    return with_condition(base, dict(conditions(ConditionsPlan(random=60, corners=16)))[name])
+
+
+def _depth_down_to(g, approach, lam):
+    """The deepest crossing (1 um grazing) on the straight path from the search's start down
+    to lam."""
+    (R0, p0), (R1, p1) = approach.pose(travel_grid(g, approach)[0]), approach.pose(lam)
+    eye, zero = np.eye(3), np.zeros(3)
+    return deepest_penetration(g, np.array([0.0, 1.0]), np.array([[eye, R0], [eye, R1]]),
+                               np.array([[zero, p0], [zero, p1]]), ("target", "chaser"),
+                               graze=1e-6).depth
+
+
+@pytest.mark.parametrize("name", ["corner 4", "random 39"])
+def test_the_consistent_aim_is_the_highest_solution(name):
+    s = _condition(name)
+    g, ic = s.geometry, s.initial
+    a, lam, closing = contact_approach(s)
+    h = a.height(lam)
+    offset = np.array(ic.lateral_offset)
+    slope = np.array(ic.lateral_velocity) / ic.chaser_speed
+    # Consistent: the path passes the offset at its first contact's height, and that contact
+    # is the full scan's.
+    np.testing.assert_allclose(np.array(a.aim) - h * slope, offset, rtol=0, atol=1e-10)
+    lam_scan, names, _ = full_scan(g, a, which="complete")
+    assert lam == lam_scan and closing == names
+    # Highest: lowered along the axis over the offset, the chaser reaches the placed pose
+    # crossing nothing (so no pose above it on that line touches, and no higher solution
+    # exists).
+    yaw, tilt = math.radians(ic.target_yaw_deg), tuple(math.radians(t) for t in ic.tilt_deg)
+    axial = Approach(yaw, tilt, tuple(offset.tolist()))
+    for placed, lowered in zip(a.pose(lam), axial.pose(h)):
+        np.testing.assert_allclose(placed, lowered, rtol=0, atol=1e-12)
+    assert _depth_down_to(g, axial, h) <= 1e-9
+
+    def aimed(x):
+        return Approach(yaw, tilt, tuple((offset + x * slope).tolist()), a.direction)
+
+    def mismatch(x):
+        return aimed(x).height(first_contact_or_faces(g, aimed(x), "complete")[0]) - x
+
+    # The whole-range bracket closes on another solution, more than 1 cm lower.
+    lower = _consistent_height(mismatch, 2.0 * g.H + 0.05)
+    assert lower < h - 0.01 and abs(mismatch(lower)) <= 1e-9
