@@ -253,6 +253,8 @@ class _Gaps:
 MARCH_SUBSTEPS = 256
 # Two features touch below this distance, their couple interior or not (m, `march_root`).
 TOUCH_GAP = 1e-9
+# The longest sub-step of a march through features that cut each other, in floors.
+CUT_FLOORS = 16
 
 
 def march_root(pair, approach, hi, start, lo, floor, xtol):
@@ -262,7 +264,9 @@ def march_root(pair, approach, hi, start, lo, floor, xtol):
     meeting a guide surface next to its edge leaves the domain as its gap reaches 0, since past
     it the circle cuts the surface). ``start`` = (gap, direction, distance) at hi. The chaser
     translates along the approach, so features a distance D apart cannot touch within a travel
-    of D: each sub-step is max(D, ``floor``), the side continued. From an interior gap above
+    of D: each sub-step is max(D, ``floor``), the side continued; while the features cut each
+    other (D within `TOUCH_GAP`) it doubles up to `CUT_FLOORS` floors, the side continued from
+    before the cut. From an interior gap above
     `TOUCH_GAP`, the pair closes where the gap turns below -`TOUCH_GAP` (brentq) or where
     it falls into +-`TOUCH_GAP` (the circle cutting the surface: the first point within
     `TOUCH_GAP`, bisected to 1e-12 of the travel, `_touch`; a seek that fails next to the
@@ -281,10 +285,13 @@ def march_root(pair, approach, hi, start, lo, floor, xtol):
 def march_steps(pair, approach, hi, start, lo, floor, xtol):
     """`march_root` one sub-step at a time: yields the travel each sub-step starts from;
     its return value (`StopIteration.value`) is `march_root`'s."""
-    lam, (g, ref, dist), seeks = hi, start, 0
+    lam, (g, ref, dist), seeks, cut = hi, start, 0, 0
     while lam > lo:
         yield lam
-        nxt = max(lam - max(abs(dist), floor), lo)
+        # While the features cut each other no closing can start: the sub-step doubles, up
+        # to `CUT_FLOORS` floors (a separation and closing inside it are not seen).
+        cut = cut + 1 if abs(dist) <= TOUCH_GAP else 0
+        nxt = max(lam - max(abs(dist), floor * min(2 ** max(cut - 1, 0), CUT_FLOORS)), lo)
         seeks += 1
         try:
             g2, ref2, d2 = _seek(pair, approach, nxt, ref)
@@ -305,7 +312,8 @@ def march_steps(pair, approach, hi, start, lo, floor, xtol):
             if abs(d2) <= TOUCH_GAP:
                 root, more = _touch(pair, approach, lam, nxt, ref)
                 return root, None, seeks + more
-        lam, g, ref, dist = nxt, g2, ref2, d2
+        # A cut's direction is round-off: the side is continued from before the cut.
+        lam, g, ref, dist = nxt, g2, ref if abs(d2) <= TOUCH_GAP else ref2, d2
     return None, (g, ref, dist), seeks
 
 
