@@ -217,7 +217,10 @@ def _slide_start_scan(Minv, a0, rows, modes, dirs, i, omega, time):
     """The direction of couple i starting to slide where the fixed point does not converge:
     a direction s(theta) along which its tangential acceleration lies, bracketed on
     `SLIDE_START_SCAN` angles around the fixed point's last direction theta0 and bisected
-    (the bracket nearest theta0); (sol, True), or (sol, False) if there is none."""
+    (the bracket nearest theta0 whose ends lie within 90 deg of s; failing that, the nearest
+    where the angle crosses zero rather than +-180 deg, `scan_brackets`: next to the stick-slip
+    transition a_t is small and turns fast with theta); (sol, True), or (sol, False) if there
+    is none."""
     dirs = list(dirs)
     th0 = math.atan2(dirs[i][1], dirs[i][0])
 
@@ -229,24 +232,35 @@ def _slide_start_scan(Minv, a0, rows, modes, dirs, i, omega, time):
     n = SLIDE_START_SCAN
     ths = [th0 + 2.0 * math.pi * (k / n - 0.5) for k in range(n + 1)]
     rs = [residual(t)[0] for t in ths]
-    best = None
-    for k in range(n):
-        if rs[k] * rs[k + 1] <= 0 and max(abs(rs[k]), abs(rs[k + 1])) < 0.5 * math.pi:
-            dist = abs(0.5 * (ths[k] + ths[k + 1]) - th0)
-            if best is None or dist < best[0]:
-                best = (dist, k)
-    if best is None:
-        return residual(th0)[1], False
-    lo, hi, flo = ths[best[1]], ths[best[1] + 1], rs[best[1]]
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        fm = residual(mid)[0]
-        if fm * flo > 0:
-            lo, flo = mid, fm
-        else:
-            hi = mid
-    sol = residual(0.5 * (lo + hi))[1]
-    return sol, bool(sol.at[i] @ dirs[i] > 0)
+    sol = None
+    for k in scan_brackets(ths, rs, th0):
+        lo, hi, flo = ths[k], ths[k + 1], rs[k]
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            fm = residual(mid)[0]
+            if fm * flo > 0:
+                lo, flo = mid, fm
+            else:
+                hi = mid
+        sol = residual(0.5 * (lo + hi))[1]
+        if sol.at[i] @ dirs[i] > 0:
+            return sol, True
+    return (residual(th0)[1] if sol is None else sol), False
+
+
+def scan_brackets(ths, rs, th0) -> list:
+    """The brackets k (ths[k], ths[k + 1]) of the slide-start scan to bisect, in order: the
+    one nearest th0 where the angle changes sign with both ends within 90 deg, then the one
+    nearest th0 where it changes sign by less than 180 deg (crossing zero, not +-180 deg)."""
+    out = []
+    for near in (lambda a, b: max(abs(a), abs(b)) < 0.5 * math.pi,
+                 lambda a, b: abs(a - b) < math.pi):
+        ks = [k for k in range(len(rs) - 1) if rs[k] * rs[k + 1] <= 0 and near(rs[k], rs[k + 1])]
+        if ks:
+            k = min(ks, key=lambda k: abs(0.5 * (ths[k] + ths[k + 1]) - th0))
+            if k not in out:
+                out.append(k)
+    return out
 
 
 def _slide_start_grid(Minv, a0, rows, modes, dirs, i_start, omega, time):

@@ -102,12 +102,26 @@ def test_a_block_on_two_points_of_a_steep_incline_slides_at_the_closed_form_rate
     assert np.abs(sol.vdot[3:]).max() < 1e-9
 
 
-def _docking_selection():
-    d = json.loads((Path(__file__).parent / "slide_start_docking.json").read_text())
+def _docking_selection(name="slide_start_docking.json"):
+    d = json.loads((Path(__file__).parent / name).read_text())
     rows = [ContactRow(r["name"], np.array(r["Wn"]), np.array(r["Wt"]), r["bn"],
                        np.array(r["bt"]), r["gap"], r["vn"], np.array(r["vt"]), r["mu"],
                        r["mu_s"]) for r in d["rows"]]
     return np.array(d["Minv"]), np.array(d["a0"]), rows, d
+
+
+def _slip_angles(Minv, a0, rows, v1, omega, th):
+    """Couple 0 sliding along each angle of th, couple 1 along v1: the angles from couple 0's
+    direction to its tangential acceleration, and whether that acceleration has a positive
+    component along it."""
+    angle, along = [], []
+    for t in th:
+        e = np.array([math.cos(t), math.sin(t)])
+        at = constraints.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), [e, v1],
+                                           omega=omega).at[0]
+        angle.append(constraints.slip_angle(e, at))
+        along.append(at @ e > 0)
+    return np.array(angle), np.array(along)
 
 
 def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_modes, monkeypatch):
@@ -124,12 +138,7 @@ def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_modes, monkey
     assert (sol.lam_n > 0).all()
     v1 = rows[1].vt / np.hypot(*rows[1].vt)
     th = np.linspace(-math.pi, math.pi, 3601)
-    res = []
-    for t in th:
-        e = np.array([math.cos(t), math.sin(t)])
-        at = constraints.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), [e, v1],
-                                           omega=d["omega"]).at[0]
-        res.append(abs(constraints.slip_angle(e, at)))
+    res = np.abs(_slip_angles(Minv, a0, rows, v1, d["omega"], th)[0])
     t_best = th[int(np.argmin(res))]
     assert min(res) < 2 * math.pi / 3600
     assert math.atan2(s[1], s[0]) == pytest.approx(t_best, abs=2 * math.pi / 3600)
@@ -196,3 +205,28 @@ def test_two_couples_at_the_stick_slip_transition_start_to_slide(select_modes):
                        avoid=[tuple(a) for a in d["avoid"]])
     assert sol.modes == (SLIDE, SLIDE) and (sol.lam_n > 0).all()
     assert np.abs(sol.at).max() <= 1e-6 * (1.0 + np.abs(sol.vdot).max())
+
+
+def test_a_start_of_sliding_next_to_the_stick_slip_transition_is_found(select_modes):
+    """A docking selection (tests/core/slide_start_steep.json): couple 0 at rest and leaving
+    stick, its sticking force 2 % outside its cone; couple 1 sliding. Sliding, couple 0's
+    tangential acceleration is small and turns fast with its direction: on the scan's grid
+    the angle between them crosses zero between neighbours more than 90 deg apart. A dense
+    sampling (20,000 angles) finds where a_t lies along s; the selection slides along it."""
+    Minv, a0, rows, d = _docking_selection("slide_start_steep.json")
+    v1 = rows[1].vt / np.hypot(*rows[1].vt)
+    stick = constraints.solve_given_modes(Minv, a0, rows, (STICK, SLIDE), [None, v1],
+                                          omega=d["omega"])
+    ratio = np.hypot(*stick.lam_t[0]) / (rows[0].mu_s * stick.lam_n[0])
+    assert 1.0 < ratio < 1.05
+    sol = select_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
+                       avoid=[tuple(a) for a in d["avoid"]])
+    assert sol.modes == (SLIDE, SLIDE) and (sol.lam_n > 0).all()
+    s = sol.dirs[0]
+    assert abs(constraints.slip_angle(s, sol.at[0])) < 1e-6 and sol.at[0] @ s > 0
+    th = np.linspace(-math.pi, math.pi, 20001)
+    angle, along = _slip_angles(Minv, a0, rows, v1, d["omega"], th)
+    res = np.where(along, angle, math.pi)
+    k = int(np.argmin(np.abs(res)))
+    assert abs(res[k]) < 1e-3
+    assert math.atan2(s[1], s[0]) == pytest.approx(th[k], abs=2 * math.pi / 20000)

@@ -159,9 +159,29 @@ def _slide_start_grid(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, startin
 
 
 @njit(cache=True)
+def _nearest_bracket(ths, rs, th0, within_quarter):
+    """`constraints.scan_brackets`' bracket of one kind: the nearest th0 where the angle
+    changes sign with both ends within 90 deg (``within_quarter``) or by less than 180 deg;
+    -1 for none."""
+    best, best_k = np.inf, -1
+    for k in range(rs.shape[0] - 1):
+        if not rs[k] * rs[k + 1] <= 0:
+            continue
+        if within_quarter:
+            near = max(abs(rs[k]), abs(rs[k + 1])) < 0.5 * math.pi
+        else:
+            near = abs(rs[k] - rs[k + 1]) < math.pi
+        if near:
+            dist = abs(0.5 * (ths[k] + ths[k + 1]) - th0)
+            if dist < best:
+                best, best_k = dist, k
+    return best_k
+
+
+@njit(cache=True)
 def _slide_start_scan(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, omega, vdot,
                       lam_n, lam_t, gf, gdd, at):
-    """`constraints._slide_start_scan` (the same scan, bracket and bisection)."""
+    """`constraints._slide_start_scan` (the same scan, brackets and bisection)."""
     th0 = math.atan2(dirs[i, 1], dirs[i, 0])
     n = ref.SLIDE_START_SCAN
     ths, rs = np.empty(n + 1), np.empty(n + 1)
@@ -171,30 +191,33 @@ def _slide_start_scan(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, omeg
                                    ths[k], omega, vdot, lam_n, lam_t, gf, gdd, at)
         if st != OK:
             return st, False
-    best, best_k = np.inf, -1
-    for k in range(n):
-        if rs[k] * rs[k + 1] <= 0 and max(abs(rs[k]), abs(rs[k + 1])) < 0.5 * math.pi:
-            dist = abs(0.5 * (ths[k] + ths[k + 1]) - th0)
-            if dist < best:
-                best, best_k = dist, k
-    if best_k < 0:
+    first = _nearest_bracket(ths, rs, th0, True)
+    second = _nearest_bracket(ths, rs, th0, False)
+    tried = False
+    for best_k in (first, second):
+        if best_k < 0 or (best_k == first and tried):
+            continue
+        tried = True
+        lo, hi, flo = ths[best_k], ths[best_k + 1], rs[best_k]
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            st, fm = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, mid,
+                                    omega, vdot, lam_n, lam_t, gf, gdd, at)
+            if st != OK:
+                return st, False
+            if fm * flo > 0:
+                lo, flo = mid, fm
+            else:
+                hi = mid
+        st, _r = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i,
+                                0.5 * (lo + hi), omega, vdot, lam_n, lam_t, gf, gdd, at)
+        if st != OK:
+            return st, False
+        if at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0:
+            return OK, True
+    if not tried:
         st, _r = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, th0,
                                 omega, vdot, lam_n, lam_t, gf, gdd, at)
         return st, False
-    lo, hi, flo = ths[best_k], ths[best_k + 1], rs[best_k]
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        st, fm = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, mid,
-                                omega, vdot, lam_n, lam_t, gf, gdd, at)
-        if st != OK:
-            return st, False
-        if fm * flo > 0:
-            lo, flo = mid, fm
-        else:
-            hi = mid
-    st, _r = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i,
-                            0.5 * (lo + hi), omega, vdot, lam_n, lam_t, gf, gdd, at)
-    if st != OK:
-        return st, False
-    return OK, at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0
+    return OK, False
 
