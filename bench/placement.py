@@ -1,13 +1,14 @@
 """What the placement (`initial_state`: the first contact of the scenario's contact set on a
 straight approach, the consistent aim with a lateral velocity, and the independent check of the
-path down to it) costs: the paper example with `complete`, and the first ``--conditions``
-random conditions of `drake-dock study conditions` (seed 2026, inside the IDSS box). Per
+path down to it) costs: the paper example, and the first ``--conditions`` conditions of
+`drake-dock study conditions` (seed 2026, inside the IDSS box; 75 for all but the first),
+with the contact set ``--pairs`` (`complete`, or `paper` as the IDSS campaign plan). Per
 placement it prints the wall time, the first-contact searches it ran (its memo's hits not
 counted) and their time, and the path check's time; then one search alone on each final
 approach (the searches' memo cleared); then the medians. A first placement loads the
 compiled kernels and is not counted.
 
-    python bench/placement.py [--conditions 12]
+    python bench/placement.py [--conditions 12] [--pairs complete|paper]
 """
 import argparse
 import time
@@ -38,14 +39,15 @@ class _Timed:
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--conditions", type=int, default=12)
+    ap.add_argument("--pairs", choices=("complete", "paper"), default="complete")
     args = ap.parse_args(argv)
     base = load_scenario(PAPER_EXAMPLE)
-    base.contact.pairs = "complete"
+    base.contact.pairs = args.pairs
     plan = conditions(ConditionsPlan())
     scene.initial_state(with_condition(base, plan[0][1]))            # kernels loaded
     cases = [("paper example", base)] + [(n, with_condition(base, c))
                                          for n, c in plan[1:1 + args.conditions]]
-    totals, checks, alone = [], [], []
+    totals, checks, alone, counts = [], [], [], []
     for name, s in cases:
         cached = search._first_contact
         cached.cache_clear()
@@ -62,6 +64,7 @@ def main(argv=None):
         scene.first_contact_or_faces(s.geometry, approach, s.contact.pairs)
         one = time.perf_counter() - t0
         totals.append(total)
+        counts.append(searches)
         checks.append(check.wall)
         alone.append(one)
         print(f"{name}: placement {1e3 * total:.0f} ms; {searches} searches "
@@ -70,6 +73,8 @@ def main(argv=None):
     print(f"median over {len(cases)}: placement {1e3 * np.median(totals):.0f} ms (fastest "
           f"{1e3 * min(totals):.0f}, slowest {1e3 * max(totals):.0f}); path check "
           f"{1e3 * np.median(checks):.0f} ms; one search {1e3 * np.median(alone):.0f} ms")
+    print(f"{counts.count(2)} of {len(cases)} placed in two searches; "
+          f"{sum(t < 0.1 for t in totals)} under 0.1 s")
 
 
 if __name__ == "__main__":
