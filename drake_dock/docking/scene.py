@@ -128,16 +128,21 @@ def contact_approach(scenario):
     return a, lam_c, closing
 
 
-# The consistent aim's tolerance on h_c(aim(s)) - s (m; `contact_approach`): brentq's xtol.
+# The consistent aim's first try is taken where |h_c(aim(s)) - s| is within this (m;
+# `contact_approach`): the ring centre at first contact then lies within AIM_TOL |slope| of the
+# offset.
 AIM_TOL = 1e-10
 
 
 def _axial_height(g: ApdsGeometry, axial: Approach, which) -> float:
     """The ring-face distance at which the chaser, lowered along the docking axis with its ring
     centre over the offset (``axial``), first touches the target APDS (0 where the faces meet
-    first). Above it the chaser touches nothing there, so no straight approach can have its
-    first contact with the ring centre at the offset higher up: where the approach through
-    this pose first touches at it, it is the highest solution of the consistent aim."""
+    first; below 0 where a pair closes past the face plane). Above it the chaser touches
+    nothing there, so no straight approach can have its first contact with the ring centre at
+    the offset higher up: where the approach through this pose first touches at it, it is the
+    highest solution of the consistent aim. (Highest as far as a closing does not depend on
+    the line the pose is reached along: a couple that becomes interior already cutting a
+    surface does not close.)"""
     return axial.height(first_contact_or_faces(g, axial, which)[0])
 
 

@@ -266,14 +266,14 @@ def march_root(pair, approach, hi, start, lo, floor, xtol):
     translates along the approach, so features a distance D apart cannot touch within a travel
     of D: each sub-step is max(D, ``floor``), the side continued; while the features cut each
     other (D within `TOUCH_GAP`) it doubles up to `CUT_FLOORS` floors, the side continued from
-    before the cut. From an interior gap above
-    `TOUCH_GAP`, the pair closes where the gap turns below -`TOUCH_GAP` (brentq) or where
-    it falls into +-`TOUCH_GAP` (the circle cutting the surface: the first point within
+    before the cut (also where the couple leaves its domain in the cut). From an interior gap
+    above `TOUCH_GAP`, the pair closes where the gap turns below -`TOUCH_GAP` (brentq) or
+    where it falls into +-`TOUCH_GAP` (the circle cutting the surface: the first point within
     `TOUCH_GAP`, bisected to 1e-12 of the travel, `_touch`; a seek that fails next to the
     touch is taken as touching there). A couple that becomes interior already cutting the
     surface (its distance within `TOUCH_GAP`: a circle that came in over an edge, which the
-    set's edge pairs, or none, model) does not close it. Returns (lam of the closing or None; (gap,
-    direction, distance) at lo; seeks taken)."""
+    set's edge pairs, or none, model) does not close it. Returns (lam of the closing or None;
+    (gap, direction, distance) at lo; seeks taken)."""
     steps = march_steps(pair, approach, hi, start, lo, floor, xtol)
     while True:
         try:
@@ -359,11 +359,12 @@ def _first_contact(geometry: tuple, approach: Approach, step, xtol, which):
     touch = touch_steps(pairs, approach, grid)
     gaps = _Gaps(pairs, approach, grid)
     for k in range(len(grid) - 1):
-        # A pair closes on the step when its gap is > 0 at grid[k] and <= 0 at grid[k + 1];
-        # otherwise a pair that comes within the step's travel is marched (`march_root`).
+        # A pair closes on the step when its gap is > `TOUCH_GAP` at grid[k] (apart, not
+        # touching or cutting) and <= 0 at grid[k + 1]; otherwise a pair that comes within the
+        # step's travel is marched (`march_root`).
         roots, travel, marched = {}, grid[k] - grid[k + 1], []
         for j in np.flatnonzero(touch[:, k]):
-            if 0 < gaps.gap(j, k) < np.inf and gaps.gap(j, k + 1) <= 0:
+            if TOUCH_GAP < gaps.gap(j, k) < np.inf and gaps.gap(j, k + 1) <= 0:
                 roots[j] = gaps.root(j, k, xtol)
             elif abs(gaps.distance(j, k)) < travel:
                 marched.append(j)

@@ -230,3 +230,31 @@ def test_a_start_of_sliding_next_to_the_stick_slip_transition_is_found(select_mo
     k = int(np.argmin(np.abs(res)))
     assert abs(res[k]) < 1e-3
     assert math.atan2(s[1], s[0]) == pytest.approx(th[k], abs=2 * math.pi / 20000)
+
+
+def test_the_scan_brackets_cross_zero_not_the_half_turn():
+    """`constraints.scan_brackets` on hand-made scans of the slip angle: a sign change through
+    +-180 deg (a_t opposite s) next to th0 is never a bracket; a steep crossing of zero (15 deg
+    to -103 deg) is, after any crossing with both ends within 90 deg; and the compiled scan's
+    choice (`_nearest_bracket`, first kind then second) is the same on 2,000 random scans with
+    ties."""
+    from drake_dock.core.kernels.slide_start import _nearest_bracket
+    ths = np.linspace(-math.pi, math.pi, 9)
+    rs = np.array([1.0, 1.0, 3.1, -3.1, 0.27, -1.8, -1.0, -1.0, -1.0])   # th0 = 0: k = 3 wraps
+    assert constraints.scan_brackets(ths, rs, 0.0) == [4]
+    rs2 = rs.copy()
+    rs2[7:] = [-0.3, 0.4]                                                  # a gentle crossing
+    assert constraints.scan_brackets(ths, rs2, 0.0) == [7, 4]
+
+    def compiled_order(ths, rs, th0):
+        first = _nearest_bracket(ths, rs, th0, True)
+        second = _nearest_bracket(ths, rs, th0, False)
+        return [k for i, k in enumerate((first, second)) if k >= 0 and not (i and k == first)]
+
+    rng = np.random.default_rng(5)
+    for _ in range(2000):
+        n = int(rng.integers(3, 40))
+        ths = np.sort(rng.uniform(-4.0, 4.0, n))
+        rs = rng.choice([-3.1, -2.0, -1.0, -0.2, 0.0, 0.2, 1.0, 2.0, 3.1], n)
+        th0 = float(rng.choice(ths))
+        assert constraints.scan_brackets(ths, rs, th0) == compiled_order(ths, rs, th0)

@@ -64,3 +64,27 @@ def test_the_consistent_aim_is_the_highest_solution(name):
     # The whole-range bracket closes on another solution, more than 1 cm lower.
     lower = _consistent_height(mismatch, 2.0 * g.H + 0.05)
     assert lower < h - 0.01 and abs(mismatch(lower)) <= 1e-9
+
+
+@pytest.mark.parametrize("name", ["random 4", "random 42"])
+def test_an_axial_pose_the_approach_does_not_first_touch_is_not_taken(name):
+    """Random 4 and 42 (a petal corner on a ring): the straight approach through the pose where
+    the chaser, lowered along the axis over the offset, first touches does not first touch
+    there (tens of micrometres away), so that pose is not the placement. The whole-range
+    bracket finds a path that passes the offset at its first contact to 1e-10 m, and that
+    contact is the full scan's."""
+    s = _condition(name)
+    g, ic = s.geometry, s.initial
+    offset = np.array(ic.lateral_offset)
+    slope = np.array(ic.lateral_velocity) / ic.chaser_speed
+    a, lam, closing = contact_approach(s)
+    yaw, tilt = math.radians(ic.target_yaw_deg), tuple(math.radians(t) for t in ic.tilt_deg)
+    axial = Approach(yaw, tilt, tuple(offset.tolist()))
+    h_axial = axial.height(first_contact_or_faces(g, axial, "complete")[0])
+    through = Approach(yaw, tilt, tuple((offset + h_axial * slope).tolist()), a.direction)
+    h_through = through.height(first_contact_or_faces(g, through, "complete")[0])
+    assert abs(h_through - h_axial) > 1e-6
+    np.testing.assert_allclose(np.array(a.aim) - a.height(lam) * slope, offset, rtol=0,
+                               atol=1e-10)
+    lam_scan, names, _ = full_scan(g, a, which="complete")
+    assert lam == lam_scan and closing == names

@@ -22,8 +22,8 @@ from drake_dock.errors import NumericalError
 
 def full_scan(g, approach, xtol=1e-13, which="paper"):
     """(lam, names, seeks) of the scan of every pair at every grid point: a pair closes on the
-    first step where its positive gap turns <= 0, or, failing that on a step it comes within
-    the step's travel of, where `march_root` closes it."""
+    first step where its gap turns from above `TOUCH_GAP` to <= 0, or, failing that on a step
+    it comes within the step's travel of, where `march_root` closes it."""
     pairs = apds_pairs(g, which)
     grid = travel_grid(g, approach)
     gaps, refs, dist = seek_gaps(pairs, approach, grid[0], [None] * len(pairs))
@@ -33,7 +33,7 @@ def full_scan(g, approach, xtol=1e-13, which="paper"):
         seeks += len(pairs)
         roots = {}
         for j in range(len(pairs)):
-            if 0 < gaps[j] < np.inf and gaps_lo[j] <= 0:
+            if search.TOUCH_GAP < gaps[j] < np.inf and gaps_lo[j] <= 0:
                 roots[pairs[j].name] = brentq(
                     lambda x, j=j: signed_gaps([pairs[j]], approach, x, [refs[j]])[0][0],
                     d_lo, d, xtol=xtol, rtol=1e-15)
@@ -266,27 +266,36 @@ def test_the_grid_fallback_evaluates_from_the_top_and_stops_at_the_first_sign_ch
 
 
 def test_a_jump_of_the_first_contact_is_placed_and_its_offset_reported():
-    """IDSS sample 15: the first contact jumps at the placement's fixed point, so no path has it
-    exactly at the requested offset: the path at the jump is taken, and the ring centre's offset
-    at first contact (`contact_offset`, in summary.json) is reported, millimetres away. Checked
-    afresh: the chosen path's first contact is the full scan's, the offset is the path's
-    lateral position at that contact's height, and its distance from the requested one is
-    |h_c - s| |lateral_velocity| / chaser_speed (docs/model.md), s the height the path was
-    aimed for."""
-    from drake_dock.docking.scene import contact_approach, initial_state
-    s = _idss_sample(15)
+    """Random 33 of the conditions sweep (complete set): the first contact jumps at the
+    placement's fixed point (1e-9 m to either side of the height the path is aimed for, the
+    first contact lies more than 0.1 mm above and below it), so no path near it has the contact
+    at the requested offset: the path at the jump is taken, and the ring centre's offset at
+    first contact (`contact_offset`, in summary.json) is reported, about a millimetre away.
+    Checked afresh: the chosen path's first contact is the full scan's, and the offset is the
+    path's lateral position at that contact's height."""
+    from drake_dock.docking.scenario import load_scenario
+    from drake_dock.docking.scene import contact_approach, first_contact_or_faces, initial_state
+    from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
+    base = load_scenario()
+    base.contact.pairs = "complete"
+    s = with_condition(base, dict(conditions(ConditionsPlan(random=60, corners=16)))["random 33"])
     a, lam, closing = contact_approach(s)
-    lam_scan, names, _ = full_scan(ApdsGeometry(), a)
+    g = s.geometry
+    lam_scan, names, _ = full_scan(g, a, which="complete")
     assert lam == lam_scan and closing == names
     ic = s.initial
-    centre = np.array(a.aim) - a.height(lam) * np.array(ic.lateral_velocity) / ic.chaser_speed
+    slope = np.array(ic.lateral_velocity) / ic.chaser_speed
+    centre = np.array(a.aim) - a.height(lam) * slope
     st = initial_state(s)
     np.testing.assert_allclose(st.contact_offset, centre, atol=1e-15)
-    slope = np.array(ic.lateral_velocity) / ic.chaser_speed
+    assert np.linalg.norm(centre - np.array(ic.lateral_offset)) > 1e-4
     aimed = (np.array(a.aim) - np.array(ic.lateral_offset)) @ slope / (slope @ slope)
-    miss = np.linalg.norm(centre - np.array(ic.lateral_offset))
-    assert miss == pytest.approx(abs(a.height(lam) - aimed) * np.linalg.norm(slope), abs=1e-12)
-    assert miss > 1e-4
+    sides = []
+    for x in (aimed - 1e-9, aimed + 1e-9):
+        near = Approach(a.yaw, a.tilt, tuple((np.array(ic.lateral_offset) + x * slope).tolist()),
+                        a.direction)
+        sides.append(near.height(first_contact_or_faces(g, near, "complete")[0]) - x)
+    assert min(sides) < -1e-4 and max(sides) > 1e-4
 
 
 def _path_depth(g, approach, lam_c):
