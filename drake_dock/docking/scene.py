@@ -22,7 +22,7 @@ from drake_dock.docking.search import (COVER_CELLS, MARCH_SUBSTEPS,  # noqa: F40
                                        first_contact_seeks, march_root, march_steps,
                                        pair_couples, pair_covers, relative_pose, search_pairs,
                                        seek_gaps, signed_gaps, touch_steps, travel_grid)
-from drake_dock.errors import InputError
+from drake_dock.errors import InputError, SeekingError
 from drake_dock.systems.contact_types import ContactOptions
 
 
@@ -111,7 +111,7 @@ def contact_approach(scenario):
     s = 0.0
     if slope.any():
         s = _axial_height(g, Approach(yaw, tilt, tuple(offset.tolist())), which)
-        if not abs(mismatch(s)) <= AIM_TOL:
+        if s is None or not abs(mismatch(s)) <= AIM_TOL:
             s = _consistent_height(mismatch, 2.0 * g.H + 0.05)
         if s is None:
             raise NoPairCloses(
@@ -142,8 +142,12 @@ def _axial_height(g: ApdsGeometry, axial: Approach, which) -> float:
     the offset higher up: where the approach through this pose first touches at it, it is the
     highest solution of the consistent aim. (Highest as far as a closing does not depend on
     the line the pose is reached along: a couple that becomes interior already cutting a
-    surface does not close.)"""
-    return axial.height(first_contact_or_faces(g, axial, which)[0])
+    surface does not close.) None where a seek on that line fails (`SeekingError`): the try is
+    a shortcut, and the whole-range bracket decides."""
+    try:
+        return axial.height(first_contact_or_faces(g, axial, which)[0])
+    except SeekingError:
+        return None
 
 
 def _isolated(g: ApdsGeometry, approach: Approach, lam: float, names) -> bool:

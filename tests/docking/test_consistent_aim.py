@@ -33,6 +33,15 @@ def _depth_down_to(g, approach, lam):
                                graze=1e-6).depth
 
 
+def _mismatch(g, yaw, tilt, offset, slope, direction):
+    """h_c(aim(x)) - x: the first contact's height on the line aimed at offset + x slope,
+    less x (the complete set)."""
+    def mismatch(x):
+        aimed = Approach(yaw, tilt, tuple((offset + x * slope).tolist()), direction)
+        return aimed.height(first_contact_or_faces(g, aimed, "complete")[0]) - x
+    return mismatch
+
+
 @pytest.mark.parametrize("name", ["corner 4", "random 39"])
 def test_the_consistent_aim_is_the_highest_solution(name):
     s = _condition(name)
@@ -55,12 +64,7 @@ def test_the_consistent_aim_is_the_highest_solution(name):
         np.testing.assert_allclose(placed, lowered, rtol=0, atol=1e-12)
     assert _depth_down_to(g, axial, h) <= 1e-9
 
-    def aimed(x):
-        return Approach(yaw, tilt, tuple((offset + x * slope).tolist()), a.direction)
-
-    def mismatch(x):
-        return aimed(x).height(first_contact_or_faces(g, aimed(x), "complete")[0]) - x
-
+    mismatch = _mismatch(g, yaw, tilt, offset, slope, a.direction)
     # The whole-range bracket closes on another solution, more than 1 cm lower.
     lower = _consistent_height(mismatch, 2.0 * g.H + 0.05)
     assert lower < h - 0.01 and abs(mismatch(lower)) <= 1e-9
@@ -88,3 +92,31 @@ def test_an_axial_pose_the_approach_does_not_first_touch_is_not_taken(name):
                                atol=1e-10)
     lam_scan, names, _ = full_scan(g, a, which="complete")
     assert lam == lam_scan and closing == names
+
+
+def test_a_failed_seek_on_the_axial_line_leaves_the_aim_to_the_bracket(monkeypatch):
+    """The first try is a shortcut: where a seek on the axial line fails (`SeekingError`), the
+    placement is the whole-range bracket's, to the bit, and still consistent to 1e-10 m."""
+    from drake_dock.docking import search
+    from drake_dock.errors import SeekingError
+    s = _condition("random 2")
+    g, ic = s.geometry, s.initial
+    offset = np.array(ic.lateral_offset)
+    slope = np.array(ic.lateral_velocity) / ic.chaser_speed
+    yaw, tilt = math.radians(ic.target_yaw_deg), tuple(math.radians(t) for t in ic.tilt_deg)
+    direction = contact_approach(s)[0].direction
+    axial = Approach(yaw, tilt, tuple(offset.tolist()))
+    original = search._first_contact
+
+    def failing_on_the_axis(geometry, approach, *rest):
+        if approach == axial:
+            raise SeekingError("a closest-couple Newton that does not converge")
+        return original(geometry, approach, *rest)
+
+    mismatch = _mismatch(g, yaw, tilt, offset, slope, direction)
+    expected = _consistent_height(mismatch, 2.0 * g.H + 0.05)
+    monkeypatch.setattr(search, "_first_contact", failing_on_the_axis)
+    a, lam, _ = contact_approach(s)
+    assert a.aim == tuple((offset + expected * slope).tolist())
+    np.testing.assert_allclose(np.array(a.aim) - a.height(lam) * slope, offset, rtol=0,
+                               atol=1e-10)
