@@ -258,3 +258,43 @@ def test_the_scan_brackets_cross_zero_not_the_half_turn():
         rs = rng.choice([-3.1, -2.0, -1.0, -0.2, 0.0, 0.2, 1.0, 2.0, 3.1], n)
         th0 = float(rng.choice(ths))
         assert constraints.scan_brackets(ths, rs, th0) == compiled_order(ths, rs, th0)
+
+
+def test_a_bracket_whose_bisection_ends_on_the_half_turn_gives_way_to_the_next(monkeypatch):
+    """`constraints._slide_start_scan` on a made-up tangential acceleration a_t(s(theta)) whose
+    angle from s is phi(theta) (theta0 = 0): -1.8 rad, then crossing zero steeply to 0.3 rad
+    over the step from the 37th scanned direction (the nearest bracket, but its ends are not
+    both within 90 deg), 0.3 rad, then turning through +180 deg to -0.3 rad over the step from
+    the 40th (a bracket within 90 deg, whose bisection ends where a_t is opposite s), and -0.3
+    rad after. The scan bisects the 40th step first, finds a_t against s there, and slides
+    along the 37th step's root, where phi = 0 (closed form)."""
+    n = constraints.SLIDE_START_SCAN
+    th = [2.0 * math.pi * (k / n - 0.5) for k in range(n + 1)]
+    b_lo, b_hi, a_lo, a_hi = th[37], th[38], th[40], th[41]
+
+    def phi(t):
+        if t <= b_lo:
+            return -1.8
+        if t <= b_hi:
+            return -1.8 + 2.1 * (t - b_lo) / (b_hi - b_lo)
+        if t <= a_lo:
+            return 0.3
+        if t <= a_hi:
+            return 0.3 + (2.0 * math.pi - 0.6) * (t - a_lo) / (a_hi - a_lo)
+        return 2.0 * math.pi - 0.3
+
+    class Made:
+        def __init__(self, dirs):
+            t = math.atan2(dirs[0][1], dirs[0][0])
+            self.at = [np.array([math.cos(t + phi(t)), math.sin(t + phi(t))])]
+
+    rs = [constraints.slip_angle(np.array([math.cos(t), math.sin(t)]),
+                                 Made([[math.cos(t), math.sin(t)]]).at[0]) for t in th]
+    assert constraints.scan_brackets(th, rs, 0.0) == [40, 37]
+    monkeypatch.setattr(constraints, "solve_given_modes",
+                        lambda Minv, a0, rows, modes, dirs, **kw: Made(dirs))
+    sol, ok = constraints._slide_start_scan(None, None, [], (SLIDE,), [np.array([1.0, 0.0])],
+                                            0, 0.0, None)
+    t_root = b_lo + (b_hi - b_lo) * 1.8 / 2.1
+    assert ok
+    assert sol.at[0] == pytest.approx([math.cos(t_root), math.sin(t_root)], abs=1e-9)
