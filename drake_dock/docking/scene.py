@@ -89,8 +89,8 @@ def contact_approach(scenario):
     lateral velocity the aim point (where the path meets the target's ring-face plane) is
     aim = offset + s v_lateral / chaser_speed, where s, the ring-face distance at contact, solves
     s = h_c(aim(s)). Its first try is `_axial_height`, the highest s any solution can have,
-    taken where |h_c(aim(s)) - s| <= `AIM_TOL`; otherwise brentq to 1e-10 m
-    (`_consistent_height`)."""
+    taken where |h_c(aim(s)) - s| <= `AIM_TOL`; then secant steps from it (`_local_height`);
+    otherwise a bracket over the whole range (`_consistent_height`)."""
     ic = scenario.initial
     g = scenario.geometry
     which = scenario.contact.pairs
@@ -110,9 +110,12 @@ def contact_approach(scenario):
 
     s = 0.0
     if slope.any():
+        s_max = 2.0 * g.H + 0.05
         s = _axial_height(g, Approach(yaw, tilt, tuple(offset.tolist())), which)
-        if s is None or not abs(mismatch(s)) <= AIM_TOL:
-            s = _consistent_height(mismatch, 2.0 * g.H + 0.05)
+        if s is not None:
+            s = _local_height(mismatch, s, s_max)
+        if s is None:
+            s = _consistent_height(mismatch, s_max)
         if s is None:
             raise NoPairCloses(
                 f"no straight approach at initial.lateral_velocity {ic.lateral_velocity} m/s "
@@ -128,10 +131,12 @@ def contact_approach(scenario):
     return a, lam_c, closing
 
 
-# The consistent aim's first try is taken where |h_c(aim(s)) - s| is within this (m;
-# `contact_approach`): the ring centre at first contact then lies within AIM_TOL |slope| of the
-# offset.
-AIM_TOL = 1e-10
+# The consistent aim's first try and secant steps are taken where |h_c(aim(s)) - s| is within
+# this (m; `contact_approach`): the ring centre at first contact then lies within
+# AIM_TOL |slope| of the offset. Ten times `TOUCH_GAP`: a closing by touch (`_touch`) is
+# resolved to about TOUCH_GAP over the gap's rate, and h_c moves there by nanometres and back
+# as the aim moves by less.
+AIM_TOL = 1e-8
 
 
 def _axial_height(g: ApdsGeometry, axial: Approach, which) -> float:
@@ -169,16 +174,78 @@ def _isolated(g: ApdsGeometry, approach: Approach, lam: float, names) -> bool:
     return False
 
 
+# Secant steps of the consistent aim from the axial height (`_local_height`).
+LOCAL_STEPS = 3
+
+
+def _local_height(mismatch, s0, s_max):
+    """The consistent aim next to the axial height s0 (`_axial_height`): s0 where
+    |mismatch(s0)| <= `AIM_TOL`; otherwise up to `LOCAL_STEPS` secant steps, the first with
+    slope -1 (h_c flat: s1 = s0 + mismatch(s0)), each taken where |mismatch| <= `AIM_TOL` and
+    bracketed (`_bracketed_height`) where the mismatch changes sign. None where they neither
+    meet nor bracket a root inside [0, s_max]: the whole-range bracket decides."""
+    m0 = mismatch(s0)
+    if abs(m0) <= AIM_TOL:
+        return s0
+    s1 = s0 + m0
+    for _ in range(LOCAL_STEPS):
+        if not 0.0 <= s1 <= s_max:
+            return None
+        m1 = mismatch(s1)
+        if abs(m1) <= AIM_TOL:
+            return s1
+        if m1 * m0 < 0:
+            return _bracketed_height(mismatch, min(s0, s1), max(s0, s1))
+        if m1 == m0:
+            return None
+        s0, m0, s1 = s1, m1, s1 - m1 * (s1 - s0) / (m1 - m0)
+    return None
+
+
+# A bracket of the mismatch narrower than min(|m(a)|, |m(b)|) / JUMP_SLOPE holds a jump of the
+# first contact and no root, as far as no branch of h_c(aim(s)) - s changes by more than
+# JUMP_SLOPE m per m of s (`_bracketed_height`).
+JUMP_SLOPE = 10.0
+
+
+class _Jump(Exception):
+    """The bracket holds a jump (`JUMP_SLOPE`); args: the end taken."""
+
+
+def _bracketed_height(mismatch, a, b):
+    """brentq to 1e-10 m on [a, b], stopped on a jump: as soon as a point it evaluates and
+    its neighbour of the other sign are closer than the smaller |mismatch| of the two over
+    `JUMP_SLOPE`, neither end's branch can reach zero between them, and the one with the
+    smaller |mismatch| is taken (the higher on a tie). ValueError where mismatch(a) and
+    mismatch(b) have one sign."""
+    seen = {}
+
+    def f(s):
+        m = seen[s] = mismatch(s)
+        xs = sorted(seen)
+        i = xs.index(s)
+        for n in xs[max(i - 1, 0):i] + xs[i + 1:i + 2]:
+            if seen[n] * m < 0 and abs(n - s) * JUMP_SLOPE < min(abs(m), abs(seen[n])):
+                raise _Jump(min((s, n), key=lambda x: (abs(seen[x]), -x)))
+        return m
+
+    try:
+        return brentq(f, a, b, xtol=1e-10)
+    except _Jump as jump:
+        return jump.args[0]
+
+
 def _consistent_height(mismatch, s_max, cells=46):
-    """The ring-face distance s in [0, s_max] with mismatch(s) = h_c(aim(s)) - s = 0, by brentq
-    over the whole range; where that range has no sign change, on the largest sign change of a
-    grid of ``cells`` intervals. The first contact h_c jumps where it passes from one pair or
-    feature to another, so the bracket may close on a jump instead of a root: the path at the
-    jump is taken, and the ring centre at first contact then misses the offset by
+    """The ring-face distance s in [0, s_max] with mismatch(s) = h_c(aim(s)) - s = 0, bracketed
+    over the whole range (`_bracketed_height`); where that range has no sign change, on the
+    largest sign change of a grid of ``cells`` intervals. The first contact h_c jumps where it
+    passes from one pair or feature to another, so the bracket may close on a jump instead of a
+    root: the path at the jump is taken, and the ring centre at first contact then misses the
+    offset by
     |mismatch(s)| |v_lateral| / chaser_speed (`InitialState.contact_offset`). None where no
     grid interval changes sign."""
     try:
-        return brentq(mismatch, 0.0, s_max, xtol=1e-10)
+        return _bracketed_height(mismatch, 0.0, s_max)
     except ValueError:                                  # no sign change over the range
         pass
     grid = np.linspace(0.0, s_max, cells + 1)
@@ -188,6 +255,6 @@ def _consistent_height(mismatch, s_max, cells=46):
         if f_k == 0.0:
             return float(grid[k])
         if f_k * f_above < 0:
-            return brentq(mismatch, grid[k], grid[k + 1], xtol=1e-10)
+            return _bracketed_height(mismatch, grid[k], grid[k + 1])
         f_above = f_k
     return None

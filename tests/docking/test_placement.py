@@ -221,12 +221,14 @@ def test_a_fast_sideways_approach_is_placed_at_its_consistent_first_contact():
 
 def test_the_fixed_point_is_a_root_or_the_jump_the_bracket_closes_on():
     """`_consistent_height` on hand-made mismatches: a root where there is one (to xtol), the
-    jump where the function jumps across zero, the largest sign change of the grid where the
-    whole range has none, and None where nothing changes sign."""
-    from drake_dock.docking.scene import _consistent_height
+    jump where the function jumps across zero (its side with the smaller miss, within that
+    miss / `JUMP_SLOPE`), the largest sign change of the grid where the whole range has none,
+    and None where nothing changes sign."""
+    from drake_dock.docking.scene import JUMP_SLOPE, _consistent_height
     assert _consistent_height(lambda s: 0.3 - 2.0 * s, 0.45) == pytest.approx(0.15, abs=1e-9)
-    jump = _consistent_height(lambda s: 0.1 if s < 0.2 else -0.05, 0.45)
-    assert jump == pytest.approx(0.2, abs=1e-9)
+    s_jump = 0.2 + 1e-3 / math.pi
+    jump = _consistent_height(lambda s: 0.1 if s < s_jump else -0.05, 0.45)
+    assert 0.0 <= jump - s_jump < 0.05 / JUMP_SLOPE
     inner = _consistent_height(lambda s: (s - 0.1) * (s - 0.3), 0.45)   # + - + over the range
     assert inner == pytest.approx(0.3, abs=1e-9)
     assert _consistent_height(lambda s: 1.0 + s, 0.45) is None
@@ -266,15 +268,17 @@ def test_the_grid_fallback_evaluates_from_the_top_and_stops_at_the_first_sign_ch
 
 
 def test_a_jump_of_the_first_contact_is_placed_and_its_offset_reported():
-    """Random 33 of the conditions sweep (complete set): the first contact jumps at the
-    placement's fixed point (1e-9 m to either side of the height the path is aimed for, the
-    first contact lies more than 0.1 mm above and below it), so no path near it has the contact
-    at the requested offset: the path at the jump is taken, and the ring centre's offset at
-    first contact (`contact_offset`, in summary.json) is reported, about a millimetre away.
-    Checked afresh: the chosen path's first contact is the full scan's, and the offset is the
-    path's lateral position at that contact's height."""
+    """Random 33 of the conditions sweep (complete set): the first contact jumps next to the
+    placement's height s (the mismatch m = h_c - s of the aimed path is 1.9 mm; within
+    |m| / `JUMP_SLOPE` of s on one side the first contact lies more than 0.1 mm below the path's
+    height, on the other more than 0.1 mm above), so no path near it has the contact at the
+    requested offset: the path at the jump is taken, and the ring centre's offset at first
+    contact (`contact_offset`, in summary.json) is reported, about a millimetre away. Checked
+    afresh: the chosen path's first contact is the full scan's, and the offset is the path's
+    lateral position at that contact's height."""
     from drake_dock.docking.scenario import load_scenario
-    from drake_dock.docking.scene import contact_approach, first_contact_or_faces, initial_state
+    from drake_dock.docking.scene import (JUMP_SLOPE, contact_approach, first_contact_or_faces,
+                                          initial_state)
     from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
     base = load_scenario()
     base.contact.pairs = "complete"
@@ -290,8 +294,10 @@ def test_a_jump_of_the_first_contact_is_placed_and_its_offset_reported():
     np.testing.assert_allclose(st.contact_offset, centre, atol=1e-15)
     assert np.linalg.norm(centre - np.array(ic.lateral_offset)) > 1e-4
     aimed = (np.array(a.aim) - np.array(ic.lateral_offset)) @ slope / (slope @ slope)
+    reach = abs(a.height(lam) - aimed) / JUMP_SLOPE
+    assert 1e-5 < reach < 1e-3
     sides = []
-    for x in (aimed - 1e-9, aimed + 1e-9):
+    for x in (aimed - reach, aimed + reach):
         near = Approach(a.yaw, a.tilt, tuple((np.array(ic.lateral_offset) + x * slope).tolist()),
                         a.direction)
         sides.append(near.height(first_contact_or_faces(g, near, "complete")[0]) - x)
