@@ -183,7 +183,11 @@ def _local_height(mismatch, s0, s_max):
     |mismatch(s0)| <= `AIM_TOL`; otherwise up to `LOCAL_STEPS` secant steps, the first with
     slope -1 (h_c flat: s1 = s0 + mismatch(s0)), each taken where |mismatch| <= `AIM_TOL` and
     bracketed (`_bracketed_height`) where the mismatch changes sign. None where they neither
-    meet nor bracket a root inside [0, s_max]: the whole-range bracket decides."""
+    meet nor bracket a root, or a step leaves [0, s_max]: the whole-range bracket decides.
+    Where mismatch(s0) > 0 the first step goes up, where no solution lies (`_axial_height`):
+    a bracket there closes on the jump of the first contact nearest s0, which is taken. A root
+    below s0 would lie between two sign changes of a mismatch positive at s0 and at 0, which
+    no bracket finds."""
     m0 = mismatch(s0)
     if abs(m0) <= AIM_TOL:
         return s0
@@ -241,9 +245,8 @@ def _consistent_height(mismatch, s_max, cells=46):
     largest sign change of a grid of ``cells`` intervals. The first contact h_c jumps where it
     passes from one pair or feature to another, so the bracket may close on a jump instead of a
     root: the path at the jump is taken, and the ring centre at first contact then misses the
-    offset by
-    |mismatch(s)| |v_lateral| / chaser_speed (`InitialState.contact_offset`). None where no
-    grid interval changes sign."""
+    offset by |mismatch(s)| |v_lateral| / chaser_speed (`InitialState.contact_offset`). None
+    where no grid interval changes sign."""
     try:
         return _bracketed_height(mismatch, 0.0, s_max)
     except ValueError:                                  # no sign change over the range

@@ -56,6 +56,30 @@ def test_a_jump_is_left_at_the_end_with_the_smaller_miss(m_up, m_down, side):
     assert len(calls) < 0.6 * len(full)
 
 
+@pytest.mark.parametrize("m_up, m_down, sign", [(0.004, -0.02, 1), (0.03, -0.002, 1),
+                                               (0.004, -0.02, -1), (0.03, -0.002, -1)])
+def test_the_bracket_stops_at_the_first_evaluation_that_shows_the_jump(m_up, m_down, sign):
+    """The stop rule evaluated afresh on the points the bracket asked for, in their order: it
+    first holds at the last of them (no evaluation after it, none missed before)."""
+    s_star = 0.2 + 1e-3 * math.sqrt(2.0)
+    f = _jump(s_star, lambda s: sign * (m_up - 0.9 * (s - s_star)),
+              lambda s: sign * (m_down - 1.1 * (s - s_star)))
+    g, calls = _counted(f)
+    _bracketed_height(g, 0.0, 0.45)
+
+    def shows_the_jump(points):
+        xs = sorted(points)
+        return any(f(a) * f(b) < 0 and (b - a) * JUMP_SLOPE < min(abs(f(a)), abs(f(b)))
+                   for a, b in zip(xs, xs[1:]))
+    shown = [shows_the_jump(calls[:k + 1]) for k in range(len(calls))]
+    assert shown.index(True) == len(calls) - 1
+
+
+def test_a_jump_of_equal_misses_is_left_at_its_higher_end():
+    s_star = 0.2 + 1e-3 / math.pi
+    assert _bracketed_height(lambda s: 0.01 if s < s_star else -0.01, 0.0, 0.45) > s_star
+
+
 def test_a_root_next_to_a_jump_is_found_not_the_jump():
     """The upper branch reaches zero 49 mm before the jump: the bracket finds that root to
     1e-10 m rather than stopping on the jump."""
@@ -100,6 +124,23 @@ def test_a_jump_next_to_the_axial_height_is_bracketed():
               lambda s: -0.0092 - 0.98 * (s - s_star))
     x = _local_height(f, s0, 0.45)
     assert x < s_star and s_star - x < 0.0058 / JUMP_SLOPE
+
+
+def test_the_secant_takes_at_most_local_steps_steps():
+    """Curved mismatches with a root r 1 mm below s0: 0.9 (r - s) - 30 (r - s)^2 is met to
+    AIM_TOL by the third step; 0.5 (r - s) - 10 (r - s)^2 is not, and after LOCAL_STEPS
+    evaluations the aim is left to the whole range."""
+    r = 0.2
+    g, calls = _counted(lambda s: 0.9 * (r - s) - 30.0 * (r - s) ** 2)
+    assert abs(_local_height(g, r + 1e-3, 0.45) - r) < 2.0 * AIM_TOL
+    assert len(calls) == 1 + LOCAL_STEPS
+    g, calls = _counted(lambda s: 0.5 * (r - s) - 10.0 * (r - s) ** 2)
+    assert _local_height(g, r + 1e-3, 0.45) is None and len(calls) == 1 + LOCAL_STEPS
+
+
+def test_a_step_above_s_max_is_not_evaluated():
+    g, calls = _counted(lambda s: 0.3)
+    assert _local_height(g, 0.2, 0.45) is None and calls == [0.2]
 
 
 def test_no_root_the_secant_can_reach_leaves_the_aim_to_the_whole_range():
