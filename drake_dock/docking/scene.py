@@ -90,7 +90,8 @@ def contact_approach(scenario):
     aim = offset + s v_lateral / chaser_speed, where s, the ring-face distance at contact, solves
     s = h_c(aim(s)). Its first try is `_axial_height`, the highest s any solution can have,
     taken where |h_c(aim(s)) - s| <= `AIM_TOL`; then secant steps from it (`_local_height`);
-    otherwise a bracket over the whole range (`_consistent_height`)."""
+    otherwise (or where a seek on the way fails) a bracket over the whole range
+    (`_consistent_height`)."""
     ic = scenario.initial
     g = scenario.geometry
     which = scenario.contact.pairs
@@ -113,7 +114,10 @@ def contact_approach(scenario):
         s_max = 2.0 * g.H + 0.05
         s = _axial_height(g, Approach(yaw, tilt, tuple(offset.tolist())), which)
         if s is not None:
-            s = _local_height(mismatch, s, s_max)
+            try:
+                s = _local_height(mismatch, s, s_max)
+            except SeekingError:          # a shortcut: the whole-range bracket decides
+                s = None
         if s is None:
             s = _consistent_height(mismatch, s_max)
         if s is None:

@@ -103,29 +103,29 @@ def test_an_axial_pose_the_approach_does_not_first_touch_is_not_taken(name):
     assert lam == lam_scan and closing == names
 
 
-def test_a_failed_seek_on_the_axial_line_leaves_the_aim_to_the_bracket(monkeypatch):
-    """The first try is a shortcut: where a seek on the axial line fails (`SeekingError`), the
-    placement is the whole-range bracket's, to the bit, and still consistent to 1e-10 m."""
+@pytest.mark.parametrize("line", ["axial", "through"])
+def test_a_failed_seek_on_a_shortcut_leaves_the_aim_to_the_bracket(monkeypatch, line):
+    """The first try and the secant steps are a shortcut: where a seek fails (`SeekingError`)
+    on the axial line, or on the straight approach through the axial pose (the first try's
+    mismatch), the placement is the whole-range bracket's, to the bit, and still consistent to
+    1e-10 m."""
     from drake_dock.docking import search
     from drake_dock.errors import SeekingError
-    s = _condition("random 2")
-    g, ic = s.geometry, s.initial
-    offset = np.array(ic.lateral_offset)
-    slope = np.array(ic.lateral_velocity) / ic.chaser_speed
-    yaw, tilt = math.radians(ic.target_yaw_deg), tuple(math.radians(t) for t in ic.tilt_deg)
-    direction = contact_approach(s)[0].direction
-    axial = Approach(yaw, tilt, tuple(offset.tolist()))
+    g, offset, slope, (a0, _, _), yaw, tilt, h_axial = _placed_and_axial("random 2")
+    failing = {"axial": Approach(yaw, tilt, tuple(offset.tolist())),
+               "through": Approach(yaw, tilt, tuple((offset + h_axial * slope).tolist()),
+                                   a0.direction)}[line]
     original = search._first_contact
 
-    def failing_on_the_axis(geometry, approach, *rest):
-        if approach == axial:
+    def failing_on_the_line(geometry, approach, *rest):
+        if approach == failing:
             raise SeekingError("a closest-couple Newton that does not converge")
         return original(geometry, approach, *rest)
 
-    mismatch = _mismatch(g, yaw, tilt, offset, slope, direction)
+    mismatch = _mismatch(g, yaw, tilt, offset, slope, a0.direction)
     expected = _consistent_height(mismatch, 2.0 * g.H + 0.05)
-    monkeypatch.setattr(search, "_first_contact", failing_on_the_axis)
-    a, lam, _ = contact_approach(s)
+    monkeypatch.setattr(search, "_first_contact", failing_on_the_line)
+    a, lam, _ = contact_approach(_condition("random 2"))
     assert a.aim == tuple((offset + expected * slope).tolist())
     np.testing.assert_allclose(np.array(a.aim) - a.height(lam) * slope, offset, rtol=0,
                                atol=1e-10)
