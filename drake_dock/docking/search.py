@@ -270,7 +270,9 @@ def march_root(pair, approach, hi, start, lo, floor, xtol):
     above `TOUCH_GAP`, the pair closes where the gap turns below -`TOUCH_GAP` (brentq) or
     where it falls into +-`TOUCH_GAP` (the circle cutting the surface: the first point within
     `TOUCH_GAP`, bisected to 1e-12 of the travel, `_touch`; a seek that fails next to the
-    touch is taken as touching there). A couple that becomes interior already cutting the
+    touch is taken as touching there). A seek that fails while the couple is outside its
+    domain (a circle nearing a surface's edge, which the edge pairs model) is taken as a touch
+    outside it (distance 0: marched as a cut). A couple that becomes interior already cutting the
     surface (its distance within `TOUCH_GAP`: a circle that came in over an edge, which the
     set's edge pairs, or none, model) does not close it. Returns (lam of the closing or None;
     (gap, direction, distance) at lo; seeks taken)."""
@@ -295,11 +297,14 @@ def march_steps(pair, approach, hi, start, lo, floor, xtol):
         seeks += 1
         try:
             g2, ref2, d2 = _seek(pair, approach, nxt, ref)
-        except SeekingError:              # next to a tangent touch (`_touch`)
-            if not (np.isfinite(g) and g > TOUCH_GAP):
+        except SeekingError:
+            if not np.isfinite(g):        # outside its domain: a touch there cannot close it
+                g2, ref2, d2 = np.inf, None, 0.0
+            elif g > TOUCH_GAP:           # next to a tangent touch (`_touch`)
+                root, more = _touch(pair, approach, lam, nxt, ref)
+                return root, None, seeks + more
+            else:
                 raise
-            root, more = _touch(pair, approach, lam, nxt, ref)
-            return root, None, seeks + more
         if np.isfinite(g) and g > TOUCH_GAP and np.isfinite(g2):
             if g2 <= 0 and abs(d2) > TOUCH_GAP:
                 calls = []

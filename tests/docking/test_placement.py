@@ -219,6 +219,33 @@ def test_a_fast_sideways_approach_is_placed_at_its_consistent_first_contact():
     assert lam == lam_scan and closing == names
 
 
+def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there():
+    """IDSS sample 694: on the straight approach through its axial pose, the chaser ring's
+    circle nears the T1 guide surface with its couple outside the domain (distances 1e-2,
+    9e-4, 8e-5 m), and the closest-couple Newton then fails (checked below at that travel).
+    The march takes the failure as a touch outside the domain and goes on: the placement is
+    consistent (the path passes the offset at its first contact to 1e-8 m |slope|), and its
+    first contact is the full scan's, which seeks every pair at every grid point."""
+    from drake_dock.docking.scene import contact_approach
+    from drake_dock.errors import SeekingError
+    s = _idss_sample(694)
+    ic = s.initial
+    offset = np.array(ic.lateral_offset)
+    slope = np.array(ic.lateral_velocity) / ic.chaser_speed
+    a, lam, closing = contact_approach(s)
+    np.testing.assert_allclose(np.array(a.aim) - a.height(lam) * slope, offset, rtol=0,
+                               atol=1e-8 * np.linalg.norm(slope))
+    lam_scan, names, _ = full_scan(s.geometry, a)
+    assert lam == lam_scan and closing == names
+    pair, = [pr for pr in apds_pairs(s.geometry, "paper") if pr.name == "cs_Cring_T1"]
+    failing = Approach(a.yaw, a.tilt, (-0.052305884320687224, -0.09989067043207144),
+                       a.direction)
+    with pytest.raises(SeekingError):
+        seek_gaps([pair], failing, 0.23063723414045384, [None])
+    gap, _, dist = seek_gaps([pair], failing, 0.23071557604432555, [None])
+    assert gap[0] == np.inf and 0 < dist[0] < 1e-4
+
+
 def test_the_fixed_point_is_a_root_or_the_jump_the_bracket_closes_on():
     """`_consistent_height` on hand-made mismatches: a root where there is one (to xtol), the
     jump where the function jumps across zero (its side with the smaller miss, within that
