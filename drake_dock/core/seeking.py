@@ -163,7 +163,14 @@ def _descent_step(H, g):
     return (V @ np.where(flat, 0.0, c)).tolist(), (V @ np.where(flat, c, 0.0)).tolist()
 
 
-def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=50, distance_rtol=None,
+# The closest-couple Newton's iteration limit (`newton_closest`). A crossing next to a
+# tangency (a ring's circle cutting a guide surface it nearly osculates, next to the surface's
+# edge) leaves J nearly singular, and the iteration walks the valley for about 90 iterations
+# before it converges quadratically. A Newton that converges within a smaller limit is unchanged.
+CLOSEST_MAX_ITER = 200
+
+
+def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=CLOSEST_MAX_ITER, distance_rtol=None,
                    rtol_beyond=0.0):
     """Bounded Newton on f(u) = 0.5 |r1(u1) - r2(u2)|^2 from (u1, u2).
 

@@ -138,8 +138,8 @@ def contact_approach(scenario):
 # The consistent aim's first try and secant steps are taken where |h_c(aim(s)) - s| is within
 # this (m; `contact_approach`): the ring centre at first contact then lies within
 # AIM_TOL |slope| of the offset. Ten times `TOUCH_GAP`: a closing by touch (`_touch`) is
-# resolved to about TOUCH_GAP over the gap's rate, and h_c moves there by nanometres and back
-# as the aim moves by less.
+# resolved to about TOUCH_GAP over the gap's rate, or, where a seek next to the touch fails,
+# to the bracket in which it failed.
 AIM_TOL = 1e-8
 
 

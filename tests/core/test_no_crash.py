@@ -318,6 +318,38 @@ def test_seeks_that_crashed(case):
     assert sides[0] * sides[1] < 0
 
 
+# The chaser ring against the T1 guide surface in the run of IDSS campaign sample 397
+# (models/idss_envelope.yaml) at t = 0.479 s: body poses (R, p) of the two APDS.
+CREEPING_X1 = ([[-0.4986210713425131, -0.8645174209558701, -0.06313997210210891],
+                [-0.8619619624733339, 0.5022104665345811, -0.06932692516069916],
+                [0.09164388938910882, 0.019856388567135303, -0.9955938536224034]],
+               [-0.01566205985912082, 0.013665294832705616, 5.2281343022534426])
+CREEPING_X2 = ([[0.9994844617295722, 0.028793339321968578, 0.014204026606468355],
+                [-0.028922747571869523, 0.9995412136520327, 0.008990933428473853],
+                [-0.013938630995947865, -0.00939711773424761, 0.9998586943884857]],
+               [-0.02190690230232254, -0.010293806935701498, 5.011666244594425])
+
+
+def test_seek_creeping_to_a_near_tangent_crossing():
+    """The ring's circle cuts the guide surface next to its edge while nearly osculating it
+    (J's smallest singular value 3e-6 of its largest): every Newton start creeps along the
+    valley for about 90 iterations before it converges (it raised at a limit of 50). Both
+    seeks find a crossing: distance below 1e-12, the circle's points on either side of the
+    couple on opposite sides of the surface's tangent plane; and they agree."""
+    pair = next(p for p in PAIRS if p.name == "cs_Cring_T1")
+    X1, X2 = ((np.array(R), np.array(p)) for R, p in (CREEPING_X1, CREEPING_X2))
+    P1, P2 = posed(pair.patch1, *X1), posed(pair.patch2, *X2)
+    found = [seek(P1, P2, distance_rtol=1e-7, rtol_beyond=0.02)
+             for seek in (seek_couple, compiled_seek.seek_couple)]
+    for c in found:
+        assert c.distance < 1e-12
+        T = P2.first(c.u2)
+        nrm = np.cross(T[:, 0], T[:, 1])
+        sides = [nrm @ (P1.position(c.u1 + e) - P2.position(c.u2)) for e in (-1e-6, 1e-6)]
+        assert sides[0] * sides[1] < 0
+    assert np.linalg.norm(found[0].p1 - found[1].p1) < 1e-6
+
+
 # ------------------------------------------------------------------- small scenes' patch types
 def _random_rotation(rng):
     return rot_vec(rng.normal(0, 2.0, 3))

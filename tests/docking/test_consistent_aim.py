@@ -131,20 +131,21 @@ def test_a_failed_seek_on_a_shortcut_leaves_the_aim_to_the_bracket(monkeypatch, 
                                atol=1e-10)
 
 
-def test_a_closing_by_touch_is_placed_within_the_searchs_resolution():
+def test_a_closing_by_touch_is_placed_by_the_first_try():
     """Random 26 (the target ring's circle touching a chaser guide surface and then cutting
-    it, `_touch`): such a closing is resolved to about TOUCH_GAP over the gap's rate, and
-    there the first contact moves by nanometres and back as the aim moves by less (checked
-    below on the full scan, a second search). The straight approach through the axial pose
-    first touches 1e-10 to 1e-8 m from it, within that resolution, so that pose is the
-    placement: its aim is offset + h_axial slope, bit for bit, and the full scan's first
-    contact on it lies within 1e-8 m of h_axial."""
+    it, `_touch`): the straight approach through the axial pose first touches within
+    `AIM_TOL` of h_axial, so that pose is the placement: its aim is offset + h_axial slope, bit
+    for bit. On the full scan (a second search) the mismatch next to h_axial is smooth in the
+    aim: its slope over 2e-9 m agrees with its slope over 2e-7 m to 1 %, and its root lies
+    within 1e-11 m of h_axial."""
     g, offset, slope, (a, _, _), yaw, tilt, h_axial = _placed_and_axial("random 26")
     assert a.aim == tuple((offset + h_axial * slope).tolist())
-    heights = []
-    for x in h_axial + np.array([-2e-9, -1e-9, 0.0, 1e-9, 2e-9]):
+    m = {}
+    for dx in (-1e-7, -1e-9, 0.0, 1e-9, 1e-7):
+        x = h_axial + dx
         near = Approach(yaw, tilt, tuple((offset + x * slope).tolist()), a.direction)
-        heights.append(near.height(full_scan(g, near, which="complete")[0]) - x)
-    assert 1e-10 < abs(heights[2]) <= 1e-8
-    steps = np.diff(heights)
-    assert (steps > 0).any() and (steps < 0).any()      # not monotone: below the resolution
+        m[dx] = near.height(full_scan(g, near, which="complete")[0]) - x
+    wide = (m[1e-7] - m[-1e-7]) / 2e-7
+    narrow = (m[1e-9] - m[-1e-9]) / 2e-9
+    assert abs(narrow / wide - 1.0) < 0.01
+    assert abs(m[0.0] / wide) < 1e-11

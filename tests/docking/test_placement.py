@@ -219,13 +219,16 @@ def test_a_fast_sideways_approach_is_placed_at_its_consistent_first_contact():
     assert lam == lam_scan and closing == names
 
 
-def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there():
+def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there(monkeypatch):
     """IDSS sample 694: on the straight approach through its axial pose, the chaser ring's
     circle nears the T1 guide surface with its couple outside the domain (distances 1e-2,
-    9e-4, 8e-5 m), and the closest-couple Newton then fails (checked below at that travel).
-    The march takes the failure as a touch outside the domain and goes on: the placement is
-    consistent (the path passes the offset at its first contact to 1e-8 m |slope|), and its
-    first contact is the full scan's, which seeks every pair at every grid point."""
+    9e-4, 8e-5 m); there its closest-couple Newton creeps (it failed at a limit of 50
+    iterations). Made to fail at that travel, the march takes the failure as a touch outside
+    the domain and goes on to the first contact of the search whose seek converges there. The
+    placement is consistent (the path passes the offset at its first contact to 1e-8 m
+    |slope|), and its first contact is the full scan's, which seeks every pair at every grid
+    point."""
+    from drake_dock.docking import search
     from drake_dock.docking.scene import contact_approach
     from drake_dock.errors import SeekingError
     s = _idss_sample(694)
@@ -240,10 +243,21 @@ def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there():
     pair, = [pr for pr in apds_pairs(s.geometry, "paper") if pr.name == "cs_Cring_T1"]
     failing = Approach(a.yaw, a.tilt, (-0.052305884320687224, -0.09989067043207144),
                        a.direction)
-    with pytest.raises(SeekingError):
-        seek_gaps([pair], failing, 0.23063723414045384, [None])
-    gap, _, dist = seek_gaps([pair], failing, 0.23071557604432555, [None])
+    lam_fail = 0.23063723414045384
+    gap, _, dist = seek_gaps([pair], failing, lam_fail, [None])
     assert gap[0] == np.inf and 0 < dist[0] < 1e-4
+    converged = search.first_contact_or_faces(s.geometry, failing)
+    original, failed = search._seek, []
+
+    def seek(pr, approach, x, ref):
+        if pr.name == pair.name and approach == failing and x == lam_fail:
+            failed.append(x)
+            raise SeekingError("a closest-couple Newton that does not converge")
+        return original(pr, approach, x, ref)
+
+    monkeypatch.setattr(search, "_seek", seek)
+    search._first_contact.cache_clear()
+    assert search.first_contact_or_faces(s.geometry, failing) == converged and failed
 
 
 def test_the_fixed_point_is_a_root_or_the_jump_the_bracket_closes_on():
@@ -348,10 +362,10 @@ def test_the_path_to_the_first_contact_is_clear_where_a_pair_closes_inside_a_ste
     step of the travel grid: the ring's inside circle crosses a tip arc next to a petal corner
     and is handed over to the guide surface before the step's end (57, 38), or touches a guide
     surface next to its edge and then cuts it (26). Checked by the independent interpenetration
-    check, the straight path down to the placed first contact crosses nothing deeper than 20 um
+    check, the straight path down to the placed first contact crosses nothing deeper than 1 um
     (random 26's circle cuts the surface next to a near-tangent touch, where the couple is
-    degenerate: its placement lies 18 um past the touch). The steps' ends alone miss these
-    contacts: the pair that closes is apart (+inf) at one end of its step or the other."""
+    degenerate and its Newton slow). The steps' ends alone miss these contacts: the pair that
+    closes is apart (+inf) at one end of its step or the other."""
     from drake_dock.docking.scenario import load_scenario
     from drake_dock.docking.scene import contact_approach
     from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
@@ -359,7 +373,7 @@ def test_the_path_to_the_first_contact_is_clear_where_a_pair_closes_inside_a_ste
     base.contact.pairs = "complete"
     s = with_condition(base, dict(conditions(ConditionsPlan(random=60, corners=16)))[name])
     a, lam, _ = contact_approach(s)
-    assert _path_depth(s.geometry, a, lam) < 2e-5
+    assert _path_depth(s.geometry, a, lam) < 1e-6
 
 
 @pytest.mark.parametrize("seed", range(6, 9))

@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from drake_dock.core.kernels.jets import PETAL, jet, patch_spec, petal_point, petal_row, position
-from drake_dock.core.seeking import FLAT, Couple
+from drake_dock.core.seeking import CLOSEST_MAX_ITER, FLAT, Couple
 from drake_dock.errors import SeekingError
 
 EPS8 = 8 * np.finfo(float).eps
@@ -384,7 +384,8 @@ def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
             continue
         started[c] = True
         u, its[m], status[m] = newton(k1, p1, R1, o1, k2, p2, R2, o2, starts[c], lower, upper,
-                                      periodic, scale, 1e-14, 50, distance_rtol, rtol_beyond)
+                                      periodic, scale, 1e-14, CLOSEST_MAX_ITER, distance_rtol,
+                                      rtol_beyond)
         _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, 1)
         U[m] = u
         X1[m, 0], X1[m, 1], X1[m, 2] = x1
@@ -440,7 +441,8 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
                                   -1.0 if distance_rtol is None else float(distance_rtol),
                                   float(rtol_beyond))
     if status.any():
-        raise SeekingError("closest-couple Newton did not converge in 50 iterations")
+        raise SeekingError(f"closest-couple Newton did not converge in {CLOSEST_MAX_ITER} "
+                           "iterations")
     best, dist = 0, np.inf
     for c in range(U.shape[0]):
         d = float(np.linalg.norm(X1[c] - X2[c]))
