@@ -43,10 +43,13 @@ class Approach:
     aim: tuple = (0.0, 0.0)
     direction: tuple = (0.0, 0.0, -1.0)
 
+    @functools.cached_property
+    def _rotation(self):
+        R = relative_pose(self.yaw, 0.0)[0]
+        return rot_vec((*self.tilt, 0.0)) @ R if self.tilt != (0.0, 0.0) else R
+
     def pose(self, lam: float):
-        R, p = relative_pose(self.yaw, lam)
-        if self.tilt != (0.0, 0.0):
-            R = rot_vec((*self.tilt, 0.0)) @ R
+        R, p = self._rotation.copy(), np.array([0.0, 0.0, lam])
         if self.aim != (0.0, 0.0) or self.direction != (0.0, 0.0, -1.0):
             p = np.array([*self.aim, 0.0]) - lam * np.asarray(self.direction)
         return R, p
