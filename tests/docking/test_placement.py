@@ -445,3 +445,39 @@ def test_a_march_through_a_cut_finds_the_floor_steps_first_contact_in_fewer_seek
     search._first_contact.cache_clear()
     assert found[search.CUT_FLOORS][0] == found[1][0]
     assert 2 * found[search.CUT_FLOORS][1] < found[1][1]
+
+
+def test_a_seek_that_fails_next_to_a_touch_is_taken_as_touching(monkeypatch):
+    """Random 26 of the conditions sweep closes by touch: the target ring's circle meets a
+    chaser guide surface (`cs_Tring_C1`) and then cuts it (`_touch`). Made to fail wherever that
+    pair's couple is interior and nearer than 1e-5 m, its seek is taken as touching there: the
+    closing pair is the same, and the first contact moves up to the first point of the travel
+    at which the distance falls to 1e-5 m (brentq on the distance less 1e-5 m, to 1e-11 m)."""
+    from drake_dock.docking.scenario import load_scenario
+    from drake_dock.docking.scene import contact_approach
+    from drake_dock.errors import SeekingError
+    from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
+    base = load_scenario()
+    base.contact.pairs = "complete"
+    s = with_condition(base, dict(conditions(ConditionsPlan(random=60, corners=16)))["random 26"])
+    a, lam, closing = contact_approach(s)
+    assert closing == ["cs_Tring_C1"]
+    pair, = [pr for pr in apds_pairs(s.geometry, "complete") if pr.name == closing[0]]
+    original, failed, near = search._seek, [], 1e-5
+
+    def seek(pr, approach, x, ref):
+        hit = original(pr, approach, x, ref)
+        if pr.name == pair.name and np.isfinite(hit[0]) and hit[2] < near:
+            failed.append(x)
+            raise SeekingError("a closest-couple Newton that does not converge")
+        return hit
+
+    monkeypatch.setattr(search, "_seek", seek)
+    search._first_contact.cache_clear()
+    try:
+        lam_f, names = search.first_contact(s.geometry, a, which="complete")
+    finally:
+        search._first_contact.cache_clear()
+    assert names == closing and failed and lam_f > lam
+    want = brentq(lambda x: original(pair, a, x, None)[2] - near, lam, lam + 1e-2, xtol=1e-13)
+    assert lam_f == pytest.approx(want, abs=1e-11)
