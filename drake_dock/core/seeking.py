@@ -166,7 +166,7 @@ def _descent_step(H, g):
 # The closest-couple Newton's iteration limit (`newton_closest`). A crossing next to a
 # tangency (a ring's circle cutting a guide surface it nearly osculates, next to the surface's
 # edge) leaves J nearly singular, and the iteration walks the valley for about 90 iterations
-# before it converges quadratically. A Newton that converges within a smaller limit is unchanged.
+# before it converges quadratically.
 CLOSEST_MAX_ITER = 200
 
 

@@ -333,7 +333,7 @@ CREEPING_X2 = ([[0.9994844617295722, 0.028793339321968578, 0.014204026606468355]
 def test_seek_creeping_to_a_near_tangent_crossing():
     """The ring's circle cuts the guide surface next to its edge while nearly osculating it
     (J's smallest singular value 3e-6 of its largest): every Newton start creeps along the
-    valley for about 90 iterations before it converges (it raised at a limit of 50). Both
+    valley for about 90 iterations before it converges (more than a limit of 50). Both
     seeks find a crossing: distance below 1e-12, the circle's points on either side of the
     couple on opposite sides of the surface's tangent plane; and they agree."""
     pair = next(p for p in PAIRS if p.name == "cs_Cring_T1")

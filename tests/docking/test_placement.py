@@ -222,12 +222,11 @@ def test_a_fast_sideways_approach_is_placed_at_its_consistent_first_contact():
 def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there(monkeypatch):
     """IDSS sample 694: on the straight approach through its axial pose, the chaser ring's
     circle nears the T1 guide surface with its couple outside the domain (distances 1e-2,
-    9e-4, 8e-5 m); there its closest-couple Newton creeps (it failed at a limit of 50
-    iterations). Made to fail at that travel, the march takes the failure as a touch outside
-    the domain and goes on to the first contact of the search whose seek converges there. The
-    placement is consistent (the path passes the offset at its first contact to 1e-8 m
-    |slope|), and its first contact is the full scan's, which seeks every pair at every grid
-    point."""
+    9e-4, 8e-5 m); there its closest-couple Newton creeps (more than 50 iterations). Made to
+    fail at that travel, the march takes the failure as a touch outside the domain and goes on
+    to the first contact of the search whose seek converges there. The placement is
+    consistent (the path passes the offset at its first contact to 1e-8 m |slope|), and its
+    first contact is the full scan's, which seeks every pair at every grid point."""
     from drake_dock.docking import search
     from drake_dock.docking.scene import contact_approach
     from drake_dock.errors import SeekingError
@@ -257,7 +256,10 @@ def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there(monkey
 
     monkeypatch.setattr(search, "_seek", seek)
     search._first_contact.cache_clear()
-    assert search.first_contact_or_faces(s.geometry, failing) == converged and failed
+    try:
+        assert search.first_contact_or_faces(s.geometry, failing) == converged and failed
+    finally:
+        search._first_contact.cache_clear()
 
 
 def test_the_fixed_point_is_a_root_or_the_jump_the_bracket_closes_on():
