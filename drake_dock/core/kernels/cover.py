@@ -80,11 +80,15 @@ def touched_steps(mc, mr, mbc, mbr, mblocks, mn, mflat, fc, fr, fbc, fbr, fblock
     lam_lo, lam_hi = grid[K], grid[0]
     for I in range(mbc.shape[0]):
         for J in range(fbc.shape[0]):
-            lo, hi, ok = _interval(mbc[I], fbc[J], mbr[I] + fbr[J], e, ee)
+            # Block spheres that cannot meet in the grid's range (grown by 1e-12 relative and
+            # absolute, far above round-off) hold no cells that can: the steps a cell marks do
+            # not depend on the range, so a part of the grid marks the whole grid's steps.
+            lo, hi, ok = _interval(mbc[I], fbc[J], (mbr[I] + fbr[J]) * (1.0 + 1e-12) + 1e-12,
+                                   e, ee)
             if not ok or lo > lam_hi + slack or hi < lam_lo - slack:
                 continue
-            # A moving cell whose sphere cannot meet block J's (grown by 1e-12 relative and
-            # absolute, far above round-off) in the range meets none of its cells there.
+            # A moving cell whose sphere cannot meet block J's (grown likewise) in the range
+            # meets none of its cells there.
             grown = fbr[J] * (1.0 + 1e-12) + 1e-12
             for a in mblocks[I]:
                 lo, hi, ok = _interval(mc[a], fbc[J], mr[a] + grown, e, ee)

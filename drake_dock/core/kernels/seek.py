@@ -148,6 +148,7 @@ def hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, p
     dim1, dim2 = U1.shape[1], U2.shape[1]
     C1, C2 = np.empty((candidates, dim1)), np.empty((candidates, dim2))
     C = 0
+    w1, w2 = 2 * h1, 2 * h2            # the candidates' exclusion half-widths
     for _ in range(candidates):
         best, bi, bj = np.inf, -1, -1
         for i in range(d2.shape[0]):
@@ -158,10 +159,13 @@ def hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, p
             break
         C1[C], C2[C] = U1[bi], U2[bj]
         C += 1
+        near2 = np.empty(d2.shape[1], dtype=np.bool_)
+        for j in range(d2.shape[1]):
+            near2[j] = _within(U2[j], U2[bj], w2)
         for i in range(d2.shape[0]):
-            if _within(U1[i], U1[bi], 2 * h1):
+            if _within(U1[i], U1[bi], w1):
                 for j in range(d2.shape[1]):
-                    if _within(U2[j], U2[bj], 2 * h2):
+                    if near2[j]:
                         d2[i, j] = np.inf
     g1, g2 = h1, h2
     for _ in range(levels):
