@@ -18,7 +18,8 @@ from drake_dock.docking.path_check import (MissedContact, NoPairCloses,  # noqa:
 from drake_dock.docking.rotations import rot_vec, rot_x, rot_z  # noqa: F401 (re-exported)
 from drake_dock.docking.search import (COVER_CELLS, MARCH_SUBSTEPS,  # noqa: F401 (re-exported)
                                        TOUCH_GAP, Approach, first_contact,
-                                       first_contact_distance, first_contact_or_faces,
+                                       first_contact_above, first_contact_distance,
+                                       first_contact_or_faces,
                                        first_contact_seeks, march_root, march_steps,
                                        pair_couples, pair_covers, relative_pose, search_pairs,
                                        seek_gaps, signed_gaps, touch_steps, travel_grid)
@@ -91,7 +92,8 @@ def contact_approach(scenario):
     s = h_c(aim(s)). Its first try is `_axial_height`, the highest s any solution can have,
     taken where |h_c(aim(s)) - s| <= `AIM_TOL`; then secant steps from it (`_local_height`);
     otherwise (or where a seek on the way fails) a bracket over the whole range
-    (`_consistent_height`)."""
+    (`_consistent_height`). A bracket is closed among the pairs that close at its ends
+    (`_among_height`)."""
     ic = scenario.initial
     g = scenario.geometry
     which = scenario.contact.pairs
@@ -105,21 +107,18 @@ def contact_approach(scenario):
     def approach(s):
         return Approach(yaw, tilt, tuple((offset + s * slope).tolist()), direction)
 
-    def mismatch(s):
-        a = approach(s)
-        return a.height(first_contact_or_faces(g, a, which)[0]) - s
-
     s = 0.0
     if slope.any():
         s_max = 2.0 * g.H + 0.05
+        mismatch = _Mismatch(g, which, approach)
         s = _axial_height(g, Approach(yaw, tilt, tuple(offset.tolist())), which)
         if s is not None:
             try:
-                s = _local_height(mismatch, s, s_max)
+                s = _local_height(mismatch, s, s_max, _among_height)
             except SeekingError:          # a shortcut: the whole-range bracket decides
                 s = None
         if s is None:
-            s = _consistent_height(mismatch, s_max)
+            s = _consistent_height(mismatch, s_max, bracket=_among_height)
         if s is None:
             raise NoPairCloses(
                 f"no straight approach at initial.lateral_velocity {ic.lateral_velocity} m/s "
@@ -182,7 +181,72 @@ def _isolated(g: ApdsGeometry, approach: Approach, lam: float, names) -> bool:
 LOCAL_STEPS = 3
 
 
-def _local_height(mismatch, s0, s_max):
+class _Mismatch:
+    """m(s) = h_c(aim(s)) - s of `contact_approach` for the approaches ``approach(s)``, with
+    the whole contact set, or among some of its pairs (`among`)."""
+
+    def __init__(self, g, which, approach):
+        self.g, self.which, self.approach = g, which, approach
+
+    def __call__(self, s):
+        return self.among(s, None)[0]
+
+    def among(self, s, names):
+        """(m(s), the closing pairs) with only the pairs ``names`` sought (all where None)."""
+        a = self.approach(s)
+        lam, closing = first_contact_or_faces(self.g, a, self.which, names)
+        return a.height(lam) - s, closing
+
+    def below(self, s, T):
+        """None where m(s) < -T (T < s): no pair closes at the height s - T or above, found
+        by a search that stops there; otherwise (m(s), the closing pairs)."""
+        a = self.approach(s)
+        lam, closing = first_contact_above(self.g, a, self.which, (s - T) / a.height(1.0))
+        return None if lam is None else (a.height(lam) - s, closing)
+
+
+def _among_height(mismatch, a, b):
+    """`_bracketed_height` on [a, b] with the mismatch among the pairs that close at a and b
+    (each search a few pairs' cost), checked with the whole set. Where a pair among them
+    closes, a first contact among them is never higher than the set's, so m >= m_among, equal
+    where the set's first contact is one of them. The end taken is evaluated with the set; so
+    is the jump's other end n where m_among(n) < 0 (where it is > 0, m(n) is too, and no
+    smaller: the jump holds for m), as far as it must: m(n) < -|m(end)| leaves the jump
+    (narrower than |m(end)| / `JUMP_SLOPE`) and the end taken as they are
+    (`_Mismatch.below`). Where a check differs, its closing pairs join the names (the whole
+    set where they add none) and the bracket is closed again; so it is with the whole set
+    where a search among the names fails (`SeekingError`: such a search goes on below the
+    set's first contact). The result is a root or a jump of m by `_bracketed_height`'s rule;
+    where the set's first contact at every point the bracket evaluates is among the names, it
+    is the bracket's with the set, and elsewhere it may lie at another jump."""
+    ends = {a: mismatch.among(a, None), b: mismatch.among(b, None)}
+    names = frozenset(ends[a][1]) | frozenset(ends[b][1])
+    while True:
+        try:
+            end, other = _bracket_ends(
+                lambda x: ends[x][0] if x in ends else mismatch.among(x, names)[0], a, b)
+            checked = [(mismatch.among(end, None), mismatch.among(end, names)[0])]
+            if other is not None:
+                m_among, closing_among = mismatch.among(other, names)
+                T = abs(checked[0][0][0])
+                # T < n keeps the stop above the face plane; a positive m_among has a closing.
+                if m_among < 0 and T < other:
+                    checked.append((mismatch.below(other, T), m_among))
+                elif not (m_among > 0 and closing_among):      # else m >= m_among > 0
+                    checked.append((mismatch.among(other, None), m_among))
+        except SeekingError:
+            if names is None:
+                raise
+            names = None
+            continue
+        differ = [full for full, m in checked if full is not None and full[0] != m]
+        if not differ or names is None:
+            return end
+        grown = names.union(*(full[1] for full in differ))
+        names = grown if grown != names else None
+
+
+def _local_height(mismatch, s0, s_max, bracket=None):
     """The consistent aim next to the axial height s0 (`_axial_height`): s0 where
     |mismatch(s0)| <= `AIM_TOL`; otherwise up to `LOCAL_STEPS` secant steps, the first with
     slope -1 (h_c flat: s1 = s0 + mismatch(s0)), each taken where |mismatch| <= `AIM_TOL` and
@@ -191,7 +255,8 @@ def _local_height(mismatch, s0, s_max):
     Where mismatch(s0) > 0 the first step goes up, where no solution lies (`_axial_height`):
     a bracket there closes on the jump of the first contact nearest s0, which is taken. A root
     below s0 would lie between two sign changes of a mismatch positive at s0 and at 0, which
-    no bracket finds."""
+    no bracket finds. ``bracket`` closes a sign change (`_bracketed_height` where None)."""
+    bracket = bracket or _bracketed_height
     m0 = mismatch(s0)
     if abs(m0) <= AIM_TOL:
         return s0
@@ -203,7 +268,7 @@ def _local_height(mismatch, s0, s_max):
         if abs(m1) <= AIM_TOL:
             return s1
         if m1 * m0 < 0:
-            return _bracketed_height(mismatch, min(s0, s1), max(s0, s1))
+            return bracket(mismatch, min(s0, s1), max(s0, s1))
         if m1 == m0:
             return None
         s0, m0, s1 = s1, m1, s1 - m1 * (s1 - s0) / (m1 - m0)
@@ -217,7 +282,7 @@ JUMP_SLOPE = 10.0
 
 
 class _Jump(Exception):
-    """The bracket holds a jump (`JUMP_SLOPE`); args: the end taken."""
+    """The bracket holds a jump (`JUMP_SLOPE`); args: the end taken and the other end."""
 
 
 def _bracketed_height(mismatch, a, b):
@@ -226,6 +291,12 @@ def _bracketed_height(mismatch, a, b):
     `JUMP_SLOPE`, neither end's branch can reach zero between them, and the one with the
     smaller |mismatch| is taken (the higher on a tie). ValueError where mismatch(a) and
     mismatch(b) have one sign."""
+    return _bracket_ends(mismatch, a, b)[0]
+
+
+def _bracket_ends(mismatch, a, b):
+    """`_bracketed_height` and the jump's other end: (s, None) for a root, (s, n) for a jump
+    left at s."""
     seen = {}
 
     def f(s):
@@ -234,25 +305,28 @@ def _bracketed_height(mismatch, a, b):
         i = xs.index(s)
         for n in xs[max(i - 1, 0):i] + xs[i + 1:i + 2]:
             if seen[n] * m < 0 and abs(n - s) * JUMP_SLOPE < min(abs(m), abs(seen[n])):
-                raise _Jump(min((s, n), key=lambda x: (abs(seen[x]), -x)))
+                end = min((s, n), key=lambda x: (abs(seen[x]), -x))
+                raise _Jump(end, n if end == s else s)
         return m
 
     try:
-        return brentq(f, a, b, xtol=1e-10)
+        return brentq(f, a, b, xtol=1e-10), None
     except _Jump as jump:
-        return jump.args[0]
+        return jump.args
 
 
-def _consistent_height(mismatch, s_max, cells=46):
+def _consistent_height(mismatch, s_max, cells=46, bracket=None):
     """The ring-face distance s in [0, s_max] with mismatch(s) = h_c(aim(s)) - s = 0, bracketed
     over the whole range (`_bracketed_height`); where that range has no sign change, on the
     largest sign change of a grid of ``cells`` intervals. The first contact h_c jumps where it
     passes from one pair or feature to another, so the bracket may close on a jump instead of a
     root: the path at the jump is taken, and the ring centre at first contact then misses the
     offset by |mismatch(s)| |v_lateral| / chaser_speed (`InitialState.contact_offset`). None
-    where no grid interval changes sign."""
+    where no grid interval changes sign. ``bracket`` closes a sign change
+    (`_bracketed_height` where None)."""
+    bracket = bracket or _bracketed_height
     try:
-        return _bracketed_height(mismatch, 0.0, s_max)
+        return bracket(mismatch, 0.0, s_max)
     except ValueError:                                  # no sign change over the range
         pass
     grid = np.linspace(0.0, s_max, cells + 1)
@@ -262,6 +336,6 @@ def _consistent_height(mismatch, s_max, cells=46):
         if f_k == 0.0:
             return float(grid[k])
         if f_k * f_above < 0:
-            return _bracketed_height(mismatch, grid[k], grid[k + 1])
+            return bracket(mismatch, grid[k], grid[k + 1])
         f_above = f_k
     return None

@@ -120,11 +120,16 @@ def first_contact(g: ApdsGeometry, approach: Approach, *, step=None, xtol=1e-13,
     return lam_c, list(names)
 
 
-def first_contact_or_faces(g: ApdsGeometry, approach: Approach, which="paper"):
+def first_contact_or_faces(g: ApdsGeometry, approach: Approach, which="paper", among=None):
     """`first_contact`, or, when no pair of the set closes on the approach, where the rings'
     faces meet (lam = 0, the ring-face plane; no closing pair): docs/model.md, "Initial
-    conditions"."""
-    lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, None, 1e-13, which)
+    conditions". With ``among`` (pair names), only those pairs of the set are sought: each
+    pair's closing is the same to the bit as with the whole set (its seeks do not depend on
+    the other pairs), so where one of them closes, the first contact among them is never
+    higher than the set's."""
+    subset = () if among is None else (tuple(sorted(among)),)    # one memo key per search
+    lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, None, 1e-13, which,
+                                     *subset)
     return (0.0, []) if lam_c is None else (lam_c, list(names))
 
 
@@ -165,19 +170,48 @@ def pair_covers(pr: PairSpec):
 def touch_steps(pairs, approach: Approach, grid):
     """Booleans (pairs, steps): the covers of pair j's patches can touch between grid[k] and
     grid[k + 1] (`drake_dock.core.covers.touch_steps`); elsewhere the pair is apart."""
-    R, p0 = approach.pose(0.0)
-    e = -(approach.pose(1.0)[1] - p0)            # the chaser's points move by -lam e
-    grid = np.asarray(grid, dtype=float)
-    out = np.zeros((len(pairs), len(grid) - 1), dtype=bool)
-    placed = {}                                  # the moving covers, each posed once
-    for j, pr in enumerate(pairs):
-        c1, c2 = pair_covers(pr)
-        moving, fixed = (c1, c2) if pr.body1 == CHASER_APDS else (c2, c1)
-        patch = pr.patch1 if pr.body1 == CHASER_APDS else pr.patch2     # held by the pairs
-        if id(patch) not in placed:
-            placed[id(patch)] = moving.posed(R, p0)
-        out[j] = compiled_cover.touch_steps(placed[id(patch)], fixed, e, grid)
-    return out
+    return _TouchSteps(pairs, approach, grid).chunk(0, len(grid) - 1)
+
+
+# `_TouchSteps` finds the first this many steps of a search's grid, and the rest where the
+# search goes on (a search ends at its first contact, and below it the covers overlap most).
+TOUCH_CHUNK = 32
+
+
+class _TouchSteps:
+    """`touch_steps` of a search's grid, found on demand: its first `TOUCH_CHUNK` steps, then
+    the rest. A step's booleans depend on the grid only through that step's ends, so a
+    chunk's are the whole grid's."""
+
+    def __init__(self, pairs, approach: Approach, grid):
+        self.pairs, self.grid = pairs, np.asarray(grid, dtype=float)
+        R, p0 = approach.pose(0.0)
+        self.e = -(approach.pose(1.0)[1] - p0)       # the chaser's points move by -lam e
+        self.covers, placed = [], {}                 # the moving covers, each posed once
+        for pr in pairs:
+            c1, c2 = pair_covers(pr)
+            moving, fixed = (c1, c2) if pr.body1 == CHASER_APDS else (c2, c1)
+            patch = pr.patch1 if pr.body1 == CHASER_APDS else pr.patch2  # held by the pairs
+            if id(patch) not in placed:
+                placed[id(patch)] = moving.posed(R, p0)
+            self.covers.append((placed[id(patch)], fixed))
+        self.chunks = {}
+
+    def chunk(self, k0, k1):
+        """Booleans (pairs, k1 - k0) of the steps k0 to k1 - 1."""
+        grid = self.grid[k0:k1 + 1]
+        out = np.zeros((len(self.pairs), k1 - k0), dtype=bool)
+        for j, (moving, fixed) in enumerate(self.covers):
+            out[j] = compiled_cover.touch_steps(moving, fixed, self.e, grid)
+        return out
+
+    def column(self, k):
+        """The pairs' booleans of step k."""
+        k0 = 0 if k < TOUCH_CHUNK else TOUCH_CHUNK
+        if k0 not in self.chunks:
+            k1 = TOUCH_CHUNK if k0 == 0 else len(self.grid) - 1
+            self.chunks[k0] = self.chunk(k0, min(k1, len(self.grid) - 1))
+        return self.chunks[k0][:, k - k0]
 
 
 class _Gaps:
@@ -359,27 +393,47 @@ def search_pairs(geometry: tuple, which: str) -> tuple:
     return tuple(apds_pairs(ApdsGeometry(*geometry), which))
 
 
+def first_contact_above(g: ApdsGeometry, approach: Approach, which, lam_stop: float):
+    """`first_contact_or_faces`'s first contact found by a search that stops at lam_stop:
+    (lam, closing pairs), or (None, []) where no pair of the set closes at lam_stop or
+    above."""
+    lam_c, names, _ = _first_contact(dataclasses.astuple(g), approach, None, 1e-13, which,
+                                     None, lam_stop)
+    return (None, []) if lam_c is None else (lam_c, list(names))
+
+
 @functools.lru_cache(maxsize=64)
-def _first_contact(geometry: tuple, approach: Approach, step, xtol, which):
+def _first_contact(geometry: tuple, approach: Approach, step, xtol, which, among=None,
+                   stop=None):
+    """(lam, closing pairs, seeks) of `first_contact`'s search with the pairs of the set
+    ``which`` (only those named in ``among`` where given). With ``stop`` it ends on the step
+    holding that travel: (None, (), seeks) where no pair closes at stop or above."""
     g = ApdsGeometry(*geometry)
     pairs = search_pairs(geometry, which)
+    if among is not None:
+        pairs = tuple(pr for pr in pairs if pr.name in among)
     grid = travel_grid(g, approach, step)
-    touch = touch_steps(pairs, approach, grid)
+    touch = _TouchSteps(pairs, approach, grid)
     gaps = _Gaps(pairs, approach, grid)
     for k in range(len(grid) - 1):
         # A pair closes on the step when its gap is > `TOUCH_GAP` at grid[k] (apart, not
         # touching or cutting) and <= 0 at grid[k + 1]; otherwise a pair that comes within the
         # step's travel is marched (`march_root`).
         roots, travel, marched = {}, grid[k] - grid[k + 1], []
-        for j in np.flatnonzero(touch[:, k]):
+        for j in np.flatnonzero(touch.column(k)):
             if TOUCH_GAP < gaps.gap(j, k) < np.inf and gaps.gap(j, k + 1) <= 0:
                 roots[j] = gaps.root(j, k, xtol)
             elif abs(gaps.distance(j, k)) < travel:
                 marched.append(j)
-        roots.update(gaps.marches(marched, k, xtol, max(roots.values(), default=None)))
+        # On the step holding ``stop`` the marches stop there, as below a known closing.
+        last = stop is not None and grid[k + 1] < stop
+        best = max([*roots.values(), *([stop] if last else [])], default=None)
+        roots.update(gaps.marches(marched, k, xtol, best))
         roots = {pairs[j].name: lam for j, lam in roots.items()}
-        if roots:
+        if roots and not (last and max(roots.values()) < stop):
             d_c = max(roots.values())
             names = tuple(sorted(n for n, r in roots.items() if r >= d_c - 1e-9))
             return d_c, names, gaps.seeks
+        if last:
+            break
     return None, (), gaps.seeks
