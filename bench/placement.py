@@ -51,8 +51,10 @@ class _Timed:
 
 def _whole_set_bracket(s):
     """The placement's wall time and searches with the bracket closed with the whole set
-    (`_bracketed_height` for `_among_height`), the searches' memo cleared."""
+    (`_bracketed_height` for `_among_height`), the searches' and the path check's memos
+    cleared."""
     search._first_contact.cache_clear()
+    path_check._checked.cache_clear()
     timed = _Timed(search._first_contact)
     with mock.patch.object(search, "_first_contact", timed), \
             mock.patch.object(scene, "_among_height", scene._bracketed_height):
