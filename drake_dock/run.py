@@ -20,7 +20,7 @@ import numpy as np
 from drake_dock.docking.replay import replay_html
 from drake_dock.docking.pairs import scenario_pairs
 from drake_dock.docking.results import (momenta, momentum_reference_point, relative_text, summary,
-                                        timeseries)
+                                        thrust_impulses, timeseries)
 from drake_dock.docking.simulate import simulate
 from drake_dock.errors import NumericalError
 from drake_dock.docking.figures import initial_configuration_figure, run_figures
@@ -92,8 +92,10 @@ def _run(scenario, out_dir, progress, state, dd, full, log):
         raise NumericalError(f"the run's summary value {bad} is not finite (an overflow of "
                              f"extreme inputs)", time=result.end_time)
     params = [getattr(scenario.bodies, n) for n in ts["body_names"]]
-    P, L, _, _ = momenta(ts, [p.mass for p in params], [p.inertia for p in params],
-                         momentum_reference_point(scenario, ts))
+    about = momentum_reference_point(scenario, ts)
+    P, L, _, _ = momenta(ts, [p.mass for p in params], [p.inertia for p in params], about)
+    J, H = thrust_impulses(result, ts, about)       # conserved: momentum less the impulse
+    P, L = P - J, L - H
     nq = result.dd.dp.plant.num_positions()
     html = replay_html(scenario, ts["t"], np.asarray(result.record.x)[:, :nq], ts=ts)
     with atomic_directory(out_dir) as tmp:

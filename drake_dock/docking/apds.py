@@ -25,6 +25,7 @@ Features beyond the paper's pairs (docs/model.md, "What the 12 pairs leave out")
 
 import dataclasses
 import math
+import typing
 
 import numpy as np
 
@@ -47,11 +48,19 @@ class ApdsGeometry:
     H: float = 0.2          # petal height
     alpha1_deg: float = 45.0  # cone angle between generatrix and ring plane
     alpha2_deg: float = 30.0  # angle of an auxiliary plane with its radius line
+    # Radius of the petals' roots on the ring face (m), Rs <= petal_root_radius <= R; null:
+    # R, the paper's petals, which stand on the ring's outside circle. At Rs they stand on
+    # the ring's inside circle and pass through the other ring's passage, so that the rings
+    # can meet face to face (docs/model.md, "APDS geometry").
+    petal_root_radius: typing.Optional[float] = None
 
     def validate(self, prefix: str = "geometry") -> "ApdsGeometry":
-        for name in ("R", "Rs", "H", "alpha1_deg", "alpha2_deg"):
+        names = ("R", "Rs", "H", "alpha1_deg", "alpha2_deg")
+        if self.petal_root_radius is not None:
+            names += ("petal_root_radius",)
+        for name in names:
             v = getattr(self, name)
-            if not isinstance(v, (int, float)) or not math.isfinite(v):
+            if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v):
                 raise InputError(f"{prefix}.{name}", v, "a finite number")
         if self.R <= 0:
             raise InputError(f"{prefix}.R", self.R, "R > 0 m")
@@ -61,23 +70,39 @@ class ApdsGeometry:
                 raise InputError(f"{prefix}.{name}", v, "0 < angle < 90 deg")
         if not 0.0 < self.Rs < self.R:
             raise InputError(f"{prefix}.Rs", self.Rs, f"0 < Rs < R = {self.R} m")
+        Rp, root = self.Rp, (f"{prefix}.petal_root_radius" if self.petal_root_radius
+                             is not None else f"{prefix}.R")
+        if self.petal_root_radius is not None and not self.Rs <= Rp <= self.R:
+            raise InputError(root, Rp, f"Rs = {self.Rs} <= petal_root_radius <= R = {self.R} m, "
+                             "or null (R)", "a petal rooted inside the passage would leave its "
+                             "root edge free, which the contact set does not model")
         cot1 = 1.0 / math.tan(math.radians(self.alpha1_deg))
-        h_max = self.R / cot1
+        h_max = Rp / cot1
         if not 0.0 < self.H < h_max:
             raise InputError(f"{prefix}.H", self.H,
-                             f"0 < H < R tan(alpha1) = {h_max:.6g} m (H cot(alpha1) < R)",
-                             "the petal would reach the axis")
+                             f"0 < H < Rp tan(alpha1) = {h_max:.6g} m (H cot(alpha1) < Rp, the "
+                             f"petal root radius)", "the petal would reach the axis")
         a2 = math.radians(self.alpha2_deg)
-        arg = self.R * math.sin(a2) / (self.R - self.H * cot1)
+        arg = Rp * math.sin(a2) / (Rp - self.H * cot1)
         # The two sides of a petal must not meet below zeta = H: theta_end < pi/6.
         if arg >= 1.0 or math.asin(arg) - a2 >= math.pi / 6:
-            limit = self.R * (1.0 - math.sin(a2) / math.sin(a2 + math.pi / 6)) / cot1
+            limit = Rp * (1.0 - math.sin(a2) / math.sin(a2 + math.pi / 6)) / cot1
             raise InputError(f"{prefix}.H", self.H,
-                             f"H < {limit:.6g} m for R = {self.R}, alpha1 = {self.alpha1_deg},"
+                             f"H < {limit:.6g} m for Rp = {Rp}, alpha1 = {self.alpha1_deg},"
                              f" alpha2 = {self.alpha2_deg}", "the petal's sides would cross")
         return self
 
     # Derived quantities ---------------------------------------------------------------------
+    @property
+    def Rp(self) -> float:
+        """The petals' root radius (m): ``petal_root_radius``, or R (the paper's)."""
+        return self.R if self.petal_root_radius is None else float(self.petal_root_radius)
+
+    @property
+    def tip_radius(self) -> float:
+        """The radius of the petal tips' arcs, Rp - H cot(alpha1) (m)."""
+        return self.Rp - self.H / math.tan(self.alpha1)
+
     @property
     def alpha1(self) -> float:
         return math.radians(self.alpha1_deg)
@@ -93,8 +118,8 @@ class ApdsGeometry:
 
     def theta_1(self, zeta):
         """Eq. (13): angular inset of the petal's sides at height zeta."""
-        rho = self.R - np.asarray(zeta, dtype=float) / math.tan(self.alpha1)
-        return np.arcsin(self.R * math.sin(self.alpha2) / rho) - self.alpha2
+        rho = self.Rp - np.asarray(zeta, dtype=float) / math.tan(self.alpha1)
+        return np.arcsin(self.Rp * math.sin(self.alpha2) / rho) - self.alpha2
 
 
 def side_phi(i: int) -> float:
@@ -110,7 +135,7 @@ def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
     if i not in range(1, 7):
         raise InputError("guide side", i, "1..6")
     phi, sigma = side_phi(i), side_sigma(i)
-    A = g.R * math.sin(g.alpha2)
+    A = g.Rp * math.sin(g.alpha2)
     tan1 = math.tan(g.alpha1)
     # The sine form holds for 0 < w < pi (w modulo 2 pi); beyond its reach, halfway from the
     # domain's ends to those limits, rho is held (docs/model.md, "Degenerate couples").
@@ -139,7 +164,7 @@ def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
         return rho, r1, r2
 
     def axial_of(rho, r1, r2):
-        return (g.R - rho) * tan1, -r1 * tan1, -r2 * tan1
+        return (g.Rp - rho) * tan1, -r1 * tan1, -r2 * tan1
 
     def axial(th):
         return axial_of(*radial(th))
@@ -149,7 +174,7 @@ def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
         return rad, axial_of(*rad)
 
     return PolarCurve(radial, axial, (phi, phi + sigma * g.theta_end), parts,
-                      kernel_params=(A, sigma, phi, tan1, g.R, g.alpha2))
+                      kernel_params=(A, sigma, phi, tan1, g.Rp, g.alpha2))
 
 
 class _PetalMap:
@@ -161,20 +186,20 @@ class _PetalMap:
         self.lower = np.array([0.0, 0.0])
         self.upper = np.array([1.0, g.H])
         self.cot1 = 1.0 / math.tan(g.alpha1)
-        self.A = g.R * math.sin(g.alpha2)
+        self.A = g.Rp * math.sin(g.alpha2)
         # The map's parameters for the compiled kernels (kind PETAL).
-        self.kernel_params = (self.phi0, self.cot1, self.A, g.alpha2, g.R)
+        self.kernel_params = (self.phi0, self.cot1, self.A, g.alpha2, g.Rp)
         # Eq. (13) holds while x = A / rho < 1, zeta < (R - A) tan(alpha1). Its reach is the
         # domain grown at both ends by half the distance from zeta = H to that limit; beyond
         # it theta_1 is held (docs/model.md, "Degenerate couples"): the surface continues as
         # the cone between two fixed meridians.
-        grow = 0.5 * ((g.R - self.A) / self.cot1 - g.H)
+        grow = 0.5 * ((g.Rp - self.A) / self.cot1 - g.H)
         self.z_reach = (-grow, g.H + grow)
 
     def _t1(self, z):
         lo, hi = self.z_reach
         held = (z < lo) | (z > hi)
-        rho = self.g.R - np.clip(z, lo, hi) * self.cot1
+        rho = self.g.Rp - np.clip(z, lo, hi) * self.cot1
         x = self.A / rho
         x1 = x * self.cot1 / rho                 # dx/dz
         x2 = 2.0 * x * self.cot1**2 / rho**2     # d2x/dz2
@@ -191,7 +216,7 @@ class _PetalMap:
         cot = self.cot1
         lo, hi = self.z_reach
         inside = lo <= z <= hi
-        rho = self.g.R - (z if inside else min(max(z, lo), hi)) * cot
+        rho = self.g.Rp - (z if inside else min(max(z, lo), hi)) * cot
         x = self.A / rho
         x1 = x * cot / rho
         x2 = 2.0 * x * cot**2 / rho**2
@@ -233,7 +258,7 @@ def guide_surface(g: ApdsGeometry, k: int) -> Reparametrized:
     if k not in (1, 2, 3):
         raise InputError("guide surface", k, "1..3")
     phi0 = side_phi(2 * k - 1)
-    cone = Cone(g.R, g.alpha1, (phi0, phi0 + math.pi / 3), (0.0, g.H))
+    cone = Cone(g.Rp, g.alpha1, (phi0, phi0 + math.pi / 3), (0.0, g.H))
     return Reparametrized(cone, _PetalMap(g, k))
 
 
@@ -249,8 +274,8 @@ def petal_edges(g: ApdsGeometry, k: int) -> dict:
         side, phi, sigma = guide_side(g, i), side_phi(i), side_sigma(i)
         out[i] = SurfaceEdge(0, upper, lambda th, side=side: side.parts(th)[1][0],
                              lambda z, phi=phi, sigma=sigma: phi + sigma * (
-                                 math.asin(m.A / (g.R - z * m.cot1)) - g.alpha2))
-    t1 = math.asin(m.A / (g.R - g.H * m.cot1)) - g.alpha2
+                                 math.asin(m.A / (g.Rp - z * m.cot1)) - g.alpha2))
+    t1 = math.asin(m.A / (g.Rp - g.H * m.cot1)) - g.alpha2
     w = math.pi / 3 - 2 * t1
     out["tip"] = SurfaceEdge(1, True, lambda th: (th - m.phi0 - t1) / w,
                              lambda s: m.phi0 + t1 + s * w)
@@ -268,7 +293,7 @@ def tip_arc(g: ApdsGeometry, k: int) -> Arc:
     if k not in (1, 2, 3):
         raise InputError("tip arc", k, "1..3")
     phi0 = side_phi(2 * k - 1)
-    return Arc(g.R - g.H / math.tan(g.alpha1), g.H,
+    return Arc(g.Rp - g.H / math.tan(g.alpha1), g.H,
                (phi0 + g.theta_end, phi0 + math.pi / 3 - g.theta_end))
 
 

@@ -18,7 +18,7 @@ REACH_TOL = 1e-7
 def cone_distance(g, X):
     """Signed distance s of points X (M, 3) to the cone of Eq. (12), positive away from the
     axis: the same for the three petals."""
-    return (np.hypot(X[:, 0], X[:, 1]) - g.R) * math.sin(g.alpha1) + X[:, 2] * math.cos(g.alpha1)
+    return (np.hypot(X[:, 0], X[:, 1]) - g.Rp) * math.sin(g.alpha1) + X[:, 2] * math.cos(g.alpha1)
 
 
 def cone_extremes(g, A, D, lo, hi):

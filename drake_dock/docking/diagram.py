@@ -28,6 +28,7 @@ from drake_dock.systems.simulator import tolerances
 from drake_dock.docking.outcome import CaptureRule, misalignment
 from drake_dock.docking.plant import DockingPlant, StewartDamperPower, make_docking_plant
 from drake_dock.docking.pairs import pair_handovers, scenario_pairs
+from drake_dock.docking.thrust import ThrustSchedule, ThrustSystem
 
 
 @dataclasses.dataclass
@@ -37,6 +38,7 @@ class DockingDiagram:
     dp: DockingPlant
     scene_graph: object
     capture: "CaptureMonitor"
+    thrust: ThrustSystem | None = None     # the scenario's post-contact thrust, if any
 
 
 def ring_poses(dp: DockingPlant, plant_context):
@@ -129,9 +131,10 @@ def build_docking_diagram(scenario, meshcat=None, options=None,
     pairs = [ContactPair(p.name, p.kind, frames[p.body1], p.patch1, frames[p.body2], p.patch2)
              for p in specs]
     options = contact_options(scenario, options)
+    schedule = ThrustSchedule.of(scenario.thrust)
     contact = builder.AddSystem(RigidContactSystem(
         dp.plant, pairs, scenario.contact, options,
-        wrench_bodies=("chaser",),
+        wrench_bodies=("chaser",) + ((("chaser_thrust", "chaser"),) if schedule else ()),
         extra_powers=[("stewart_damper_work", StewartDamperPower(dp))],
         energy_scale=0.5 * scenario.bodies.chaser.mass * scenario.initial.chaser_speed ** 2
         or 1.0, handovers=[Handover(*h) for h in pair_handovers(scenario.geometry, specs)]
@@ -142,6 +145,14 @@ def build_docking_diagram(scenario, meshcat=None, options=None,
     builder.Connect(contact.GetOutputPort("state"), to_pose.get_input_port())
     builder.Connect(to_pose.get_output_port(),
                     scene_graph.get_source_pose_port(dp.plant.get_source_id()))
+    thrust = None
+    if schedule is not None:
+        thrust = builder.AddSystem(ThrustSystem(dp, schedule))
+        thrust.set_name("thrust")
+        builder.Connect(contact.GetOutputPort("state"), thrust.GetInputPort("state"))
+        builder.Connect(contact.GetOutputPort("first_contact_time"),
+                        thrust.GetInputPort("first_contact_time"))
+        builder.Connect(thrust.get_output_port(), contact.GetInputPort("chaser_thrust"))
     capture = builder.AddSystem(CaptureMonitor(dp, CaptureRule.of(scenario.simulation,
                                                                   scenario.geometry)))
     capture.set_name("capture")
@@ -153,4 +164,4 @@ def build_docking_diagram(scenario, meshcat=None, options=None,
         builder.ExportOutput(port, port.get_name())
     if meshcat is not None:
         MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat)
-    return DockingDiagram(builder.Build(), contact, dp, scene_graph, capture)
+    return DockingDiagram(builder.Build(), contact, dp, scene_graph, capture, thrust)

@@ -59,6 +59,18 @@ from drake_dock.errors import InputError
 
 PETAL_FEATURES = ("ring inside circle", "guide side", "petal")     # name prefixes
 RING_FEATURES = ("ring",)
+ALL_FEATURES = ("ring", "guide side", "petal")
+
+
+def checked_features(g) -> tuple:
+    """(the feature name prefixes checked against the other APDS's petals, those checked
+    against its ring). Petals on the ring's outside circle (the paper's, Rp >= Rs) pass the
+    other ring's annulus in the paper's reading (docs/model.md), so petals and ring are not
+    checked against each other; petals standing on the ring's inside circle (Rp = Rs) pass
+    through the other ring's passage, and every feature is checked against both."""
+    if g.Rp <= g.Rs:
+        return ALL_FEATURES, ALL_FEATURES
+    return PETAL_FEATURES, RING_FEATURES
 SAME_PLACE = 1e-10      # m: hits this close on one path are one crossing (a shared edge)
 MAX_TRIANGLES = 4e6     # of an APDS (the default: 0.44 million)
 
@@ -90,7 +102,7 @@ class MeshResolution:
     def chord_errors(self, g) -> dict:
         """The sagittas (m) of the widest rows: {"petal": from the cone, "petal root": from the
         ring's outside circle, "ring": from the ring's outside wall}."""
-        root = g.R * (math.pi / (3 * self.across)) ** 2 / 8
+        root = g.Rp * (math.pi / (3 * self.across)) ** 2 / 8
         return {"petal": math.sin(g.alpha1) * root, "petal root": root,
                 "ring": g.R * (math.pi / self.around) ** 2 / 2}
 
@@ -99,8 +111,8 @@ def petal_points(g, k, s, zeta):
     """Points of petal k's guide surface at fraction s across (0 and 1 on guide sides 2k - 1
     and 2k) and height zeta (Eq. 12, 13), in the APDS frame."""
     s, zeta = np.broadcast_arrays(np.asarray(s, float), np.asarray(zeta, float))
-    rho = g.R - zeta / math.tan(g.alpha1)
-    inset = np.arcsin(g.R * math.sin(g.alpha2) / rho) - g.alpha2
+    rho = g.Rp - zeta / math.tan(g.alpha1)
+    inset = np.arcsin(g.Rp * math.sin(g.alpha2) / rho) - g.alpha2
     th = (2 * k - 2) * math.pi / 3 + inset + s * (math.pi / 3 - 2 * inset)
     return np.stack([rho * np.cos(th), rho * np.sin(th), zeta], -1)
 
@@ -332,7 +344,7 @@ class TriangleMesh:
 @functools.lru_cache(maxsize=4)
 def apds_meshes(shape, res, ring_depth):
     """([petal 1, 2, 3], ring) `TriangleMesh`es of an APDS; shape = (R, Rs, H, alpha1,
-    alpha2), alpha in rad."""
+    alpha2, Rp), alpha in rad."""
     g = _Shape(*shape)
     petals = []
     for k in (1, 2, 3):
@@ -349,6 +361,7 @@ class _Shape:
     H: float
     alpha1: float
     alpha2: float
+    Rp: float
 
 
 class _Watch:
@@ -451,13 +464,15 @@ def deepest_penetration_mesh(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_tr
     if not isinstance(res, MeshResolution):
         raise InputError("resolution", res, "a MeshResolution or None")
     res.validate()
-    shape = (float(g.R), float(g.Rs), float(g.H), float(g.alpha1), float(g.alpha2))
+    shape = (float(g.R), float(g.Rs), float(g.H), float(g.alpha1), float(g.alpha2),
+             float(g.Rp))
     petals, ring = apds_meshes(shape, res, float(ring_depth))
     feats = mesh_features(g, res) if features is None else features
+    vs_petals, vs_ring = checked_features(g)
     on_petals = [(f, X[~((np.abs(X[:, 2]) < 1e-12)          # roots on the outside circle
-                        & (np.abs(np.hypot(X[:, 0], X[:, 1]) - g.R) < 1e-9))])
-                 for f, X in feats.items() if f.startswith(PETAL_FEATURES)]
-    on_ring = [(f, X) for f, X in feats.items() if f.startswith(RING_FEATURES)]
+                        & (np.abs(np.hypot(X[:, 0], X[:, 1]) - g.Rp) < 1e-9))])
+                 for f, X in feats.items() if f.startswith(vs_petals)]
+    on_ring = [(f, X) for f, X in feats.items() if f.startswith(vs_ring)]
     which = {kind: [f for f, X in group for _ in range(len(X))]
              for kind, group in (("petal", on_petals), ("ring", on_ring))}
     Xp, Xr = (np.concatenate([X for _, X in group] + [np.zeros((0, 3))])

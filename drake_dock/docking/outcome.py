@@ -1,13 +1,19 @@
 """How a docking run ends: the named outcomes and their rules (pure functions of the rings'
-relative pose over time and of whether a couple is in contact).
+relative pose over time and of whether post-contact thrust still acts).
 
 - ``captured``: the latches can engage: the axial ring-centre distance within
   ``simulation.capture_distance``, the lateral offset within ``simulation.capture_lateral`` and
   the tilt between the docking axes within ``simulation.capture_tilt_deg`` (`CaptureRule`;
   `drake_dock.docking.diagram.CaptureMonitor` locates it with a witness).
-- ``rebound``: no couple in contact, the ring distance above its start and growing.
+- ``missed``: the chaser passes beside the target (the rings' centres more than 2 R apart
+  across the axis: their disks no longer overlap) or beyond its ring plane (the chaser's ring
+  centre more than a petal height H behind the target's ring face).
+- ``rebound``: the rings separate: their distance above its start and growing, with no thrust
+  still to act (a couple may still graze).
 - ``jammed``: the distance to capture (`CaptureRule.to_go`) has not fallen by ``JAM_DISTANCE``
-  for ``simulation.jam_time`` seconds.
+  for ``simulation.jam_time`` seconds with no thrust still to act (the thrust restarts the
+  clock while it drives the chaser). The run's result names the couples that hold the rings
+  (`drake_dock.docking.simulate`).
 - ``timeout``: ``simulation.duration`` reached first.
 """
 from __future__ import annotations
@@ -16,7 +22,7 @@ import dataclasses
 import math
 
 
-OUTCOMES = ("captured", "rebound", "jammed", "timeout")
+OUTCOMES = ("captured", "missed", "rebound", "jammed", "timeout")
 JAM_DISTANCE = 1e-3     # m: the progress that resets the jam clock
 
 
@@ -74,23 +80,37 @@ class CaptureRule:
 
 @dataclasses.dataclass
 class OutcomeWatch:
-    """Fed the ring distance and the distance to capture (`CaptureRule.to_go`) at each step;
-    ``update`` returns (outcome, reason) once a rule other than capture holds, else None."""
+    """Fed the rings' pose (`misalignment`) and the distance to capture (`CaptureRule.to_go`)
+    at each step; ``update`` returns (outcome, reason) once a rule other than capture holds,
+    else None. ``beside`` (m, 2 R) and ``beyond`` (m, H) are the `missed` rule's bounds."""
 
     d_start: float
     jam_time: float
+    beside: float = math.inf
+    beyond: float = math.inf
     t_best: float = 0.0
     d_best: float = float("inf")
     d_last: float = float("inf")
 
-    def update(self, t: float, d: float, in_contact: bool, to_go: float | None = None):
+    def update(self, t: float, d: float, lateral: float = 0.0, to_go: float | None = None,
+               driven: bool = False):
+        """``d``: the axial ring-centre distance (m), ``lateral`` the lateral offset (m),
+        ``driven``: post-contact thrust acts now or later."""
         to_go = d if to_go is None else to_go
-        if to_go <= self.d_best - JAM_DISTANCE or self.d_best == float("inf"):
-            self.d_best, self.t_best = to_go, t
+        if driven or to_go <= self.d_best - JAM_DISTANCE or self.d_best == float("inf"):
+            self.d_best, self.t_best = min(to_go, self.d_best), t
         growing, self.d_last = d > self.d_last, d
-        if not in_contact and growing and d > self.d_start:
-            return "rebound", (f"separating with no couple in contact: ring distance {d:.6g} m "
-                               f"above its start {self.d_start:.6g} m")
+        if lateral > self.beside:
+            return "missed", (f"the chaser passes beside the target: the ring centres "
+                              f"{lateral:.4g} m apart across the axis (> 2 R = "
+                              f"{self.beside:g} m)")
+        if d < -self.beyond:
+            return "missed", (f"the chaser passes beyond the target's ring plane: its ring "
+                              f"centre {-d:.4g} m behind it (> H = {self.beyond:g} m), "
+                              f"{lateral:.4g} m off the axis")
+        if not driven and growing and d > self.d_start:
+            return "rebound", (f"the rings separate: ring distance {d:.6g} m, above its start "
+                               f"{self.d_start:.6g} m and growing")
         if t - self.t_best >= self.jam_time:
             return "jammed", (f"the distance to capture has not fallen by {JAM_DISTANCE:g} m "
                               f"in {self.jam_time:g} s (at {to_go:.6g} m; ring distance "

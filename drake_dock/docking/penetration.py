@@ -45,6 +45,18 @@ from drake_dock.docking.rotations import rot_vec
 
 PETAL_FEATURES = ("ring inside circle", "guide side", "petal")     # name prefixes
 RING_FEATURES = ("ring",)
+ALL_FEATURES = ("ring", "guide side", "petal")
+
+
+def checked_features(g) -> tuple:
+    """(the feature name prefixes checked against the other APDS's petals, those checked
+    against its ring). Petals on the ring's outside circle (the paper's, Rp >= Rs) pass the
+    other ring's annulus in the paper's reading (docs/model.md), so petals and ring are not
+    checked against each other; petals standing on the ring's inside circle (Rp = Rs) pass
+    through the other ring's passage, and every feature is checked against both."""
+    if g.Rp <= g.Rs:
+        return ALL_FEATURES, ALL_FEATURES
+    return PETAL_FEATURES, RING_FEATURES
 
 
 @dataclasses.dataclass
@@ -66,8 +78,8 @@ class Penetration:
 
 def _inset(g, zeta):
     """Eq. (13): theta_1(zeta) = arcsin(R sin(alpha2) / rho(zeta)) - alpha2."""
-    rho = g.R - zeta / math.tan(g.alpha1)
-    return np.arcsin(np.clip(g.R * math.sin(g.alpha2) / rho, -1.0, 1.0)) - g.alpha2
+    rho = g.Rp - zeta / math.tan(g.alpha1)
+    return np.arcsin(np.clip(g.Rp * math.sin(g.alpha2) / rho, -1.0, 1.0)) - g.alpha2
 
 
 def feature_points(g, *, n_circle=1440, n_side=80, n_arc=60, n_face=9):
@@ -80,15 +92,15 @@ def feature_points(g, *, n_circle=1440, n_side=80, n_arc=60, n_face=9):
 
     out = {"ring inside circle": circle(g.Rs), "ring outside circle": circle(g.R)}
     out["ring face"] = np.concatenate([circle(r)[::4] for r in np.linspace(g.Rs, g.R, n_face)])
-    A, tan1 = g.R * math.sin(g.alpha2), math.tan(g.alpha1)
+    A, tan1 = g.Rp * math.sin(g.alpha2), math.tan(g.alpha1)
     end = float(_inset(g, g.H))
     for i in range(1, 7):                          # Eq. (14), sine form
         phi, sigma = (i - 1) * math.pi / 3, (1 if i % 2 else -1)
         t = phi + sigma * np.linspace(0.0, end, n_side)
         rho = A / np.sin(g.alpha2 + sigma * (t - phi))
         out[f"guide side {i}"] = np.stack([rho * np.cos(t), rho * np.sin(t),
-                                           (g.R - rho) * tan1], -1)
-    r_tip = g.R - g.H / tan1
+                                           (g.Rp - rho) * tan1], -1)
+    r_tip = g.Rp - g.H / tan1
     for k in (1, 2, 3):
         phi = (2 * k - 2) * math.pi / 3
         t = np.linspace(phi + end, phi + math.pi / 3 - end, n_arc)
@@ -138,7 +150,7 @@ def free_edges(g, n=4001) -> dict:
         a, b = f[f"guide side {2 * k - 1}"], f[f"guide side {2 * k}"]
         th_a, th_b = math.atan2(a[0, 1], a[0, 0]), math.atan2(b[0, 1], b[0, 0])
         th = th_b + np.linspace(0.0, 1.0, n) * ((th_a - th_b + math.pi) % (2 * math.pi) - math.pi)
-        root = np.column_stack([g.R * np.cos(th), g.R * np.sin(th), np.zeros(n)])
+        root = np.column_stack([g.Rp * np.cos(th), g.Rp * np.sin(th), np.zeros(n)])
         out[k] = np.concatenate([a, f[f"petal {k} tip arc"], b[::-1], root])
     return out
 
@@ -149,7 +161,7 @@ def annulus_rim(g, X):
     APDS's petals pass in the paper's reading, so not checked against them. Only the root's
     own sample is left out; the next sample of a side (`feature_points`) lies 4 mm above the
     ring face."""
-    return (np.abs(X[:, 2]) < 1e-12) & (np.abs(np.hypot(X[:, 0], X[:, 1]) - g.R) < 1e-9)
+    return (np.abs(X[:, 2]) < 1e-12) & (np.abs(np.hypot(X[:, 0], X[:, 1]) - g.Rp) < 1e-9)
 
 
 def foot_on_cone(g, X, s):
@@ -175,7 +187,7 @@ _POLYLINES = {}
 
 def edge_polylines(g) -> dict:
     """{petal k: its free edges (`free_edges`) as a `Polyline`}, kept per geometry."""
-    key = (g.R, g.H, g.alpha1, g.alpha2)
+    key = (g.Rp, g.H, g.alpha1, g.alpha2)
     hit = _POLYLINES.get(key)
     if hit is None:
         if len(_POLYLINES) > 8:
@@ -426,11 +438,12 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
     best, rank = Penetration(), None
     edges = edge_polylines(g)
     on_petals = {f: ~annulus_rim(g, X) for f, X in feats.items()}
+    vs_petals, vs_ring = checked_features(g)
     for a, b in ((0, 1), (1, 0)):
         R, p = relative_poses(R_WA, p_WA, a, b)
         watches = {f: _PetalWatch(tuple(f"{names[b]} petal {k}" for k in (1, 2, 3)), edges,
                                   graze, sparse=sparse)
-                   for f in feats if f.startswith(PETAL_FEATURES)}
+                   for f in feats if f.startswith(vs_petals)}
         moved = {}      # a translation: {feature: (X R^T, the watched points that can cross)}
         if sparse and all(np.array_equal(R[0], R_n) for R_n in R[1:]):
             for fname, X in feats.items():
@@ -465,7 +478,7 @@ def deepest_penetration(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_travel=
                     low = Y[:, :, 2].min(axis=1)
                 else:           # the ring's solid lies below its face: only rows reaching it
                     low = (X @ Rz.T + pz).min(axis=0) - 1e-9
-                if fname.startswith(RING_FEATURES):
+                if fname.startswith(vs_ring):
                     rows = np.flatnonzero(low < 0.0)
                     if Y is None and len(rows):
                         Y = np.stack([X @ block[c][1].T + block[c][2] for c in rows])

@@ -151,6 +151,15 @@ def body_momenta(dp: DockingPlant, plant_context, about=np.zeros(3)):
     return P, L, sP, sL
 
 
+def relative_kinetic_energy(dp: DockingPlant, plant_context) -> float:
+    """The kinetic energy in the centre-of-mass frame of the three bodies (J): the total
+    1/2 v^T M v less the centre of mass's |P|^2 / (2 m). This is what contact can take or
+    give: about 1/2 mu v^2 for a closing speed v, mu the reduced mass of the two spacecraft."""
+    P, _, _, _ = body_momenta(dp, plant_context)
+    m = sum(b.default_mass() for b in dp.bodies.values())
+    return float(dp.plant.CalcKineticEnergy(plant_context) - P @ P / (2.0 * m))
+
+
 # The Stewart element's energy -------------------------------------------------------------
 def _half_rotation(R):
     """R^(1/2): the rotation by half the angle about the same axis."""

@@ -12,10 +12,12 @@ for far couples); stewart_x[N,3] (m), stewart_rpy[N,3] (rad) (the Stewart elemen
 target APDS in the world frame, `drake_dock.docking.plant.stewart_force`); sample_kind[N]
 (0 step end, 1 just before an impact, 2 just after); ring_distance[N]; energy[N,k] with
 energy_names[k]; impact_t[M], impact_couples[M,12] (bool), impact_normal_impulse[M,12],
-impact_tangential_impulse[M,12,2], impact_restitution[M].
+impact_tangential_impulse[M,12,2], impact_restitution[M]; thrust_force_W[N,3] (N, the
+post-contact thrust on the chaser, world frame; zero without a ``thrust`` section).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -26,6 +28,8 @@ from drake_dock.docking.outcome import misalignment
 from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
                                       stewart_force, stewart_potential)
 from drake_dock.docking.pairs import CHASER_APDS, cost_by_pair_type, scenario_pairs
+from drake_dock.docking.simulate import PRE_IMPACT
+from drake_dock.docking.thrust import ThrustSchedule
 
 IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or sticking)
 
@@ -83,7 +87,62 @@ def timeseries(result) -> dict:
         energy_names=np.array(energy_names),
         impact_t=np.array([imp["t"] for imp in result.impacts], dtype=float),
         impact_couples=imp_c, impact_normal_impulse=imp_n, impact_tangential_impulse=imp_t,
-        impact_restitution=np.array([imp["restitution"] for imp in result.impacts], dtype=float))
+        impact_restitution=np.array([imp["restitution"] for imp in result.impacts], dtype=float),
+        thrust_force_W=thrust_forces(result, np.asarray(rec.t), R_WB[:, BODY_NAMES.index(
+            "chaser")]))
+
+
+def first_contact_time(result) -> float:
+    """The time of the run's first impact (s; every contact starts with one), inf without."""
+    return float(result.impacts[0]["t"]) if result.impacts else math.inf
+
+
+def thrust_forces(result, t, R_WC) -> np.ndarray:
+    """The thrust on the chaser at the samples t (N,) with its rotations R_WC (N, 3, 3): the
+    force times its docking axis (the APDS frame's e3, parallel to the chaser's) where the
+    schedule acts (`drake_dock.docking.thrust.ThrustSchedule`), else zero. At the first
+    impact, the sample just before it has none."""
+    schedule = ThrustSchedule.of(result.scenario.thrust)
+    F = np.zeros((len(t), 3))
+    tc = first_contact_time(result)
+    if schedule is None or not math.isfinite(tc):
+        return F
+    kinds = np.asarray(result.record.kind)
+    for k in range(len(t)):
+        if schedule.on(t[k] - tc) and not (t[k] == tc and kinds[k] == PRE_IMPACT):
+            F[k] = schedule.force * R_WC[k][:, 2]
+    return F
+
+
+def thrust_impulses(result, ts: dict, about) -> tuple[np.ndarray, np.ndarray]:
+    """The linear impulse J[N,3] and the angular impulse H[N,3] about the fixed point
+    ``about`` of the thrust from t = 0 to each sample: over each sample interval, the part in
+    which the schedule acts, by the trapezoid rule on the force F e3 and the moment
+    (p - about) x F e3 of the chaser's mass centre p, linear between the samples (the switch
+    times are exact; the rest is second order in the step)."""
+    t = ts["t"]
+    N = len(t)
+    J, H = np.zeros((N, 3)), np.zeros((N, 3))
+    schedule = ThrustSchedule.of(result.scenario.thrust)
+    tc = first_contact_time(result)
+    if schedule is None or not math.isfinite(tc) or N < 2:
+        return J, H
+    j = ts["body_names"].tolist().index("chaser")
+    f = schedule.force * ts["R_WB"][:, j, :, 2]
+    tau = np.cross(ts["p_WB"][:, j] - np.asarray(about), f)
+    a, b = t[:-1], t[1:]
+    width = np.where(b > a, b - a, 1.0)
+    dJ, dH = np.zeros((N - 1, 3)), np.zeros((N - 1, 3))
+    for w0, w1 in schedule.windows:
+        lo, hi = np.maximum(a, tc + w0), np.minimum(b, tc + w1)
+        on = np.flatnonzero(hi > lo)
+        for d, y in ((dJ, f), (dH, tau)):
+            y0, y1 = y[on], y[on + 1]
+            ya = y0 + (y1 - y0) * ((lo[on] - a[on]) / width[on])[:, None]
+            yb = y0 + (y1 - y0) * ((hi[on] - a[on]) / width[on])[:, None]
+            d[on] += 0.5 * (hi[on] - lo[on])[:, None] * (ya + yb)
+    J[1:], H[1:] = np.cumsum(dJ, axis=0), np.cumsum(dH, axis=0)
+    return J, H
 
 
 def rigid_chaser_force(result):
@@ -164,8 +223,9 @@ def summary(result, ts: dict) -> dict:
     s = result.scenario
     b = s.bodies
     params = [getattr(b, n) for n in ts["body_names"]]
-    P, L, sP, sL = momenta(ts, [p.mass for p in params], [p.inertia for p in params],
-                           momentum_reference_point(s, ts))
+    about = momentum_reference_point(s, ts)
+    P, L, sP, sL = momenta(ts, [p.mass for p in params], [p.inertia for p in params], about)
+    J, H = thrust_impulses(result, ts, about)       # the only external forces
     lam = ts["lambda_n"]
     k_peak = np.unravel_index(np.argmax(lam), lam.shape) if lam.size else None
     peak = float(lam[k_peak]) if k_peak is not None else 0.0
@@ -188,9 +248,18 @@ def summary(result, ts: dict) -> dict:
         "peak_contact_force_couple": (str(ts["couple_names"][k_peak[1]]) if peak > 0 else None),
         "peak_contact_force_time_s": (float(ts["t"][k_peak[0]]) if peak > 0 else None),
         "momentum_drift_relative": {
-            "linear": _relative(np.linalg.norm(P - P[0], axis=1).max(), sP),
-            "angular": _relative(np.linalg.norm(L - L[0], axis=1).max(), sL)},
+            "linear": _relative(np.linalg.norm(P - P[0] - J, axis=1).max(), sP),
+            "angular": _relative(np.linalg.norm(L - L[0] - H, axis=1).max(), sL)},
         "energy_ledger": energy_ledger(ts),
+        "end_state": {
+            "holding_couples": [dataclasses.asdict(h) for h in result.holding],
+            "relative_kinetic_energy_J": (None if math.isnan(result.relative_kinetic_energy)
+                                          else result.relative_kinetic_energy)},
+        "thrust": None if s.thrust is None else {
+            "force_N": s.thrust.force, "windows_after_contact_s": [
+                [a, None if math.isinf(b) else b] for a, b in ThrustSchedule.of(s.thrust).windows],
+            "first_contact_time_s": (first_contact_time(result) if result.impacts else None),
+            "impulse_Ns": float(np.linalg.norm(J[-1]))},
         "first_contact_ring_distance_m": result.initial.d_contact,
         "first_contact_lateral_offset_m": list(result.initial.contact_offset),
         "initial_ring_distance_m": result.initial.d0,

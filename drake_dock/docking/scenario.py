@@ -97,6 +97,19 @@ class DockingContact(ContactLaw):
 
 
 @dataclasses.dataclass
+class ThrustParams:
+    """Post-contact thrust (docs/model.md, "Post-contact thrust"): ``force`` (N) on the chaser
+    along its docking axis, towards the target, from ``delay`` (s after the first contact) for
+    ``duration`` (s; null: until the run ends), or in the ``pulses`` [start, end] (s after the
+    first contact), the alternative to delay and duration."""
+
+    force: float = 0.0
+    delay: float = 0.0
+    duration: typing.Optional[float] = None
+    pulses: list[list[float]] = dataclasses.field(default_factory=list)
+
+
+@dataclasses.dataclass
 class SimulationParams:
     duration: float = 10.0           # the timeout (s): a run ends earlier at a named outcome
     jam_time: float = 2.0            # s without 1 mm of progress of the rings: "jammed"
@@ -137,6 +150,7 @@ class Scenario:
     contact: DockingContact = dataclasses.field(default_factory=DockingContact)
     initial: InitialCondition = dataclasses.field(default_factory=InitialCondition)
     simulation: SimulationParams = dataclasses.field(default_factory=SimulationParams)
+    thrust: ThrustParams | None = None          # absent: no thrust
     simulator_config: SimulatorConfig = dataclasses.field(
         default_factory=default_simulator_config)
 
@@ -292,8 +306,36 @@ def validate(s: Scenario) -> Scenario:
             0 < _finite("simulation.capture_tilt_deg", s.simulation.capture_tilt_deg) < 90):
         raise InputError("simulation.capture_tilt_deg", s.simulation.capture_tilt_deg,
                          "0 < tolerance < 90 deg, or null (not tested)")
+    if s.thrust is not None:
+        _validate_thrust(s.thrust)
     _validate_simulator_config(s.simulator_config, s.simulation.duration)
     return s
+
+
+MAX_THRUST = 1e5     # N: thrust.force (a spacecraft's jets give tens to hundreds of N)
+
+
+def _validate_thrust(th: ThrustParams):
+    f = "thrust"
+    if not 0 <= _finite(f"{f}.force", th.force) <= MAX_THRUST:
+        raise InputError(f"{f}.force", th.force, f"0 <= force <= {MAX_THRUST:.0e} N (along the "
+                         "chaser's docking axis, towards the target)")
+    _nonnegative(f"{f}.delay", th.delay)
+    if th.duration is not None:
+        _positive(f"{f}.duration", th.duration)
+    if not isinstance(th.pulses, list):
+        raise InputError(f"{f}.pulses", th.pulses, "a list of [start, end] pairs (s)")
+    if th.pulses and (th.delay != 0.0 or th.duration is not None):
+        raise InputError(f"{f}.pulses", th.pulses, "pulses alone, or delay and duration "
+                         "(pulses is the alternative to delay and duration)",
+                         f"delay {th.delay:g} and duration {th.duration} given as well")
+    last = 0.0
+    for k, pulse in enumerate(th.pulses):
+        start, end = _vector(f"{f}.pulses[{k}]", pulse, 2)
+        if not last <= start < end:
+            raise InputError(f"{f}.pulses[{k}]", pulse, f"[start, end] with {last:g} <= start < "
+                             "end (s after the first contact; pulses in order, apart)")
+        last = end
 
 
 def _validate_simulator_config(c: SimulatorConfig, duration: float):

@@ -15,16 +15,19 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import math
 import time as _time
+
+import numpy as np
 
 from pydrake.systems.analysis import Simulator, SimulatorStatus
 
 from drake_dock.core.hybrid import Mode
-from drake_dock.systems.contact_system import COUPLE_OUTPUT_SIZE, ContactModes
+from drake_dock.systems.contact_system import COUPLE_OUTPUT_SIZE, COUPLE_SLICES, ContactModes
 from drake_dock.systems.contact_types import copied_states
 from drake_dock.docking.diagram import DockingDiagram, build_docking_diagram
 from drake_dock.docking.outcome import OutcomeWatch, progress_fraction
-from drake_dock.docking.plant import set_initial_state
+from drake_dock.docking.plant import relative_kinetic_energy, set_initial_state
 from drake_dock.docking.scene import InitialState, initial_state
 from drake_dock.errors import DrakeDockError, NumericalError
 from drake_dock.systems.simulator import make_simulator, make_witness_approach
@@ -60,6 +63,24 @@ class RunResult:
     timing: dict | None = None  # `Timing.shares`: seeking / contact dynamics / impacts / other
     outcome: str = "timeout"   # `drake_dock.docking.outcome.OUTCOMES`
     reason: str = ""
+    # At the end of a run that is not captured: the couples in contact (`Holding`), and the
+    # kinetic energy left in the centre-of-mass frame (J).
+    holding: list = dataclasses.field(default_factory=list)
+    relative_kinetic_energy: float = math.nan
+
+
+@dataclasses.dataclass(frozen=True)
+class Holding:
+    """A couple in contact at the end of a run: its name, the angle of its normal to the
+    docking axis (deg; 0: the couple pushes the rings apart along the axis, 90: sideways) and
+    its normal force (N)."""
+
+    couple: str
+    normal_angle_deg: float
+    force_N: float
+
+    def describe(self) -> str:
+        return f"{self.couple} ({self.normal_angle_deg:.3g} deg from the axis, {self.force_N:.4g} N)"
 
 
 def docking_simulator(dd: DockingDiagram, state: InitialState, config,
@@ -173,6 +194,15 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
     watch = None
     ended = []
 
+    def driven(root) -> bool:
+        """Whether post-contact thrust acts now or later."""
+        if dd.thrust is None:
+            return False
+        tc = float(dd.contact.GetOutputPort("first_contact_time").Eval(
+            dd.contact.GetMyContextFromRoot(root))[0])
+        return dd.thrust.schedule.still_to_act(root.get_time() - tc if math.isfinite(tc)
+                                               else -math.inf)
+
     def monitor(root):
         from pydrake.systems.framework import EventStatus
         rec.sample(root)
@@ -185,9 +215,7 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
         if progress is not None:
             progress(t, t_end, progress_fraction(t, t_end, to_go, watch.d_start,
                                                  sp.capture_distance))
-        modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
-        in_contact = any(modes.pairs[i].mode.in_contact for i in modes.index().near)
-        end = watch.update(t, d, in_contact, to_go)
+        end = watch.update(t, d, pose[1], to_go, driven(root))
         if end is not None:
             ended.append(end)
             return EventStatus.ReachedTermination(dd.capture, end[0])
@@ -201,8 +229,9 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
                             lambda: (root.get_time(), _couples_in_play(dd, root))):
         sim.Initialize()
         rec.sample(root)
+        g = scenario.geometry
         watch = OutcomeWatch(dd.capture.distance(dd.capture.GetMyContextFromRoot(root)),
-                             sp.jam_time)
+                             sp.jam_time, beside=2.0 * g.R, beyond=g.H)
         sim.set_monitor(monitor)
         status = sim.AdvanceTo(t_end)
     wall = _time.perf_counter() - wall0
@@ -216,10 +245,38 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
         outcome, reason = "timeout", f"simulation.duration {t_end:g} s reached"
     captured = outcome == "captured"
     modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
+    holding, ke_rel = [], math.nan
+    if not captured:
+        holding, ke_rel = _holding(dd, root)
+        if outcome in ("jammed", "timeout"):
+            reason += (f"; held by {', '.join(h.describe() for h in holding) or 'no couple'}"
+                       f"; relative kinetic energy {ke_rel:.4g} J")
     return RunResult(scenario, dd, state, rec.record, list(modes.impacts), modes.mode_changes,
                      captured, root.get_time() if captured else None, root.get_time(), wall,
                      dd.contact.evaluations - evals0, dd.contact.timing.shares(wall),
-                     outcome, reason)
+                     outcome, reason, holding, ke_rel)
+
+
+def _holding(dd: DockingDiagram, root) -> tuple[list, float]:
+    """The couples in contact in the root context, largest normal force first (`Holding`), and
+    the relative kinetic energy (`relative_kinetic_energy`)."""
+    contact = dd.contact
+    cc = contact.GetMyContextFromRoot(root)
+    table = contact.couple_table(cc)
+    pc = dd.dp.plant.CreateDefaultContext()
+    x = contact.GetOutputPort("state").Eval(cc)
+    dd.dp.plant.SetPositionsAndVelocities(pc, x)
+    axis = dd.dp.apds_frames["target_apds"].CalcPoseInWorld(pc).rotation().col(2)
+    S = COUPLE_SLICES
+    out = []
+    for p, st, row in zip(contact.pairs, contact.get_modes(cc).pairs, table):
+        if st.mode.in_contact:
+            n = row[S["frame"]].reshape(3, 3)[:, 2]
+            cos = min(abs(float(np.dot(n, axis))) / max(float(np.linalg.norm(n)), 1e-300), 1.0)
+            out.append(Holding(p.name, math.degrees(math.acos(cos)),
+                               float(row[S["lambda_n"]][0])))
+    out.sort(key=lambda h: -h.force_N)
+    return out, relative_kinetic_energy(dd.dp, pc)
 
 
 __all__ = ["simulate", "docking_simulator", "RunResult", "Record", "STEP", "PRE_IMPACT",

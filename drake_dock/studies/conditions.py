@@ -225,7 +225,8 @@ def rows_csv(rows) -> str:
 
 
 # Marker and colour of each outcome in the studies' figures.
-OUTCOME_STYLE = {"captured": ("o", "tab:green"), "rebound": ("s", "tab:blue"),
+OUTCOME_STYLE = {"captured": ("o", "tab:green"), "missed": ("^", "tab:gray"),
+                 "rebound": ("s", "tab:blue"),
                  "jammed": ("D", "tab:orange"), "timeout": ("v", "tab:purple"),
                  "error": ("x", "tab:red")}
 

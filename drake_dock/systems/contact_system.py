@@ -105,7 +105,8 @@ class RigidContactSystem(LeafSystem):
     """See the module docstring. ``plant`` is a finalized continuous-time MultibodyPlant (it
     need not be part of the diagram); ``pairs`` the declared `ContactPair`s; ``wrench_bodies``
     names bodies that get an input port ``<body>_wrench`` (6-vector [torque, force], world
-    frame, applied at the body origin). ``extra_powers`` is a sequence of (name, f) with
+    frame, applied at the body origin), or holds (port name, body) for a further such port
+    (the wrenches on a body add up; their work is the ``input_work`` integral). ``extra_powers`` is a sequence of (name, f) with
     f(q, v) -> power (W); each is integrated as continuous state and appended to the
     ``energy`` output (e.g. the power of a damper, for an energy ledger). The energy integrals
     are state in units of ``energy_scale`` (J): Drake's error control compares every state's
@@ -143,8 +144,9 @@ class RigidContactSystem(LeafSystem):
         self._gf_port = self.DeclareVectorInputPort("generalized_force", self.nv)
         self._wrench_ports = {}
         for b in wrench_bodies:
-            body = plant.GetBodyByName(b)
-            self._wrench_ports[b] = (body, self.DeclareVectorInputPort(f"{b}_wrench", 6))
+            name, b = (f"{b}_wrench", b) if isinstance(b, str) else b
+            self._wrench_ports[name] = (plant.GetBodyByName(b),
+                                        self.DeclareVectorInputPort(name, 6))
         self._cache = self.DeclareCacheEntry(
             "contact evaluation", ValueProducer(
                 allocate=lambda: AbstractValue.Make(None), calc=self._calc_eval),
@@ -153,6 +155,8 @@ class RigidContactSystem(LeafSystem):
                                      prerequisites_of_calc={self.xc_ticket()})
         self.DeclareVectorOutputPort("generalized_contact_force", self.nv, self._out_gf)
         self.DeclareVectorOutputPort("energy", len(self.energy_names), self._out_energy)
+        self.DeclareVectorOutputPort("first_contact_time", 1, self._out_first_contact,
+                                     prerequisites_of_calc={self.all_state_ticket()})
         self._couple_ports = [
             self.DeclareVectorOutputPort(f"couple_{p.name}", COUPLE_OUTPUT_SIZE,
                                          lambda c, o, i=i: self._out_couple(c, o, i))
@@ -238,6 +242,11 @@ class RigidContactSystem(LeafSystem):
         w = x[self.ie:] * self.energy_scale
         out.SetFromVector(np.concatenate([[ke, pe, w[0], w[1], w[2],
                                            self.get_modes(context).impact_loss], w[3:]]))
+
+    def _out_first_contact(self, context, out):
+        """The time of the first impact (s; every contact starts with one), +inf before it."""
+        impacts = self.get_modes(context).impacts
+        out.SetFromVector([impacts[0]["t"] if impacts else math.inf])
 
     def _out_couple(self, context, out, i):
         y = np.zeros(COUPLE_OUTPUT_SIZE)

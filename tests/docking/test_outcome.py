@@ -14,9 +14,12 @@ from drake_dock.docking.outcome import (JAM_DISTANCE, CaptureRule, OutcomeWatch,
 from drake_dock.docking.scenario import PAPER_EXAMPLE
 
 
-def feed(watch, ts, ds, contact):
-    for t, d, c in zip(ts, ds, contact):
-        end = watch.update(t, d, c)
+def feed(watch, ts, ds, driven=None, lateral=None):
+    n = len(ts)
+    driven = [False] * n if driven is None else driven
+    lateral = [0.0] * n if lateral is None else lateral
+    for t, d, dr, lat in zip(ts, ds, driven, lateral):
+        end = watch.update(t, d, lat, None, dr)
         if end:
             return t, end[0]
     return None
@@ -24,23 +27,46 @@ def feed(watch, ts, ds, contact):
 
 def test_steady_approach_has_no_outcome():
     ts = np.linspace(0, 10, 1001)
-    assert feed(OutcomeWatch(0.1, 2.0), ts, 0.1 - 0.009 * ts, [True] * len(ts)) is None
+    assert feed(OutcomeWatch(0.1, 2.0), ts, 0.1 - 0.009 * ts) is None
 
 
 def test_stalled_rings_are_jammed_after_jam_time():
     ts = np.linspace(0, 10, 1001)
     ds = np.maximum(0.1 - 0.05 * ts, 0.02)          # reach 0.02 m at t = 1.6 s, then stall
-    t, outcome = feed(OutcomeWatch(0.1, 2.0), ts, ds, [True] * len(ts))
+    t, outcome = feed(OutcomeWatch(0.1, 2.0), ts, ds)
     # The last millimetre of progress ends at the stall (t = 1.6 s) or one mm before it.
     assert outcome == "jammed" and 1.6 - JAM_DISTANCE / 0.05 + 2.0 - 0.011 <= t <= 3.611
 
 
-def test_separating_rings_rebound_only_without_contact():
+def test_no_jam_while_thrust_still_acts():
+    """The same stall under thrust that acts until t = 5 s: the jam clock starts when the
+    thrust has ended, so the run is jammed jam_time after 5 s, not 2 s after the stall."""
+    ts = np.linspace(0, 10, 1001)
+    ds = np.maximum(0.1 - 0.05 * ts, 0.02)
+    t, outcome = feed(OutcomeWatch(0.1, 2.0), ts, ds, driven=list(ts < 5.0))
+    assert outcome == "jammed" and 7.0 - 0.011 <= t <= 7.011
+
+
+def test_separating_rings_rebound_unless_thrust_still_acts():
+    """Above its start and growing: rebound, in contact or not (a couple may graze); not while
+    thrust still acts, which can bring the chaser back."""
     ts = np.linspace(0, 2, 201)
     ds = 0.1 - 0.1 * ts + 0.1 * ts ** 2               # back above 0.1 m after t = 1 s
-    assert feed(OutcomeWatch(0.1, 5.0), ts, ds, [True] * len(ts)) is None
-    t, outcome = feed(OutcomeWatch(0.1, 5.0), ts, ds, [False] * len(ts))
+    assert feed(OutcomeWatch(0.1, 5.0), ts, ds, driven=[True] * len(ts)) is None
+    t, outcome = feed(OutcomeWatch(0.1, 5.0), ts, ds)
     assert outcome == "rebound" and 1.0 < t <= 1.02
+
+
+def test_missed_beside_or_beyond_the_target():
+    """The ring centres more than 2 R apart across the axis (the rings' disks no longer
+    overlap), or the chaser's ring centre more than H behind the target's ring face: missed,
+    at the first sample past the bound."""
+    ts = np.linspace(0, 2, 201)
+    t, outcome = feed(OutcomeWatch(0.1, 5.0, beside=1.2, beyond=0.2), ts, 0.1 + 0 * ts,
+                      lateral=list(0.8 * ts))
+    assert outcome == "missed" and 1.5 - 1e-9 < t <= 1.51
+    t, outcome = feed(OutcomeWatch(0.1, 5.0, beside=1.2, beyond=0.2), ts, 0.1 - 0.2 * ts)
+    assert outcome == "missed" and 1.5 - 1e-9 < t <= 1.51
 
 
 def _rot(axis, angle):
@@ -98,7 +124,7 @@ def test_a_misaligned_ring_past_the_axis_jams():
     watch = OutcomeWatch(0.1, 2.0)
     for t in ts:
         d = 0.1 - 0.05 * t
-        end = watch.update(t, d, True, rule.to_go(d, 0.015, 0.0))
+        end = watch.update(t, d, 0.015, rule.to_go(d, 0.015, 0.0))
         if end:
             break
     # to_go stops at 0.010 m when d falls below it (t = 1.8 s); jammed 2 s after the last mm.
