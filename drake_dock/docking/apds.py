@@ -53,9 +53,13 @@ class ApdsGeometry:
     # the ring's inside circle and pass through the other ring's passage, so that the rings
     # can meet face to face (docs/model.md, "APDS geometry").
     petal_root_radius: typing.Optional[float] = None
+    # The petals' sides start this far inside their 60-degree sectors (deg; the paper's 0):
+    # a petal spans [delta, 60 - delta] deg at its root, so that the two APDS's petals,
+    # interleaved, keep 2 delta apart there (docs/model.md, "APDS geometry").
+    petal_inset_deg: float = 0.0
 
     def validate(self, prefix: str = "geometry") -> "ApdsGeometry":
-        names = ("R", "Rs", "H", "alpha1_deg", "alpha2_deg")
+        names = ("R", "Rs", "H", "alpha1_deg", "alpha2_deg", "petal_inset_deg")
         if self.petal_root_radius is not None:
             names += ("petal_root_radius",)
         for name in names:
@@ -76,6 +80,9 @@ class ApdsGeometry:
             raise InputError(root, Rp, f"Rs = {self.Rs} <= petal_root_radius <= R = {self.R} m, "
                              "or null (R)", "a petal rooted inside the passage would leave its "
                              "root edge free, which the contact set does not model")
+        if not 0.0 <= self.petal_inset_deg < 30.0:
+            raise InputError(f"{prefix}.petal_inset_deg", self.petal_inset_deg,
+                             "0 <= inset < 30 deg")
         cot1 = 1.0 / math.tan(math.radians(self.alpha1_deg))
         h_max = Rp / cot1
         if not 0.0 < self.H < h_max:
@@ -84,12 +91,14 @@ class ApdsGeometry:
                              f"petal root radius)", "the petal would reach the axis")
         a2 = math.radians(self.alpha2_deg)
         arg = Rp * math.sin(a2) / (Rp - self.H * cot1)
-        # The two sides of a petal must not meet below zeta = H: theta_end < pi/6.
-        if arg >= 1.0 or math.asin(arg) - a2 >= math.pi / 6:
-            limit = Rp * (1.0 - math.sin(a2) / math.sin(a2 + math.pi / 6)) / cot1
+        # The two sides of a petal must not meet below zeta = H: theta_end < pi/6 - inset.
+        half = math.pi / 6 - self.inset
+        if arg >= 1.0 or math.asin(arg) - a2 >= half:
+            limit = Rp * (1.0 - math.sin(a2) / math.sin(a2 + half)) / cot1
             raise InputError(f"{prefix}.H", self.H,
                              f"H < {limit:.6g} m for Rp = {Rp}, alpha1 = {self.alpha1_deg},"
-                             f" alpha2 = {self.alpha2_deg}", "the petal's sides would cross")
+                             f" alpha2 = {self.alpha2_deg}, petal_inset_deg = "
+                             f"{self.petal_inset_deg}", "the petal's sides would cross")
         return self
 
     # Derived quantities ---------------------------------------------------------------------
@@ -97,6 +106,11 @@ class ApdsGeometry:
     def Rp(self) -> float:
         """The petals' root radius (m): ``petal_root_radius``, or R (the paper's)."""
         return self.R if self.petal_root_radius is None else float(self.petal_root_radius)
+
+    @property
+    def inset(self) -> float:
+        """``petal_inset_deg`` in rad."""
+        return math.radians(self.petal_inset_deg)
 
     @property
     def tip_radius(self) -> float:
@@ -123,7 +137,13 @@ class ApdsGeometry:
 
 
 def side_phi(i: int) -> float:
+    """The azimuth of the sector boundary where guide side i stands, (i - 1) pi / 3."""
     return (i - 1) * math.pi / 3.0
+
+
+def side_root(g: ApdsGeometry, i: int) -> float:
+    """The azimuth of guide side i's root, phi_i + sigma_i inset (the paper's: phi_i)."""
+    return side_phi(i) + side_sigma(i) * g.inset
 
 
 def side_sigma(i: int) -> int:
@@ -134,7 +154,7 @@ def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
     """Guide side n_i, Eq. (14) in the sine form; u = (theta,)."""
     if i not in range(1, 7):
         raise InputError("guide side", i, "1..6")
-    phi, sigma = side_phi(i), side_sigma(i)
+    phi, sigma = side_root(g, i), side_sigma(i)
     A = g.Rp * math.sin(g.alpha2)
     tan1 = math.tan(g.alpha1)
     # The sine form holds for 0 < w < pi (w modulo 2 pi); beyond its reach, halfway from the
@@ -182,13 +202,14 @@ class _PetalMap:
 
     def __init__(self, g: ApdsGeometry, k: int):
         self.g = g
-        self.phi0 = side_phi(2 * k - 1)
+        self.phi0 = side_root(g, 2 * k - 1)
+        self.width = math.pi / 3 - 2 * g.inset       # the petal's angle at its root
         self.lower = np.array([0.0, 0.0])
         self.upper = np.array([1.0, g.H])
         self.cot1 = 1.0 / math.tan(g.alpha1)
         self.A = g.Rp * math.sin(g.alpha2)
         # The map's parameters for the compiled kernels (kind PETAL).
-        self.kernel_params = (self.phi0, self.cot1, self.A, g.alpha2, g.Rp)
+        self.kernel_params = (self.phi0, self.cot1, self.A, g.alpha2, g.Rp, self.width)
         # Eq. (13) holds while x = A / rho < 1, zeta < (R - A) tan(alpha1). Its reach is the
         # domain grown at both ends by half the distance from zeta = H to that limit; beyond
         # it theta_1 is held (docs/model.md, "Degenerate couples"): the surface continues as
@@ -223,7 +244,7 @@ class _PetalMap:
         q = math.sqrt(1.0 - x * x)
         t1 = math.asin(x) - self.g.alpha2
         d1, d2 = (x1 / q, x2 / q + x * x1**2 / q**3) if inside else (0.0, 0.0)
-        w = math.pi / 3 - 2 * t1
+        w = self.width - 2 * t1
         return ((self.phi0 + t1 + a * w, z), ((w, d1 * (1 - 2 * a)), (0.0, 1.0)),
                 (((0.0, -2 * d1), (-2 * d1, d2 * (1 - 2 * a))), ((0.0, 0.0), (0.0, 0.0))))
 
@@ -231,14 +252,14 @@ class _PetalMap:
         s = np.asarray(s, dtype=float)
         a, z = s[..., 0], s[..., 1]
         t1, _, _ = self._t1(z)
-        return np.stack([self.phi0 + t1 + a * (math.pi / 3 - 2 * t1), z], axis=-1)
+        return np.stack([self.phi0 + t1 + a * (self.width - 2 * t1), z], axis=-1)
 
     def jac(self, s):
         s = np.asarray(s, dtype=float)
         a, z = s[..., 0], s[..., 1]
         t1, d1, _ = self._t1(z)
         J = np.zeros(a.shape + (2, 2))
-        J[..., 0, 0] = math.pi / 3 - 2 * t1
+        J[..., 0, 0] = self.width - 2 * t1
         J[..., 0, 1] = d1 * (1 - 2 * a)
         J[..., 1, 1] = 1.0
         return J
@@ -257,8 +278,8 @@ def guide_surface(g: ApdsGeometry, k: int) -> Reparametrized:
     """Guide surface k (Eq. 12-13) between sides 2k-1 and 2k; u = (s, zeta)."""
     if k not in (1, 2, 3):
         raise InputError("guide surface", k, "1..3")
-    phi0 = side_phi(2 * k - 1)
-    cone = Cone(g.Rp, g.alpha1, (phi0, phi0 + math.pi / 3), (0.0, g.H))
+    phi0 = side_root(g, 2 * k - 1)
+    cone = Cone(g.Rp, g.alpha1, (phi0, phi0 + math.pi / 3 - 2 * g.inset), (0.0, g.H))
     return Reparametrized(cone, _PetalMap(g, k))
 
 
@@ -271,12 +292,12 @@ def petal_edges(g: ApdsGeometry, k: int) -> dict:
     m = _PetalMap(g, k)
     out = {}
     for i, upper in ((2 * k - 1, False), (2 * k, True)):
-        side, phi, sigma = guide_side(g, i), side_phi(i), side_sigma(i)
+        side, phi, sigma = guide_side(g, i), side_root(g, i), side_sigma(i)
         out[i] = SurfaceEdge(0, upper, lambda th, side=side: side.parts(th)[1][0],
                              lambda z, phi=phi, sigma=sigma: phi + sigma * (
                                  math.asin(m.A / (g.Rp - z * m.cot1)) - g.alpha2))
     t1 = math.asin(m.A / (g.Rp - g.H * m.cot1)) - g.alpha2
-    w = math.pi / 3 - 2 * t1
+    w = m.width - 2 * t1
     out["tip"] = SurfaceEdge(1, True, lambda th: (th - m.phi0 - t1) / w,
                              lambda s: m.phi0 + t1 + s * w)
     return out
@@ -292,9 +313,9 @@ def tip_arc(g: ApdsGeometry, k: int) -> Arc:
     theta from the end of side 2k - 1 to the end of side 2k (Eq. 14-15)."""
     if k not in (1, 2, 3):
         raise InputError("tip arc", k, "1..3")
-    phi0 = side_phi(2 * k - 1)
+    phi0 = side_root(g, 2 * k - 1)
     return Arc(g.Rp - g.H / math.tan(g.alpha1), g.H,
-               (phi0 + g.theta_end, phi0 + math.pi / 3 - g.theta_end))
+               (phi0 + g.theta_end, phi0 + math.pi / 3 - 2 * g.inset - g.theta_end))
 
 
 # Half-width of a petal's tip land (`tip_land`): a corner within it of a tip arc rests on the

@@ -113,7 +113,7 @@ def petal_points(g, k, s, zeta):
     s, zeta = np.broadcast_arrays(np.asarray(s, float), np.asarray(zeta, float))
     rho = g.Rp - zeta / math.tan(g.alpha1)
     inset = np.arcsin(g.Rp * math.sin(g.alpha2) / rho) - g.alpha2
-    th = (2 * k - 2) * math.pi / 3 + inset + s * (math.pi / 3 - 2 * inset)
+    th = (2 * k - 2) * math.pi / 3 + g.inset + inset + s * (math.pi / 3 - 2 * g.inset - 2 * inset)
     return np.stack([rho * np.cos(th), rho * np.sin(th), zeta], -1)
 
 
@@ -344,7 +344,7 @@ class TriangleMesh:
 @functools.lru_cache(maxsize=4)
 def apds_meshes(shape, res, ring_depth):
     """([petal 1, 2, 3], ring) `TriangleMesh`es of an APDS; shape = (R, Rs, H, alpha1,
-    alpha2, Rp), alpha in rad."""
+    alpha2, Rp, inset), angles in rad."""
     g = _Shape(*shape)
     petals = []
     for k in (1, 2, 3):
@@ -362,6 +362,7 @@ class _Shape:
     alpha1: float
     alpha2: float
     Rp: float
+    inset: float
 
 
 class _Watch:
@@ -465,7 +466,7 @@ def deepest_penetration_mesh(g, t, R_WA, p_WA, names, *, ring_depth=0.04, max_tr
         raise InputError("resolution", res, "a MeshResolution or None")
     res.validate()
     shape = (float(g.R), float(g.Rs), float(g.H), float(g.alpha1), float(g.alpha2),
-             float(g.Rp))
+             float(g.Rp), float(g.inset))
     petals, ring = apds_meshes(shape, res, float(ring_depth))
     feats = mesh_features(g, res) if features is None else features
     vs_petals, vs_ring = checked_features(g)

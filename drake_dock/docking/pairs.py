@@ -73,6 +73,9 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         pairs += corner_land_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
         pairs += corner_land_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
         pairs.append(PairSpec("cc_Crim_Trim", "CC", CHASER_APDS, P.rim, TARGET_APDS, P.rim))
+        if g.Rp <= g.Rs:
+            pairs += rim_petal_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
+            pairs += rim_petal_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
     return pairs
 
 
@@ -89,6 +92,18 @@ def edge_pairs(P, one, other) -> list[PairSpec]:
     out = [PairSpec(f"cc_{x}ring_{y}{i}", "CC", b1, P.ring, b2, P.sides[i]) for i in range(1, 7)]
     out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
     out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
+    return out
+
+
+def rim_petal_pairs(P, one, other) -> list[PairSpec]:
+    """APDS ``one``'s ring outside circle (Body 1) against APDS ``other``'s guide sides
+    (cc_<X>rim_<Y><i>, C-C) and guide surfaces (cs_<X>rim_<Y><k>, C-S): declared where the
+    petals stand on the ring's inside circle (Rp <= Rs), so that the other ring's annulus is
+    solid to them. A tilted, offset ring meets a petal near its root with its rim there (docs/
+    model.md, "Facing and the contact pairs")."""
+    (x, b1), (y, b2) = one, other
+    out = [PairSpec(f"cc_{x}rim_{y}{i}", "CC", b1, P.rim, b2, P.sides[i]) for i in range(1, 7)]
+    out += [PairSpec(f"cs_{x}rim_{y}{k}", "CS", b1, P.rim, b2, P.surfaces[k]) for k in (1, 2, 3)]
     return out
 
 
@@ -214,7 +229,9 @@ PAIR_TYPES = (
     (re.compile(r"cc_[CT]rim_[CT]rim$"), "ring outside circle / ring outside circle"),
     (re.compile(r"ps_[CT]corner\d_[CT]\d$"), "petal corner / guide surface"),
     (re.compile(r"cc_Ctip\d_Ttip\d$"), "tip arc / tip arc"),
-    (re.compile(r"ps_[CT]corner\d_[CT]tip\d$"), "petal corner / tip land"))
+    (re.compile(r"ps_[CT]corner\d_[CT]tip\d$"), "petal corner / tip land"),
+    (re.compile(r"cc_[CT]rim_[CT]\d$"), "ring outside circle / guide side"),
+    (re.compile(r"cs_[CT]rim_[CT]\d$"), "ring outside circle / guide surface"))
 
 
 def pair_type(name: str) -> str:
@@ -263,6 +280,9 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
                 e = f"cc_{x}ring_{y}{'tip' + str(k) if key == 'tip' else key}"
                 if {e, f"cs_{x}ring_{y}{k}"} <= names:
                     out.append((e, f"cs_{x}ring_{y}{k}", edge))
+                # A ring's outside circle between guide surface k and its sides.
+                if key != "tip" and {f"cc_{x}rim_{y}{key}", f"cs_{x}rim_{y}{k}"} <= names:
+                    out.append((f"cc_{x}rim_{y}{key}", f"cs_{x}rim_{y}{k}", edge))
     return out
 
 

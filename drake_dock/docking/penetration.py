@@ -95,15 +95,16 @@ def feature_points(g, *, n_circle=1440, n_side=80, n_arc=60, n_face=9):
     A, tan1 = g.Rp * math.sin(g.alpha2), math.tan(g.alpha1)
     end = float(_inset(g, g.H))
     for i in range(1, 7):                          # Eq. (14), sine form
-        phi, sigma = (i - 1) * math.pi / 3, (1 if i % 2 else -1)
+        sigma = 1 if i % 2 else -1
+        phi = (i - 1) * math.pi / 3 + sigma * g.inset     # the side's root
         t = phi + sigma * np.linspace(0.0, end, n_side)
         rho = A / np.sin(g.alpha2 + sigma * (t - phi))
         out[f"guide side {i}"] = np.stack([rho * np.cos(t), rho * np.sin(t),
                                            (g.Rp - rho) * tan1], -1)
     r_tip = g.Rp - g.H / tan1
     for k in (1, 2, 3):
-        phi = (2 * k - 2) * math.pi / 3
-        t = np.linspace(phi + end, phi + math.pi / 3 - end, n_arc)
+        phi = (2 * k - 2) * math.pi / 3 + g.inset
+        t = np.linspace(phi + end, phi + math.pi / 3 - 2 * g.inset - end, n_arc)
         out[f"petal {k} tip arc"] = np.stack([r_tip * np.cos(t), r_tip * np.sin(t),
                                               np.full_like(t, g.H)], -1)
     return out
@@ -127,9 +128,9 @@ def petal_places(g, X, petals=(1, 2, 3)):
     theta = np.arctan2(X[:, 1], X[:, 0])
     fractions = []
     for k in petals:
-        phi = (2 * k - 2) * math.pi / 3
+        phi = (2 * k - 2) * math.pi / 3 + g.inset        # side 2k - 1's root
         dth = np.mod(theta - phi + math.pi, 2 * math.pi) - math.pi
-        fractions.append((dth - inset) / (math.pi / 3 - 2 * inset))
+        fractions.append((dth - inset) / (math.pi / 3 - 2 * g.inset - 2 * inset))
     return s, fractions, zeta_f
 
 
@@ -187,7 +188,7 @@ _POLYLINES = {}
 
 def edge_polylines(g) -> dict:
     """{petal k: its free edges (`free_edges`) as a `Polyline`}, kept per geometry."""
-    key = (g.Rp, g.H, g.alpha1, g.alpha2)
+    key = (g.Rp, g.H, g.alpha1, g.alpha2, g.inset)
     hit = _POLYLINES.get(key)
     if hit is None:
         if len(_POLYLINES) > 8:

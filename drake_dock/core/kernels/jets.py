@@ -13,9 +13,10 @@ both give the same bits. The kinds:
   rho = A / sin(alpha2 + sigma (theta - phi)), z = (R - rho) tan alpha1 (a guide side).
 - ANNULUS [height]: `Annulus`, u = (rho, theta). An `Arc` is a CIRCLE (its domain is the
   patch's, not the kernel's).
-- PETAL [R0, cot alpha, phi0, cot alpha1, A, alpha2, R]: a `Cone` reparametrized across the
-  petal between two guide sides, theta = phi0 + theta_1(z) + s (pi/3 - 2 theta_1(z)) with
-  theta_1 of Eq. (13) (a guide surface).
+- PETAL [R0, cot alpha, phi0, cot alpha1, A, alpha2, R, w0]: a `Cone` reparametrized across
+  the petal between two guide sides, theta = phi0 + theta_1(z) + s (w0 - 2 theta_1(z)) with
+  theta_1 of Eq. (13) and w0 the petal's angle at its root (pi/3 in the paper; a guide
+  surface).
 
 Each jet is returned as six 3-tuples (r, T0, T1, K00, K01, K11); a curve's T1, K01, K11 are
 zero. `position` is r alone, with the same operations as `jet` (the same bits) and none of the
@@ -87,7 +88,7 @@ def _petal(prm, a, z):
     q = math.sqrt(1.0 - x * x)
     t1 = math.asin(x) - alpha2
     d1, d2 = x1 / q, x2 / q + x * math.pow(x1, 2.0) / math.pow(q, 3.0)
-    w = math.pi / 3 - 2 * t1
+    w = prm[7] - 2 * t1
     j00, j01, j10, j11 = w, d1 * (1 - 2 * a), 0.0, 1.0
     h001 = -2 * d1
     h011 = d2 * (1 - 2 * a)
@@ -167,9 +168,9 @@ def position(kind, prm, u0, u1):
 @njit(cache=True)
 def petal_row(prm, z):
     """What a PETAL's point at zeta = z shares with the others at that z (`_petal`): theta_1
-    (Eq. 13), the petal's angle pi/3 - 2 theta_1 and the cone's radius (Eq. 12)."""
+    (Eq. 13), the petal's angle w0 - 2 theta_1 and the cone's radius (Eq. 12)."""
     t1 = math.asin(prm[4] / (prm[6] - z * prm[3])) - prm[5]
-    return t1, math.pi / 3 - 2 * t1, prm[0] - z * prm[1]
+    return t1, prm[7] - 2 * t1, prm[0] - z * prm[1]
 
 
 @njit(cache=True)
