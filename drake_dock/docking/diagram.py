@@ -128,8 +128,8 @@ def build_docking_diagram(scenario, meshcat=None, options=None,
     dp = make_docking_plant(scenario, scene_graph)
     frames = dp.apds_frames
     specs = scenario_pairs(scenario)
-    pairs = [ContactPair(p.name, p.kind, frames[p.body1], p.patch1, frames[p.body2], p.patch2)
-             for p in specs]
+    pairs = [ContactPair(p.name, p.kind, frames[p.body1], p.patch1, frames[p.body2], p.patch2,
+                         p.sigma) for p in specs]
     options = contact_options(scenario, options)
     schedule = ThrustSchedule.of(scenario.thrust)
     contact = builder.AddSystem(RigidContactSystem(

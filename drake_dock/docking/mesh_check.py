@@ -154,8 +154,9 @@ def grid_triangles(V, wrap=False):
 
 
 def ring_grids(g, res, ring_depth):
-    """The ring solid's four vertex grids (around, rows, 3): face, back, inside and outside
-    walls. Shared rims are computed alike, so the solid closes exactly."""
+    """The ring solid's four vertex grids (around, rows, 3): face, back, inside wall and the
+    outer chamfer (rho = R + zeta, 45 deg; `penetration.ring_depth_of`). Shared rims are
+    computed alike, so the solid closes exactly."""
     th = 2.0 * math.pi * np.arange(res.around) / res.around
     c, s = np.cos(th), np.sin(th)
 
@@ -165,7 +166,9 @@ def ring_grids(g, res, ring_depth):
 
     radii = np.linspace(g.Rs, g.R, res.radial + 1)
     depths = np.linspace(0.0, -ring_depth, res.deep + 1)
-    return [grid(radii, 0.0), grid(radii, -ring_depth), grid(g.Rs, depths), grid(g.R, depths)]
+    back = np.linspace(g.Rs, g.R - ring_depth, res.radial + 1)
+    return [grid(radii, 0.0), grid(back, -ring_depth), grid(g.Rs, depths),
+            grid(g.R + depths, depths)]
 
 
 def free_edges(V):

@@ -35,6 +35,10 @@ class PairSpec:
     patch1: Patch
     body2: str
     patch2: Patch
+    # The orientation of the couple's normal where the scene knows it (`ContactPair.sigma`):
+    # +1 for a ring's outside circle against the other ring's face, which is solid on one side
+    # only. None: taken from the side the patches are on when the pair becomes potential.
+    sigma: float | None = None
 
 
 def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
@@ -91,7 +95,7 @@ def edge_pairs(P, one, other) -> list[PairSpec]:
     (x, b1), (y, b2) = one, other
     out = [PairSpec(f"cc_{x}ring_{y}{i}", "CC", b1, P.ring, b2, P.sides[i]) for i in range(1, 7)]
     out += [PairSpec(f"cc_{x}ring_{y}tip{k}", "CC", b1, P.ring, b2, P.tips[k]) for k in (1, 2, 3)]
-    out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face))
+    out.append(PairSpec(f"cs_{x}rim_{y}face", "CS", b1, P.rim, b2, P.face, sigma=1.0))
     return out
 
 

@@ -234,9 +234,13 @@ def _beside(F, P, j):
 
 
 def ring_depth_of(g, X, ring_depth):
-    """Depth of points X (M, 3) inside the ring's solid (<= 0: outside)."""
+    """Depth of points X (M, 3) inside the ring's solid (<= 0: outside): the annulus
+    Rs <= rho <= R + zeta from its face (zeta = 0) to ``ring_depth`` behind it, its outer edge
+    chamfered at 45 deg, so that another ring meets it only at its face and its rim, the
+    features the contact pairs model (docs/model.md, "APDS geometry")."""
     rho = np.hypot(X[:, 0], X[:, 1])
-    return np.minimum.reduce([-X[:, 2], X[:, 2] + ring_depth, rho - g.Rs, g.R - rho])
+    return np.minimum.reduce([-X[:, 2], X[:, 2] + ring_depth, rho - g.Rs,
+                              (g.R + X[:, 2] - rho) * math.sqrt(0.5)])
 
 
 def _rotvec(R):

@@ -85,14 +85,27 @@ def seek_gaps(pairs, approach, d, refs):
     R, p = approach.pose(d)
     poses = {TARGET_APDS: (np.eye(3), np.zeros(3)), CHASER_APDS: (R, p)}
     out, dirs, dist = [], [], []
-    for cp, ref in zip(pair_couples(pairs, poses), refs):
+    for pr, cp, ref in zip(pairs, pair_couples(pairs, poses), refs):
         dist.append(cp.distance)
         if not cp.interior:
             out.append(np.inf)
             dirs.append(None)
             continue
         v = cp.p1 - cp.p2
-        s = 1.0 if ref is None or v @ ref >= 0 else -1.0
+        if pr.sigma is not None and pr.kind == "CS":
+            # A declared side (a ring's face, solid on one side): the side of the surface's
+            # normal sigma N the curve's point lies on, as the contact system takes it.
+            T = posed(pr.patch2, *poses[pr.body2]).first(cp.u2)
+            s = 1.0 if pr.sigma * (v @ np.cross(T[:, 0], T[:, 1])) >= 0 else -1.0
+            if cp.distance < TOUCH_GAP:
+                # The curve cuts the surface (their least distance is zero there, to
+                # round-off): it is through, past its first touch; the bisection finds that
+                # touch.
+                out.append(-2.0 * TOUCH_GAP)
+                dirs.append(None)
+                continue
+        else:
+            s = 1.0 if ref is None or v @ ref >= 0 else -1.0
         out.append(s * cp.distance)
         dirs.append(s * v / max(cp.distance, 1e-300))
     return np.array(out), dirs, np.array(dist)

@@ -334,12 +334,15 @@ class RigidContactSystem(LeafSystem):
     # ------------------------------------------------------------------ events
     def _on_step(self, context, state):
         """Per-step event: far pairs whose travel bound has used ``reseek_early`` of their
-        clearance are sought again at the start of this step (with every other transition due,
-        as at a witness event). The clearance witness stays the guarantee; sought a little
-        early, a pair needs no isolated event."""
+        clearance, and tracked couples that drifted (`PlantEvaluator.drifting`), are sought
+        again at the start of this step (with every other transition due, as at a witness
+        event). The clearance witness stays the guarantee; sought a little early, a pair needs
+        no isolated event."""
         modes = self.get_modes(context)
         E = self._cache.Eval(context)
         early = self.options.reseek_early
+        if self.evaluator.drifting(E, modes.pairs):
+            return self._on_event(context, None, state, early=early)
         index = modes.index()
         far = index.far
         if not index.sought.any():

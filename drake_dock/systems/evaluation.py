@@ -114,9 +114,9 @@ class PlantEvaluator:
             twists.append((V.rotational(), V.translational()))
         return poses, twists
 
-    def couple(self, i, u, poses, twists, sigma, time):
-        """Pair i's couple at u (Eq. 47); `DriftError` when its projection step exceeds
-        ``drift_tol`` of the domain span."""
+    def couple(self, i, u, poses, twists, sigma, time, strict=True):
+        """Pair i's couple at u (Eq. 47); with ``strict`` (a couple in contact), `DriftError`
+        when its projection step exceeds ``drift_tol`` of the domain span."""
         p = self.pairs[i]
         a, b = self.fidx[i]
         try:
@@ -125,7 +125,7 @@ class PlantEvaluator:
         except SingularCoupleError as e:
             raise SingularCoupleError(str(e), time=time, couples=[p.name]) from None
         rel = np.abs(ev.drift) / self.spans[i]
-        if rel.max() > self.options.drift_tol:
+        if strict and rel.max() > self.options.drift_tol:
             raise DriftError(f"couple drift {rel.max():.3e} of the domain span exceeds "
                              f"drift_tol = {self.options.drift_tol:g}", time=time,
                              couples=[p.name])
@@ -134,7 +134,8 @@ class PlantEvaluator:
     def couples(self, t, u, poses, twists, modes, near):
         """The couples of the pairs ``near`` that are not far (`CoupleEval` or None per pair)
         and the couples' rate u*' = Eq. (47) + drift_feedback x projection; `DriftError` as
-        `couple`."""
+        `couple` for a couple in contact. A tracked couple that drifts further is sought again
+        at the next step's start (`drifting`)."""
         k, fb = len(self.pairs), self.options.drift_feedback
         evals = [None] * k
         udot = np.zeros(self.nu)
@@ -146,7 +147,8 @@ class PlantEvaluator:
             ftwists = [(float_vec(w), float_vec(v)) for w, v in twists]
             for i in near:
                 sl = self.couple_slice(i)
-                ev = evals[i] = self.couple(i, u[sl], fposes, ftwists, modes.pairs[i].sigma, t)
+                ev = evals[i] = self.couple(i, u[sl], fposes, ftwists, modes.pairs[i].sigma, t,
+                                            modes.pairs[i].mode.in_contact)
                 udot[sl] = ev.udot + fb * ev.drift
         if self.kernel is None:
             return evals, udot
@@ -168,8 +170,10 @@ class PlantEvaluator:
                                           "(|d| = 0), its normal is undefined", time=t,
                                           couples=[self.pairs[i].name])
         rel = out[:, KERNEL_DRIFT_REL]
-        if (rel > self.options.drift_tol).any():
-            i = int(np.argmax(rel > self.options.drift_tol))
+        over = [i for i in np.flatnonzero(rel > self.options.drift_tol).tolist()
+                if modes.pairs[i].mode.in_contact]
+        if over:
+            i = over[0]
             raise DriftError(f"couple drift {rel[i]:.3e} of the domain span exceeds "
                              f"drift_tol = {self.options.drift_tol:g}", time=t,
                              couples=[self.pairs[i].name])
@@ -179,6 +183,13 @@ class PlantEvaluator:
             sl = self.couple_slice(i)
             udot[sl] = python_udot[sl]
         return evals, udot
+
+    def drifting(self, E, states) -> bool:
+        """Whether a tracked couple (not in contact) of the evaluation E projected by more than
+        ``drift_tol`` of its domain span: it is sought again (`Transitions.resolve`)."""
+        return any(c is not None and not states[i].mode.in_contact
+                   and (np.abs(c.drift) / self.spans[i]).max() > self.options.drift_tol
+                   for i, c in enumerate(E.evals))
 
     def row(self, i, ev, poses, ctx):
         """Pair i's `ContactRow` (`row_arrays`)."""

@@ -36,10 +36,19 @@ def lzb_impact(ev, t, modes, ctx, poses, evs, S, v):
     M = ev.plant.CalcMassMatrix(ctx)
     approach = float(-min(r.vn for r in rows))
     e = hybrid.zeno_restitution(approach, law.restitution, opt.zeno_speed)
+    def solve(compiled):
+        return solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt, mu=law.mu,
+                         mu_s=ev.mu_s, law=law.impact_law, rtol=opt.impact_rtol,
+                         compiled=compiled)
     try:
-        res = solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt, mu=law.mu,
-                        mu_s=ev.mu_s, law=law.impact_law, rtol=opt.impact_rtol,
-                        compiled=opt.lzb_compiled)
+        try:
+            res = solve(opt.lzb_compiled)
+        except NumericalError:
+            if not opt.lzb_compiled:
+                raise
+            # The compiled driver's steps can stall where the reference's DOP853 steps over
+            # (two couples that stick and slip in turn): the impact is solved again by it.
+            res = solve(False)
     except NumericalError as err:
         if os.environ.get("DRAKE_DOCK_DUMP_LZB"):
             np.savez(os.environ["DRAKE_DOCK_DUMP_LZB"], M=M, Wn=Wn, Wt=Wt, v=v, e=e)

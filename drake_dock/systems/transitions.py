@@ -72,7 +72,9 @@ class Transitions:
                 raise SingularCoupleError(
                     f"the Jacobian of a couple in contact turned singular (Eq. 39 fails; "
                     f"conditioning {c.conditioning:.2e})", time=t, couples=[p.name])
-            if _reseek(p, c, margin, poses[ev.fidx[i][1]][0], opt.conditioning_min):
+            drifted = (not st.mode.in_contact
+                       and (np.abs(c.drift) / ev.spans[i]).max() > opt.drift_tol)
+            if drifted or _reseek(p, c, margin, poses[ev.fidx[i][1]][0], opt.conditioning_min):
                 sought.append((i, self.seek(i, poses, modes.pairs, u, t, st.mode.in_contact)))
         for i, after in sought:
             self.carry(i, after, modes.pairs)

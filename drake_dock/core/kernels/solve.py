@@ -56,8 +56,11 @@ def solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, 
     Ct = np.empty((m, nv))         # C^T and D^T, C-ordered: C = Ct.T as the reference's
     Dt = np.empty((m, nv))
     rhs = np.empty(m)
+    soft = 0.0       # the Baumgarte terms' squared norm (see the reference's singular case)
     j = 0
     for i in range(k):
+        if modes[i] != DETACH:
+            soft += (2 * omega * vn[i] + omega ** 2 * gap[i]) ** 2
         if modes[i] == STICK:
             for c in range(3):
                 for a in range(nv):
@@ -97,7 +100,8 @@ def solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, 
     else:
         cond = np.linalg.cond(A)
         lam = np.linalg.lstsq(A, b, rcond=1e-10)[0]
-        if np.linalg.norm(np.dot(A, lam) - b) > 1e-8 * (1.0 + np.linalg.norm(b)):
+        if np.linalg.norm(np.dot(A, lam) - b) > (1e-8 * (1.0 + np.linalg.norm(b))
+                                                   + math.sqrt(soft)):
             return SINGULAR, cond
         ns = 0
         for i in range(k):
