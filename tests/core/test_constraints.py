@@ -193,3 +193,44 @@ def test_random_sliding_contacts_match_the_enumeration(select_modes):
         assert any(np.allclose(vdot, sol.vdot, rtol=0.0, atol=1e-12) for _, vdot, _ in found)
         detached += DETACH in sol.modes
     assert 0 < detached < 300
+
+
+@pytest.mark.parametrize("solve", [constraints.solve_given_modes, compiled.solve_given_modes],
+                         ids=["python", "compiled"])
+def test_two_sticking_points_carry_the_load_within_the_baumgarte_terms(solve):
+    """A box resting on two sticking points of the plane is statically indeterminate: their
+    six rows have rank 5 (the two points' distance is held twice). When the two couples' gaps
+    drift apart by round-off, the stabilised rows (Eq. 52) ask the two normal accelerations for
+    different corrections, and the equations are inconsistent by as much: the least-squares
+    forces are taken. Closed form: the plane carries the weight m g, shared equally by the
+    symmetric points, no tangential force, and the residual is within the Baumgarte terms."""
+    m = 2.0
+    M = body_mass(m, [0.1, 0.2, 0.15])
+    a0 = np.array([0.0, 0.0, -G, 0.0, 0.0, 0.0])
+    r = np.array([0.3, 0.0, -0.1])
+    rows = [plane_row("left", r * [-1, 1, 1], gap=0.0, vn=0.0, vt=[0, 0], mu=0.5),
+            plane_row("right", r, gap=0.0, vn=3e-7, vt=[0, 0], mu=0.5)]
+    sol = solve(np.linalg.inv(M), a0, rows, ("stick", "stick"), [None, None], omega=OMEGA)
+    soft = 2 * OMEGA * 3e-7
+    assert sol.lam_n.sum() == pytest.approx(m * G, abs=10 * m * soft)
+    assert sol.lam_n[0] == pytest.approx(sol.lam_n[1], abs=10 * m * soft)
+    assert np.abs(sol.lam_t).max() < 10 * m * soft
+    gdd = [r_.Wn @ sol.vdot + r_.bn + 2 * OMEGA * r_.vn for r_ in rows]
+    assert max(abs(x) for x in gdd) <= soft
+
+
+@pytest.mark.parametrize("solve", [constraints.solve_given_modes, compiled.solve_given_modes],
+                         ids=["python", "compiled"])
+def test_inconsistent_redundant_sticking_beyond_the_baumgarte_terms_is_singular(solve):
+    """The same box with the two points at one place but asked for different normal
+    accelerations by their velocity-product terms (1e-3 m/s^2 apart, far beyond round-off and
+    with no Baumgarte term to account for it): no forces hold both rows, a
+    `SingularContactError`."""
+    from drake_dock.errors import SingularContactError
+    M = body_mass(2.0, [0.1, 0.2, 0.15])
+    a0 = np.array([0.0, 0.0, -G, 0.0, 0.0, 0.0])
+    r = np.array([0.3, 0.0, -0.1])
+    rows = [plane_row("a", r, gap=0.0, vn=0.0, vt=[0, 0], mu=0.5),
+            plane_row("b", r, gap=0.0, vn=0.0, vt=[0, 0], mu=0.5, bn=1e-3)]
+    with pytest.raises(SingularContactError):
+        solve(np.linalg.inv(M), a0, rows, ("stick", "stick"), [None, None], omega=OMEGA)
