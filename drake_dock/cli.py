@@ -10,6 +10,7 @@ or a previous drake_dock output (`drake_dock.docking.output.check_destination`).
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 import sys
 import textwrap
 import warnings
@@ -125,7 +126,8 @@ def main(argv=None) -> int:
                 raise InputError("--duration", args.duration, "> 0 s")
             scenario.simulation.duration = args.duration
             validate(scenario)
-        return [format_summary(run(scenario, args.out, progress=bar))]
+        out = run(scenario, args.out, progress=bar, full=True, name=Path(args.scenario).stem)
+        return [format_summary(out.summary, out.cost)]
     return _guarded(work, args.out, None if bar is None else bar.close)
 
 

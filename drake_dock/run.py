@@ -1,6 +1,7 @@
 """Runs a docking scenario end to end and writes its outputs atomically into a directory:
-``timeseries.npz``, ``summary.json``, the figures (PNG), ``replay.html`` and ``drake.log`` (the
-lines Drake logged during the run, which are kept off the terminal).
+``summary.json`` (the numbers of the run), ``cost.json`` (what it cost the solver),
+``timeseries.npz``, the figures (PNG), ``replay.html`` and ``drake.log`` (the lines Drake logged
+during the run, which are kept off the terminal).
 
 A failed run (bad input, numerical failure) leaves no directory, or the previous complete one
 untouched (`drake_dock.docking.output.atomic_directory`). The destination is checked before anything is
@@ -19,8 +20,8 @@ import numpy as np
 
 from drake_dock.docking.replay import replay_html
 from drake_dock.docking.pairs import scenario_pairs
-from drake_dock.docking.results import (momenta, momentum_reference_point, relative_text, summary,
-                                        timeseries)
+from drake_dock.docking.results import (momenta, momentum_reference_point, relative_text,
+                                        run_cost, summary, timeseries)
 from drake_dock.docking.simulate import simulate
 from drake_dock.errors import NumericalError
 from drake_dock.docking.figures import initial_configuration_figure, run_figures
@@ -68,25 +69,27 @@ def drake_log():
         logger.propagate = saved
 
 
-def run(scenario, out_dir, *, progress=None, state=None, dd=None, full=False):
+def run(scenario, out_dir, *, progress=None, state=None, dd=None, full=False, name=None):
     """Simulates ``scenario`` and writes everything into ``out_dir``; returns the summary, or
-    with ``full`` a namespace (summary, timeseries, result: the `RunResult`, figures: the
-    `FigureRecord`s). ``dd``: a docking Diagram built by the caller (with a controller on
+    with ``full`` a namespace (summary, cost, timeseries, result: the `RunResult`, figures: the
+    `FigureRecord`s). ``name``: the scenario's name in the outputs (its file name without
+    extension, say; default "scenario"). ``dd``: a docking Diagram built by the caller (with a controller on
     ``chaser_wrench``, say; `drake_dock.docking.simulate.simulate`). Raises `InputError` for a
     destination that may not be replaced, before simulating, and `NumericalError` for a failed
     simulation or a non-finite summary value (nothing written)."""
     check_destination(out_dir)
     with drake_log() as log:
-        return _run(scenario, out_dir, progress, state, dd, full, log)
+        return _run(scenario, out_dir, progress, state, dd, full, log, name or "scenario")
 
 
-def _run(scenario, out_dir, progress, state, dd, full, log):
+def _run(scenario, out_dir, progress, state, dd, full, log, name):
     result = simulate(scenario, progress=progress, state=state, dd=dd)
     if hasattr(progress, "note"):
         progress.note(f"{result.outcome} at t = {result.end_time:.4f} s; writing the outputs "
                       f"(arrays, figures, replay)")
     ts = timeseries(result)
-    summ = summary(result, ts)
+    summ = {"scenario_name": name, **summary(result, ts)}
+    cost = run_cost(result, ts)
     bad = _non_finite(summ)
     if bad is not None:
         raise NumericalError(f"the run's summary value {bad} is not finite (an overflow of "
@@ -109,31 +112,58 @@ def _run(scenario, out_dir, progress, state, dd, full, log):
         summ["figures"] = [r.name for r in records]
         (tmp / "replay.html").write_text(html)
         (tmp / "summary.json").write_text(json.dumps(summ, indent=2, allow_nan=False) + "\n")
+        (tmp / "cost.json").write_text(json.dumps(cost, indent=2) + "\n")
         (tmp / "drake.log").write_text("".join(line + "\n" for line in log))
     if full:
-        return SimpleNamespace(summary=summ, timeseries=ts, result=result, figures=records)
+        return SimpleNamespace(summary=summ, cost=cost, timeseries=ts, result=result,
+                               figures=records)
     return summ
 
 
-def format_summary(s) -> str:
+def _at(peak: dict) -> str:
+    return "" if peak["time_s"] is None else f" at {peak['time_s']:.3f} s"
+
+
+def format_summary(s, cost=None) -> str:
+    """The printed summary of a run: outcome, misalignment, loads, energy, conservation and
+    (with ``cost``) the simulation's wall time."""
     fm = s["final_misalignment"]
     led = s["energy_ledger"]
     md = s["momentum_drift_relative"]
-    return "\n".join([
-        f"{s['outcome']} at t = {s['end_time_s']:.6f} s ({s['outcome_reason']}); final "
-        f"misalignment: axial {fm['axial_m']:.4g} m, lateral {fm['lateral_m']:.3g} m, tilt "
-        f"{fm['tilt_deg']:.3g} deg",
-        f"impacts: {s['number_of_impacts']}; peak contact force {s['peak_contact_force_N']:.6g} N;"
-        f" largest impulse {s['largest_impulse_Ns']:.6g} N s",
-        f"momentum drift (relative): linear {relative_text(md['linear'])}, angular "
-        f"{relative_text(md['angular'])}",
-        f"energy: initial {led['initial_total_J']:.6g} J; dissipated by the damper "
-        f"{led['dissipated_damper_J']:.6g} J, friction {led['dissipated_friction_J']:.6g} J, "
-        f"impacts {led['dissipated_impacts_J']:.6g} J; ledger closure "
+    lo = s["loads"]
+    fi, mi = lo["interface_force_N"], lo["interface_moment_Nm"]
+    st, sf = lo["stewart_stroke_m"], lo["stewart_force_N"]
+    pc = lo["couple_normal_force_N"]
+    rel = s["relative_kinetic_energy_at_contact_J"]
+    lines = [
+        f"{s['outcome']} at t = {s['end_time_s']:.6f} s ({s['outcome_reason']})",
+        f"final misalignment: axial {1e3 * fm['axial_m']:.4g} mm, lateral "
+        f"{1e3 * fm['lateral_m']:.3g} mm, tilt {fm['tilt_deg']:.3g} deg",
+        f"interface loads at the target ring: force {fi['peak']:.4g} N{_at(fi)} (axial "
+        f"{fi['axial_peak']:.4g} N, lateral {fi['lateral_peak']:.4g} N), moment "
+        f"{mi['peak']:.4g} N m{_at(mi)}",
+        f"Stewart element: stroke {1e3 * st['peak']:.4g} mm{_at(st)}, force "
+        f"{sf['peak']:.4g} N{_at(sf)}",
+        f"contact: peak total force {lo['total_contact_force_N']['peak']:.4g} N; peak "
+        f"couple normal force {pc['peak']:.4g} N"
+        + (f" ({pc['couple']}: {s['couples'][pc['couple']]['description']})" if pc["couple"]
+           else "")
+        + f"; {s['number_of_impacts']} impacts, largest impulse "
+        f"{s['largest_impulse_Ns']:.4g} N s",
+        f"energy: relative kinetic energy at contact "
+        + ("none (no contact)" if rel is None else f"{rel:.4g} J")
+        + f" (centre-of-mass frame); in the inertial frame: initial {led['initial_total_J']:.4g}"
+        f" J, dissipated by the damper {led['dissipated_damper_J']:.4g} J, friction "
+        f"{led['dissipated_friction_J']:.4g} J, impacts {led['dissipated_impacts_J']:.4g} J,"
+        f" input work {led['input_work_J']:.4g} J; ledger closure "
         f"{relative_text(led['closure_error_relative'])}",
-        f"wall time {s['wall_time_s']:.2f} s for {s['end_time_s']:.4f} s simulated "
-        f"({s['derivative_evaluations']} derivative evaluations)",
-        time_shares_line(s["time_shares"]), *pair_type_lines(s["cost_by_pair_type"])])
+        f"momentum drift (relative): linear {relative_text(md['linear'])}, angular "
+        f"{relative_text(md['angular'])}"]
+    if cost is not None:
+        lines.append(f"simulation: wall time {cost['wall_time_s']:.2f} s for "
+                     f"{cost['simulated_s']:.4f} s simulated ({cost['derivative_evaluations']} "
+                     f"derivative evaluations; solver cost in cost.json)")
+    return "\n".join(lines)
 
 
 def pair_type_lines(cost) -> list:

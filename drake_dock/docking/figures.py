@@ -69,7 +69,7 @@ def ring_distance_force_figure(ts, summary, out, focus):
     a_f = sh.fig.add_subplot(gs[0, 1])
     a_p = sh.fig.add_subplot(gs[1, 1], sharex=a_f)
     sh.line(a_d, t, ts["ring_distance"] * 1e3, "ring-centre distance", PALETTE[0])
-    a_d.axhline(summary["capture_distance_m"] * 1e3, color="k", ls="--", lw=0.8,
+    a_d.axhline(summary["capture_tolerances"]["axial_m"] * 1e3, color="k", ls="--", lw=0.8,
                 label="capture distance")
     if summary["captured"]:
         a_d.axvline(summary["capture_time_s"], color=PALETTE[3], lw=1.0, label="capture")

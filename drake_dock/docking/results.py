@@ -25,6 +25,7 @@ from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.outcome import misalignment
 from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
                                       stewart_force, stewart_potential)
+from drake_dock.docking.loads import peak_loads
 from drake_dock.docking.pairs import CHASER_APDS, cost_by_pair_type, scenario_pairs
 
 IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or sticking)
@@ -134,20 +135,56 @@ def relative_text(x, spec=".2e") -> str:
     return "undefined" if x is None else format(x, spec)
 
 
-def energy_ledger(ts: dict) -> dict:
-    """kinetic + Stewart potential + dissipated (damper, friction, impacts) - input work must
-    equal the initial total; closure is the largest |residual| over the run relative to it."""
+def centre_of_mass_kinetic_energy(ts: dict, masses) -> np.ndarray:
+    """|P|^2 / (2 M) [N] (J): the kinetic energy of the motion of the system's centre of mass
+    (P the total linear momentum, M the total mass). Contact cannot change it; only an input
+    (thrust) can."""
+    m = np.asarray(masses, float)
+    P = np.einsum("b,nbi->ni", m, ts["v_WB"])
+    return np.einsum("ni,ni->n", P, P) / (2.0 * m.sum())
+
+
+def first_contact_sample(ts: dict) -> int | None:
+    """The first sample at which a couple is in contact or an impact happens (the sample just
+    before it), or None for a run without contact."""
+    hits = np.flatnonzero((ts["status"] >= IN_CONTACT).any(1) | (ts["sample_kind"] == 1))
+    return int(hits[0]) if hits.size else None
+
+
+def relative_kinetic_energy_at_contact(ts: dict, masses) -> float | None:
+    """The kinetic energy in the system's centre-of-mass frame (the inertial kinetic energy
+    minus `centre_of_mass_kinetic_energy`) at the first contact (`first_contact_sample`): what
+    the contact, the damper and the Stewart spring can act on; 1/2 mu v^2 for two bodies
+    closing at v without rotation (mu the reduced mass). None without contact."""
+    k = first_contact_sample(ts)
+    if k is None:
+        return None
+    kinetic = ts["energy"][:, ts["energy_names"].tolist().index("kinetic")]
+    return float(kinetic[k] - centre_of_mass_kinetic_energy(ts, masses)[k])
+
+
+def energy_ledger(ts: dict, masses=None) -> dict:
+    """The ledger in the inertial (world) frame: kinetic + Stewart potential + dissipated
+    (damper, friction, impacts) - input work must equal the initial total; closure is the
+    largest |residual| over the run relative to it. With ``masses``, the part of the initial
+    total in the motion of the centre of mass (`centre_of_mass_kinetic_energy`), which no
+    contact dissipates."""
     E = dict(zip(ts["energy_names"].tolist(), ts["energy"].T))
     ke, pe = E["kinetic"], E["potential"]
     damper = -E["stewart_damper_work"]
     friction, impacts, inputs = E["friction_loss"], E["impact_loss"], E["input_work"]
     total0 = ke[0] + pe[0]
     residual = ke + pe + damper + friction + impacts - inputs - total0
-    return {"initial_total_J": float(total0), "kinetic_J": float(ke[-1]),
-            "stewart_potential_J": float(pe[-1]), "dissipated_damper_J": float(damper[-1]),
-            "dissipated_friction_J": float(friction[-1]),
-            "dissipated_impacts_J": float(impacts[-1]), "input_work_J": float(inputs[-1]),
-            "closure_error_relative": _relative(np.abs(residual).max(), abs(total0))}
+    out = {"frame": "inertial (world)", "initial_total_J": float(total0)}
+    if masses is not None:
+        out["initial_centre_of_mass_motion_J"] = float(
+            centre_of_mass_kinetic_energy(ts, masses)[0])
+    out.update({"kinetic_J": float(ke[-1]),
+                "stewart_potential_J": float(pe[-1]), "dissipated_damper_J": float(damper[-1]),
+                "dissipated_friction_J": float(friction[-1]),
+                "dissipated_impacts_J": float(impacts[-1]), "input_work_J": float(inputs[-1]),
+                "closure_error_relative": _relative(np.abs(residual).max(), abs(total0))})
+    return out
 
 
 def final_misalignment(ts: dict) -> dict:
@@ -160,46 +197,82 @@ def final_misalignment(ts: dict) -> dict:
     return {"axial_m": axial, "lateral_m": lateral, "tilt_deg": math.degrees(tilt)}
 
 
+def near_couples(ts: dict) -> np.ndarray:
+    """Indices of the couples that came near: tracked or in contact at some sample, or in an
+    impact. The others stayed far throughout (their rows hold no contact)."""
+    return np.flatnonzero((ts["status"] > Mode.FAR).any(0) | ts["impact_couples"].any(0))
+
+
+def couples_table(ts: dict, pairs) -> dict:
+    """{couple: its description in plain words (`drake_dock.docking.pairs.describe_pair`), the
+    share of samples in contact, its peak normal force, its impacts and their normal impulse}
+    for the couples that came near (`near_couples`)."""
+    words = {p.name: p.description for p in pairs}
+    names = ts["couple_names"].tolist()
+    out = {}
+    for j in near_couples(ts):
+        lam = ts["lambda_n"][:, j]
+        out[names[j]] = {
+            "description": words[names[j]],
+            "in_contact_share": float((ts["status"][:, j] >= IN_CONTACT).mean()),
+            "peak_normal_force_N": float(lam.max(initial=0.0)),
+            "impacts": int(ts["impact_couples"][:, j].sum()),
+            "normal_impulse_Ns": float(ts["impact_normal_impulse"][:, j].sum())}
+    return out
+
+
 def summary(result, ts: dict) -> dict:
+    """The numbers of a run for a docking engineer (summary.json): the outcome and its reason,
+    capture, the final misalignment, the peak loads (`drake_dock.docking.loads.peak_loads`),
+    the relative kinetic energy at contact, the energy ledger, the impacts, the momentum drift,
+    the first contact and the couples that came near (`couples_table`). The solver's cost is
+    apart (`run_cost`)."""
     s = result.scenario
     b = s.bodies
     params = [getattr(b, n) for n in ts["body_names"]]
-    P, L, sP, sL = momenta(ts, [p.mass for p in params], [p.inertia for p in params],
+    masses = [p.mass for p in params]
+    P, L, sP, sL = momenta(ts, masses, [p.inertia for p in params],
                            momentum_reference_point(s, ts))
-    lam = ts["lambda_n"]
-    k_peak = np.unravel_index(np.argmax(lam), lam.shape) if lam.size else None
-    peak = float(lam[k_peak]) if k_peak is not None else 0.0
+    pairs = scenario_pairs(s)
     imp = ts["impact_normal_impulse"]
     return {
         "outcome": result.outcome,
         "outcome_reason": result.reason,
-        "final_misalignment": final_misalignment(ts),
         "captured": bool(result.captured),
         "capture_time_s": result.capture_time,
-        "capture_distance_m": s.simulation.capture_distance,
+        "end_time_s": result.end_time,
+        "final_misalignment": final_misalignment(ts),
         "capture_tolerances": {"axial_m": s.simulation.capture_distance,
                                "lateral_m": s.simulation.capture_lateral,
                                "tilt_deg": s.simulation.capture_tilt_deg},
-        "end_time_s": result.end_time,
+        "loads": peak_loads(ts, pairs),
+        "relative_kinetic_energy_at_contact_J": relative_kinetic_energy_at_contact(ts, masses),
+        "energy_ledger": energy_ledger(ts, masses),
         "number_of_impacts": len(result.impacts),
         "impact_times_s": ts["impact_t"].tolist(),
         "largest_impulse_Ns": float(imp.max()) if imp.size else 0.0,
-        "peak_contact_force_N": peak,
-        "peak_contact_force_couple": (str(ts["couple_names"][k_peak[1]]) if peak > 0 else None),
-        "peak_contact_force_time_s": (float(ts["t"][k_peak[0]]) if peak > 0 else None),
         "momentum_drift_relative": {
             "linear": _relative(np.linalg.norm(P - P[0], axis=1).max(), sP),
             "angular": _relative(np.linalg.norm(L - L[0], axis=1).max(), sL)},
-        "energy_ledger": energy_ledger(ts),
         "first_contact_ring_distance_m": result.initial.d_contact,
         "first_contact_lateral_offset_m": list(result.initial.contact_offset),
         "initial_ring_distance_m": result.initial.d0,
         "first_closing_couples": list(result.initial.closing_pairs),
+        "couples": couples_table(ts, pairs),
+    }
+
+
+def run_cost(result, ts: dict) -> dict:
+    """What the run cost the solver (cost.json): the wall time of the simulation (compilation
+    and output writing excluded), the derivative evaluations, samples and mode changes, the
+    time shares and the cost per pair type (`drake_dock.docking.pairs.cost_by_pair_type`).
+    Wall times vary from run to run."""
+    return {
+        "wall_time_s": result.wall_time,
+        "simulated_s": result.end_time,
+        "derivative_evaluations": result.evaluations,
         "samples": int(len(ts["t"])),
         "mode_changes": result.mode_changes,
-        "derivative_evaluations": result.evaluations,
-        "wall_time_s": result.wall_time,
         "time_shares": result.timing,
         "cost_by_pair_type": cost_by_pair_type(result.timing),
     }
-
