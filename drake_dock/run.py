@@ -95,14 +95,13 @@ def _run(scenario, out_dir, progress, state, dd, full, log, name):
         raise NumericalError(f"the run's summary value {bad} is not finite (an overflow of "
                              f"extreme inputs)", time=result.end_time)
     params = [getattr(scenario.bodies, n) for n in ts["body_names"]]
-    P, L, _, _ = momenta(ts, [p.mass for p in params], [p.inertia for p in params],
-                         momentum_reference_point(scenario, ts))
+    momentum = momenta(ts, [p.mass for p in params], [p.inertia for p in params],
+                       momentum_reference_point(scenario, ts))
     nq = result.dd.dp.plant.num_positions()
     html = replay_html(scenario, ts["t"], np.asarray(result.record.x)[:, :nq], ts=ts)
     with atomic_directory(out_dir) as tmp:
         (tmp / "timeseries.npz").write_bytes(_npz_bytes(ts))
-        records = run_figures(ts, summ, (P, L), tmp, focus_couples=result.initial.closing_pairs,
-                              pairs=scenario_pairs(scenario))
+        records = run_figures(ts, summ, momentum, tmp, pairs=scenario_pairs(scenario))
         poses = {n: (ts["R_WA"][0, j], ts["p_WA"][0, j])
                  for j, n in enumerate(ts["apds_names"].tolist())}
         cn = ts["couple_names"].tolist()
