@@ -20,8 +20,8 @@ import numpy as np
 
 from drake_dock.docking.replay import replay_html
 from drake_dock.docking.pairs import scenario_pairs
-from drake_dock.docking.results import (momenta, momentum_reference_point, relative_text,
-                                        run_cost, summary, timeseries)
+from drake_dock.docking.results import (momenta, momentum_reference_point, near_timeseries,
+                                        relative_text, run_cost, summary, timeseries)
 from drake_dock.docking.simulate import simulate
 from drake_dock.errors import NumericalError
 from drake_dock.docking.figures import initial_configuration_figure, run_figures
@@ -29,10 +29,10 @@ from drake_dock.docking.output import atomic_directory, check_destination
 
 
 def _npz_bytes(arrays: dict) -> bytes:
-    """np.savez into memory. Zip entries carry a fixed timestamp, so equal arrays give equal
-    bytes (bitwise reproducible files)."""
+    """np.savez_compressed into memory. Zip entries carry a fixed timestamp, so equal arrays
+    give equal bytes (bitwise reproducible files)."""
     buf = io.BytesIO()
-    np.savez(buf, **arrays)
+    np.savez_compressed(buf, **arrays)
     return buf.getvalue()
 
 
@@ -98,9 +98,9 @@ def _run(scenario, out_dir, progress, state, dd, full, log, name):
     momentum = momenta(ts, [p.mass for p in params], [p.inertia for p in params],
                        momentum_reference_point(scenario, ts))
     nq = result.dd.dp.plant.num_positions()
-    html = replay_html(scenario, ts["t"], np.asarray(result.record.x)[:, :nq], ts=ts)
+    html = replay_html(scenario, ts["t"], np.asarray(result.record.x)[:, :nq], ts=ts, title=name)
     with atomic_directory(out_dir) as tmp:
-        (tmp / "timeseries.npz").write_bytes(_npz_bytes(ts))
+        (tmp / "timeseries.npz").write_bytes(_npz_bytes(near_timeseries(ts)))
         records = run_figures(ts, summ, momentum, tmp, pairs=scenario_pairs(scenario))
         poses = {n: (ts["R_WA"][0, j], ts["p_WA"][0, j])
                  for j, n in enumerate(ts["apds_names"].tolist())}

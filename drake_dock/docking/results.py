@@ -1,18 +1,19 @@
 """The arrays of timeseries.npz and the numbers of summary.json, from a `RunResult`.
 
-Field layout: t[N]; body_names[3]; p_WB[N,3,3], R_WB[N,3,3,3], v_WB[N,3,3], w_WB[N,3,3]
-(mass centres, world frame); apds_names[2]; p_WA[N,2,3], R_WA[N,2,3,3] (ring centre, e3 along the
-axis towards the other APDS); couple_names[12]; status[N,12] (the pair's `Mode`: 0 far,
-1 tracked, 2 sliding, 3 sticking); active[N,12] (tracked or in contact); gap[N,12];
-lambda_n[N,12]; lambda_t[N,12,2];
-u[N,12,3] (couple parameters, unused entries 0); p1_W[N,12,3], p2_W[N,12,3]; frame_W[N,12,3,3]
+Field layout (C: the couples; all of the scene's in memory, those that came near in
+timeseries.npz, `near_timeseries`): t[N]; body_names[3]; p_WB[N,3,3], R_WB[N,3,3,3], v_WB[N,3,3],
+w_WB[N,3,3] (mass centres, world frame); apds_names[2]; p_WA[N,2,3], R_WA[N,2,3,3] (ring centre,
+e3 along the axis towards the other APDS); couple_names[C]; status[N,C] (the pair's `Mode`: 0
+far, 1 tracked, 2 sliding, 3 sticking); active[N,C] (tracked or in contact); gap[N,C];
+lambda_n[N,C]; lambda_t[N,C,2];
+u[N,C,3] (couple parameters, unused entries 0); p1_W[N,C,3], p2_W[N,C,3]; frame_W[N,C,3,3]
 (columns ta, tb, n: the contact frame, n from the couple's body 2 to its body 1; the identity
 for far couples); stewart_x[N,3] (m), stewart_rpy[N,3] (rad) (the Stewart element's deflection,
 `drake_dock.docking.plant.stewart_deflection`); stewart_force_W[N,3] (N, its force on the
 target APDS in the world frame, `drake_dock.docking.plant.stewart_force`); sample_kind[N]
 (0 step end, 1 just before an impact, 2 just after); ring_distance[N]; energy[N,k] with
-energy_names[k]; impact_t[M], impact_couples[M,12] (bool), impact_normal_impulse[M,12],
-impact_tangential_impulse[M,12,2], impact_restitution[M].
+energy_names[k]; impact_t[M], impact_couples[M,C] (bool), impact_normal_impulse[M,C],
+impact_tangential_impulse[M,C,2], impact_restitution[M].
 """
 from __future__ import annotations
 
@@ -201,6 +202,21 @@ def near_couples(ts: dict) -> np.ndarray:
     """Indices of the couples that came near: tracked or in contact at some sample, or in an
     impact. The others stayed far throughout (their rows hold no contact)."""
     return np.flatnonzero((ts["status"] > Mode.FAR).any(0) | ts["impact_couples"].any(0))
+
+
+# The per-couple arrays of a timeseries and the axis that runs over the couples.
+PER_COUPLE = {"couple_names": 0, "status": 1, "active": 1, "gap": 1, "lambda_n": 1,
+              "lambda_t": 1, "u": 1, "p1_W": 1, "p2_W": 1, "frame_W": 1, "impact_couples": 1,
+              "impact_normal_impulse": 1, "impact_tangential_impulse": 1}
+
+
+def near_timeseries(ts: dict) -> dict:
+    """The timeseries with the per-couple arrays cut to the couples that came near
+    (`near_couples`), as timeseries.npz holds it: the other couples stayed far, their rows hold
+    no contact."""
+    near = near_couples(ts)
+    return {k: np.take(v, near, axis=PER_COUPLE[k]) if k in PER_COUPLE else v
+            for k, v in ts.items()}
 
 
 def couples_table(ts: dict, pairs) -> dict:

@@ -15,13 +15,12 @@ from drake_dock.docking.figure_kit import PALETTE, decades
 from drake_dock.docking.figures import IMPULSE_FLOOR
 from drake_dock.docking.loads import interface_loads
 from drake_dock.docking.outcome import misalignment
-from drake_dock.docking.scenario import MODELS_DIR, load_scenario
+from drake_dock.docking.scenario import load_scenario
 from drake_dock.docking.scene import apds_pairs
 from drake_dock.run import run
 from matplotlib.colors import to_rgb
 
 PUSH_N, PUSH_AFTER_S = 2000.0, 0.06     # lateral force on the chaser (world x) and its start
-BOX_DURATION = 1.5                      # s of idss_box_corner: impacts and sliding on 4 couples
 MAX_DECADES = 12
 MIN_PIXELS = 12                         # pixels of a series' colour that must be on screen
 TOLERANCE = 32                          # per channel, of 255 (anti-aliasing)
@@ -32,7 +31,7 @@ def _push(t, x):
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
+def runs(tmp_path_factory, box_corner):
     base = tmp_path_factory.mktemp("figures")
     scenario = load_scenario()
     paper = run(scenario, base / "paper", full=True)
@@ -40,11 +39,8 @@ def runs(tmp_path_factory):
     n = dd.dp.plant.num_positions() + dd.dp.plant.num_velocities()
     pushed = run(scenario, base / "pushed", dd=with_controller(dd, WrenchController(n, _push)),
                  full=True)
-    box_scenario = load_scenario(MODELS_DIR / "idss_box_corner.yaml")
-    box_scenario.simulation.duration = BOX_DURATION
-    box = run(box_scenario, base / "box", full=True, name="idss_box_corner")
     return {"paper": (paper, base / "paper"), "pushed": (pushed, base / "pushed"),
-            "box": (box, base / "box")}
+            "box": box_corner}
 
 
 def _pixels_of(img, box, rgb):
