@@ -1,7 +1,8 @@
 """Runs a docking scenario end to end and writes its outputs atomically into a directory:
 ``summary.json`` (the numbers of the run), ``cost.json`` (what it cost the solver),
-``timeseries.npz``, the figures (PNG), ``replay.html`` and ``drake.log`` (the lines Drake logged
-during the run, which are kept off the terminal).
+``timeseries.npz``, the figures (PNG), ``replay.html`` and ``drake.log``: the lines Drake logged
+during the run, which are kept off the terminal, but for the replay's Meshcat start-up line
+(`QUIET`); without other lines no drake.log is written.
 
 A failed run (bad input, numerical failure) leaves no directory, or the previous complete one
 untouched (`drake_dock.docking.output.atomic_directory`). The destination is checked before anything is
@@ -49,6 +50,16 @@ def _non_finite(node, path=""):
         if bad is not None:
             return bad
     return None
+
+
+# Lines Drake logs that say nothing about the run: the address of the Meshcat server that
+# draws the replay, which is closed when the run ends.
+QUIET = ("Meshcat listening for connections",)
+
+
+def log_worth_keeping(lines) -> list:
+    """Drake's log lines but the `QUIET` ones."""
+    return [line for line in lines if not any(q in line for q in QUIET)]
 
 
 @contextlib.contextmanager
@@ -112,7 +123,9 @@ def _run(scenario, out_dir, progress, state, dd, full, log, name):
         (tmp / "replay.html").write_text(html)
         (tmp / "summary.json").write_text(json.dumps(summ, indent=2, allow_nan=False) + "\n")
         (tmp / "cost.json").write_text(json.dumps(cost, indent=2) + "\n")
-        (tmp / "drake.log").write_text("".join(line + "\n" for line in log))
+        kept = log_worth_keeping(log)
+        if kept:
+            (tmp / "drake.log").write_text("".join(line + "\n" for line in kept))
     if full:
         return SimpleNamespace(summary=summ, cost=cost, timeseries=ts, result=result,
                                figures=records)

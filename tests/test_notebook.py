@@ -24,7 +24,7 @@ def test_tutorial_notebook_executes(tmp_path):
     work, closure = re.search(r"controlled: captured at t = \S+ s; input work (\S+) J; "
                               r"closure (\S+)", text).groups()
     assert float(work) > 1.0 and float(closure) < 1e-6
-    assert "interface_loads.png" in text and "drake.log" in text
+    assert "interface_loads.png" in text and "summary.json" in text
     assert re.search(r"cc_T\d_C\d: peak lambda_n +\d", text)
     images = [o for o in outputs if "image/png" in o.get("data", {})]
     assert len(images) >= 2

@@ -339,7 +339,11 @@ def load_scenario(filename=None, *, data: str | None = None) -> Scenario:
         raise InputError("scenario file", str(filename or "<string>"), "valid YAML",
                          str(e).splitlines()[0]) from None
     if raw is None:
-        raw = {}
+        raise InputError("scenario file", str(filename or "<string>"),
+                         f"a YAML mapping of sections "
+                         f"({', '.join(f.name for f in dataclasses.fields(Scenario))}); "
+                         f"`drake-dock run --print-scenario` prints a complete one",
+                         "the file holds no YAML content (empty, or only comments)")
     if not isinstance(raw, dict):
         raise InputError("scenario", raw, "a mapping of fields")
     _check_raw(raw, Scenario, "")
