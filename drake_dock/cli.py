@@ -27,6 +27,7 @@ from __future__ import annotations
 import argparse
 import sys
 import textwrap
+import time
 import warnings
 from pathlib import Path
 
@@ -184,6 +185,36 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+COMPILE_NOTE_AFTER = 2.0     # s of kernel preparation before the compile note is printed
+
+
+def prepare_kernels(stream=None) -> float:
+    """Compiles the numba kernels, or loads them from their cache
+    (`drake_dock.core.kernels.compile_cache`), before a run, so that the run's wall time and
+    its progress bar are the simulation's; a note on ``stream`` (stderr) says so when it takes
+    longer than COMPILE_NOTE_AFTER (a first run after an install or an update). Returns the
+    seconds it took."""
+    import threading
+    import time
+
+    from drake_dock.core.kernels.compile_cache import warm
+    stream = stream or sys.stderr
+
+    def note():
+        stream.write("drake-dock: compiling the numba kernels (after an install or an update "
+                     "only: about 90 s; later runs load them from the cache)\n")
+        stream.flush()
+    timer = threading.Timer(COMPILE_NOTE_AFTER, note)
+    timer.daemon = True
+    t0 = time.perf_counter()
+    timer.start()
+    try:
+        warm()
+    finally:
+        timer.cancel()
+    return time.perf_counter() - t0
+
+
 def _need_out(out, what):
     if out is None:
         raise InputError("--out", MISSING, f"give a directory for {what} (--out DIR: a new "
@@ -214,8 +245,14 @@ def main(argv=None) -> int:
                 raise InputError("--duration", args.duration, "> 0 s")
             scenario.simulation.duration = args.duration
             validate(scenario)
+        kernels = prepare_kernels()
+        t0 = time.perf_counter()
         out = run(scenario, args.out, progress=bar, full=True, name=Path(args.scenario).stem)
-        return [format_summary(out.summary, out.cost)]
+        outputs = time.perf_counter() - t0 - out.cost["wall_time_s"]
+        return [format_summary(out.summary, out.cost),
+                f"wall time: kernels {kernels:.1f} s (compiled after an install or an update, "
+                f"loaded from the cache after), simulation {out.cost['wall_time_s']:.1f} s, "
+                f"outputs {outputs:.1f} s"]
     return _guarded(work, args.out, None if bar is None else bar.close)
 
 

@@ -172,9 +172,9 @@ def format_summary(s, cost=None) -> str:
         f"momentum drift (relative): linear {relative_text(md['linear'])}, angular "
         f"{relative_text(md['angular'])}"]
     if cost is not None:
-        lines.append(f"simulation: wall time {cost['wall_time_s']:.2f} s for "
-                     f"{cost['simulated_s']:.4f} s simulated ({cost['derivative_evaluations']} "
-                     f"derivative evaluations; solver cost in cost.json)")
+        lines.append(f"solver: {cost['derivative_evaluations']} derivative evaluations for "
+                     f"{cost['simulated_s']:.4f} s simulated in {cost['wall_time_s']:.2f} s "
+                     f"(more in cost.json)")
     return "\n".join(lines)
 
 

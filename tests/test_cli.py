@@ -1,6 +1,7 @@
 """Smoke tests of the command line, as a user runs it."""
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -22,6 +23,13 @@ def test_short_run_writes_outputs(tmp_path):
     out = tmp_path / "paper"
     r = _run(["run", "--out", str(out), "--duration", "0.005"])
     assert r.returncode == 0, r.stderr
+    # The printed wall time separates the kernels, the simulation (cost.json's) and the outputs.
+    kernels, simulation, outputs = map(float, re.search(
+        r"wall time: kernels ([0-9.]+) s .*, simulation ([0-9.]+) s, outputs ([0-9.]+) s",
+        r.stdout).groups())
+    cost = json.loads((out / "cost.json").read_text())
+    assert simulation == pytest.approx(cost["wall_time_s"], abs=0.051)
+    assert kernels >= 0 and outputs > 0
     helped = _run(["run", "--help"]).stdout
     for p in out.iterdir():
         if p.name != MARKER:
@@ -149,3 +157,22 @@ def test_input_errors_lead_with_their_reason(tmp_path):
     msg = " ".join(r.stderr.split())
     assert r.returncode == 2 and "holds no YAML content (empty, or only comments)" in msg
     assert "NoneType" not in msg and not (tmp_path / "out").exists()
+
+
+def test_kernels_prepared_with_a_note_when_it_takes_long(monkeypatch):
+    """The kernels are compiled (or loaded) before the run; when that takes long (a first run
+    after an install) a note says so while it happens, and not otherwise."""
+    import io
+    import time
+
+    from drake_dock import cli
+    monkeypatch.setattr(cli, "COMPILE_NOTE_AFTER", 0.05)
+    monkeypatch.setattr("drake_dock.core.kernels.compile_cache.warm", lambda: time.sleep(0.5))
+    slow = io.StringIO()
+    assert cli.prepare_kernels(slow) >= 0.5
+    assert "compiling the numba kernels" in slow.getvalue()
+    monkeypatch.setattr("drake_dock.core.kernels.compile_cache.warm", lambda: None)
+    fast = io.StringIO()
+    assert cli.prepare_kernels(fast) < 0.05
+    time.sleep(0.1)                   # past the note's delay: it was cancelled
+    assert fast.getvalue() == ""

@@ -139,7 +139,8 @@ class Sheet:
         axes, whose boxes the record keeps when they overlap the axes (they should not)."""
         fig = self.fig
         fig.tight_layout()
-        fig.canvas.draw()
+        # Saved at the figure's own dpi: the boxes below are those of the file's drawing.
+        fig.savefig(Path(out_dir) / name, dpi=DPI)
         height = fig.bbox.height
         records = []
         for ax in fig.axes:
@@ -153,7 +154,6 @@ class Sheet:
                       "y": (*ax.get_ylim(), ax.get_yscale())}
             records.append(AxesRecord(box, self.drawn.get(ax, []), self.notes.get(ax, []),
                                       overlaps, limits))
-        fig.savefig(Path(out_dir) / name, dpi=DPI)
         plt.close(fig)
         return FigureRecord(name, records)
 
