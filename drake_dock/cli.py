@@ -72,8 +72,8 @@ def studies_text() -> str:
         lines.append(f"  {name:<{width}}{wrapped[0]}")
         lines += [" " * (width + 2) + w for w in wrapped[1:]]
     lines += ["", "Each writes its files (CSV, figures, summary) into DIR and prints its summary "
-              "lines;", "--quick runs a few points only. README.md describes each study's "
-              "files."]
+              "lines;", "--quick runs a few points only. docs/studies.md describes each "
+              "study's files."]
     return "\n".join(lines)
 
 
@@ -150,6 +150,10 @@ def _parser() -> argparse.ArgumentParser:
     run_p.add_argument("--duration", type=float, default=None,
                        help="override simulation.duration, the timeout (s)")
     run_p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    run_p.add_argument("--print-scenario", action="store_true",
+                       help="print the full scenario the run would use (every field, defaults "
+                            "filled in, --duration applied) as YAML, and exit without "
+                            "simulating")
     study_p = sub.add_parser(
         "study", help="run a study (`drake-dock study` lists them)", formatter_class=raw,
         description="Runs a study and writes its files into DIR.",
@@ -234,20 +238,27 @@ def main(argv=None) -> int:
     from drake_dock.docking.output import check_destination
     from drake_dock.run import format_summary, run
     from drake_dock.docking.scenario import load_scenario, validate
+    from drake_dock.docking.scenario import scenario_yaml
+
+    def scenario():
+        s = load_scenario(args.scenario)
+        if args.duration is not None:
+            if not args.duration > 0:
+                raise InputError("--duration", args.duration, "> 0 s")
+            s.simulation.duration = args.duration
+            validate(s)
+        return s
+    if args.print_scenario:
+        return _guarded(lambda: [scenario_yaml(scenario()).rstrip("\n")], None)
     bar = None if args.no_progress else ProgressBar()
 
     def work():
         _need_out(args.out, "the run's outputs")
         check_destination(args.out)
-        scenario = load_scenario(args.scenario)
-        if args.duration is not None:
-            if not args.duration > 0:
-                raise InputError("--duration", args.duration, "> 0 s")
-            scenario.simulation.duration = args.duration
-            validate(scenario)
+        scenario_ = scenario()
         kernels = prepare_kernels()
         t0 = time.perf_counter()
-        out = run(scenario, args.out, progress=bar, full=True, name=Path(args.scenario).stem)
+        out = run(scenario_, args.out, progress=bar, full=True, name=Path(args.scenario).stem)
         outputs = time.perf_counter() - t0 - out.cost["wall_time_s"]
         return [format_summary(out.summary, out.cost),
                 f"wall time: kernels {kernels:.1f} s (compiled after an install or an update, "
@@ -279,7 +290,8 @@ def _guarded(work, out, finish=None) -> int:
         warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     for line in lines:
         print(line)
-    print(f"wrote {out}")
+    if out is not None:
+        print(f"wrote {out}")
     return 0
 
 

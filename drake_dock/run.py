@@ -119,7 +119,8 @@ def _run(scenario, out_dir, progress, state, dd, full, log, name):
         first = {c: SimpleNamespace(p1=ts["p1_W"][0, cn.index(c)], p2=ts["p2_W"][0, cn.index(c)])
                  for c in result.initial.closing_pairs}
         records.append(initial_configuration_figure(scenario.geometry, poses, first, tmp))
-        summ["figures"] = [r.name for r in records]
+        summ = {**{k: v for k, v in summ.items() if k != "scenario"},
+                "figures": [r.name for r in records], "scenario": summ["scenario"]}
         (tmp / "replay.html").write_text(html)
         (tmp / "summary.json").write_text(json.dumps(summ, indent=2, allow_nan=False) + "\n")
         (tmp / "cost.json").write_text(json.dumps(cost, indent=2) + "\n")

@@ -28,6 +28,7 @@ from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection
                                       stewart_force, stewart_potential)
 from drake_dock.docking.loads import peak_loads
 from drake_dock.docking.pairs import CHASER_APDS, cost_by_pair_type, scenario_pairs
+from drake_dock.docking.scenario import scenario_dict
 
 IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or sticking)
 
@@ -275,6 +276,7 @@ def summary(result, ts: dict) -> dict:
         "initial_ring_distance_m": result.initial.d0,
         "first_closing_couples": list(result.initial.closing_pairs),
         "couples": couples_table(ts, pairs),
+        "scenario": scenario_dict(s),
     }
 
 

@@ -319,6 +319,33 @@ def _validate_simulator_config(c: SimulatorConfig, duration: float):
                          f"0 (as fast as possible) or >= {MIN_REALTIME_RATE:g}")
 
 
+# Writing ---------------------------------------------------------------------------------------
+def scenario_dict(node):
+    """A scenario (or any part of it) as plain data: every field, the defaults filled in and
+    None kept (null: a tolerance left out), in the order of the dataclasses; what
+    `load_scenario` reads back to an equal scenario."""
+    fields = _schema_fields(type(node))
+    if fields is not None:
+        return {name: scenario_dict(getattr(node, name)) for name in fields}
+    if isinstance(node, (list, tuple)):
+        return [scenario_dict(x) for x in node]
+    return node
+
+
+class _Dumper(yaml.SafeDumper):
+    """Sections and fields one a line, vectors on one line ([x, y, z])."""
+
+
+_Dumper.add_representer(list, lambda d, v: d.represent_sequence("tag:yaml.org,2002:seq", v,
+                                                                flow_style=True))
+
+
+def scenario_yaml(scenario: Scenario) -> str:
+    """The full scenario as YAML (`scenario_dict`): `drake-dock run --print-scenario`."""
+    return yaml.dump(scenario_dict(scenario), Dumper=_Dumper, sort_keys=False,
+                     default_flow_style=False, width=100)
+
+
 def load_scenario(filename=None, *, data: str | None = None) -> Scenario:
     """Loads and validates a scenario from a YAML file (default: the paper's example) or a
     string. Raises `InputError` (a ValueError) naming the field for any bad value, and for an

@@ -152,3 +152,24 @@ def test_feature_words_follow_the_geometry():
         assert abs((az - centre + math.pi) % (2 * math.pi) - math.pi) <= half + 1e-9, (i, k)
     described = [p.description for p in apds_pairs(g, "complete")]
     assert len(set(described)) == len(described) and all(" / " in d for d in described)
+
+
+def test_summary_stores_the_scenario(paper):
+    """summary.json's `scenario` is the full scenario of the run: JSON is YAML, so it loads
+    back to the run's scenario."""
+    full, out = paper
+    s = json.loads((out / "summary.json").read_text())
+    assert load_scenario(data=json.dumps(s["scenario"])) == full.result.scenario
+    assert list(s)[-1] == "scenario"
+
+
+def test_outputs_doc_lists_the_summary_keys(paper):
+    """docs/outputs.md's table of summary.json names every top-level key, in the file's order."""
+    import re
+    from pathlib import Path
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "outputs.md").read_text()
+    section = doc.split("## summary.json")[1].split("\n## ")[0]
+    listed = [k for row in re.findall(r"^\| ((?:`[A-Za-z_0-9]+`(?:, )?)+) \|", section, re.M)
+              for k in re.findall(r"`([A-Za-z_0-9]+)`", row)]
+    _, out = paper
+    assert listed == list(json.loads((out / "summary.json").read_text()))
