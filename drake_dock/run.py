@@ -25,7 +25,8 @@ from drake_dock.docking.results import (momenta, momentum_reference_point, near_
                                         relative_text, run_cost, summary, timeseries)
 from drake_dock.docking.simulate import simulate
 from drake_dock.errors import NumericalError
-from drake_dock.docking.figures import initial_configuration_figure, run_figures
+from drake_dock.docking.figures import run_figures
+from drake_dock.docking.initial_figure import initial_configuration_figure
 from drake_dock.docking.output import atomic_directory, check_destination
 
 
@@ -177,14 +178,6 @@ def format_summary(s, cost=None) -> str:
                      f"{cost['simulated_s']:.4f} s simulated in {cost['wall_time_s']:.2f} s "
                      f"(more in cost.json)")
     return "\n".join(lines)
-
-
-def pair_type_lines(cost) -> list:
-    """A line per pair type tracked or sought: its seeks and their wall time, and the
-    evaluations in which a pair of it was tracked."""
-    return [f"  {t}: {c['pairs']} pairs, {c['seeks']} seeks ({c['seek_time_s']:.3g} s), "
-            f"{c['screens']} screened, tracked in {c['tracked_evaluations']} evaluations"
-            for t, c in cost.items() if c["seeks"] or c["tracked_evaluations"]]
 
 
 def time_shares_line(ts) -> str:
