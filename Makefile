@@ -6,10 +6,15 @@ OUT ?= out/paper_example
 
 .PHONY: demo test test-core bench clean notebook
 
+# The install says what it does: pip lists each package it collects and installs; then the
+# numba kernels are compiled once, so that the first run simulates at full speed.
 $(BIN)/.installed: pyproject.toml constraints.txt
+	@echo "== drake_dock: creating $(VENV) and installing Drake, numba and the other dependencies (about 2 min the first time)"
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade "pip==26.3"
-	$(BIN)/python -m pip install --quiet -c constraints.txt -e ".[test]"
+	$(BIN)/python -m pip install -c constraints.txt -e ".[test]"
+	@echo "== drake_dock: compiling the numba kernels (about 90 s, once; runs load them from the cache)"
+	$(BIN)/python -m drake_dock.core.kernels
 	touch $@
 
 demo: $(BIN)/.installed

@@ -1,22 +1,83 @@
-"""``drake-dock``: a thin command line over `drake_dock.run.run`.
+"""drake-dock simulates the capture-phase contact between two spacecraft carrying androgynous
+peripheral docking systems (APDS): a scenario in; the outcome, the loads at the docking ring,
+the energy ledger, figures and a 3D replay out.
 
-Exit codes: 0 success; 2 bad input (the message names the field, the value and the allowed
-range), found before anything is simulated, ``--out`` included; 3 numerical failure (the
-message names the time and the couples). Any other error is reported in one paragraph too
-(exit 3, "internal error"), never as a traceback. On failure no output directory is written, or
-the previous complete one is left untouched. ``--out`` must be a new path, an empty directory
-or a previous drake_dock output (`drake_dock.docking.output.check_destination`).
+outcomes of a run (the first that holds ends it):
+  captured   the latches can engage: the rings within simulation.capture_distance axially,
+             capture_lateral across and capture_tilt_deg in tilt
+  rebound    the rings separate with no couple in contact
+  jammed     the distance to capture has not fallen by 1 mm in simulation.jam_time
+  timeout    simulation.duration reached
+
+exit codes:
+  0    success: the outputs are written and `wrote DIR` is printed
+  2    bad input: the message gives the field, the value, the reason and what is allowed;
+       found before anything is simulated (--out included)
+  3    numerical failure: the message names the time and the couples
+  130  campaign stopped by Ctrl-C: the finished samples are kept; the same command runs the rest
+On failure nothing is written at --out (a previous output there is left as it was).
+
+examples:
+  drake-dock run --out out/paper_example              (the paper's example)
+  drake-dock run models/idss_box_corner.yaml --out out/box_corner
+  drake-dock study conditions --quick --out out/conditions
 """
 from __future__ import annotations
 
 import argparse
 import sys
 import textwrap
+import time
 import warnings
+from pathlib import Path
 
 from drake_dock import __version__
-from drake_dock.errors import DrakeDockError, InputError
+from drake_dock.errors import MISSING, DrakeDockError, InputError
 from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE
+
+RUN_EPILOG = """files written into DIR:
+  summary.json      the outcome and its reason, capture time, final misalignment, peak loads
+                    at the target ring, Stewart stroke and force, contact forces, relative
+                    kinetic energy at contact, energy ledger, impacts, the couples in plain words
+  cost.json         what the run cost the solver (wall time, evaluations, time shares)
+  timeseries.npz    the sampled motion, couples, forces and energies (compressed)
+  *.png             the paper's Figs. 6-9, couple forces, energy ledger, interface loads and
+                    the initial configuration
+  replay.html       a 3D replay in one page (open it in a browser)
+  drake.log         what Drake logged during the run, when it logged anything that matters
+DIR must be a new path, an empty directory or a previous drake_dock output; it is replaced
+atomically. The run prints a summary and `wrote DIR`; exit codes: 0 success, 2 bad input,
+3 numerical failure (`drake-dock --help`)."""
+
+# The studies: name -> what it does (`drake-dock study` lists them).
+STUDIES = {
+    "speed-accuracy": "drake_dock against Drake's compliant contact (point and hydroelastic, "
+                      "SAP and RK3): wall time against accuracy on the paper's example and an "
+                      "off-nominal condition",
+    "stability": "five cases where methods fail: step size, unequal stiffness, Painleve "
+                 "friction, grazing contact, Zeno bounces",
+    "conditions": "60 seeded conditions and 16 corners of the IDSS initial-contact box, each "
+                  "run to its outcome and checked for interpenetration",
+    "roll": "the coaxial approach over the whole relative-roll range, each run to its outcome",
+    "funnel": "the capture range (the largest lateral offset that captures) over the petal "
+              "tips' clearance and the post-contact thrust (default scenario: "
+              "models/apds_funnel.yaml)",
+}
+STUDY_USAGE = "drake-dock study NAME [SCENARIO.yaml] --out DIR [--quick]"
+
+
+def studies_text() -> str:
+    """The list printed by `drake-dock study` alone."""
+    width = max(map(len, STUDIES)) + 2
+    lines = [f"usage: {STUDY_USAGE}", "", "studies:"]
+    for name, what in STUDIES.items():
+        wrapped = textwrap.wrap(what, 96 - width - 2)
+        lines.append(f"  {name:<{width}}{wrapped[0]}")
+        lines += [" " * (width + 2) + w for w in wrapped[1:]]
+    lines += ["", "Each writes its files (CSV, figures, summary) into DIR and prints its summary "
+              "lines;", "--quick runs a few points only. docs/studies.md describes each "
+              "study's files."]
+    return "\n".join(lines)
 
 
 class ProgressBar:
@@ -68,37 +129,56 @@ def _error(kind, e) -> str:
                          break_on_hyphens=False)
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="drake-dock", description=__doc__.splitlines()[0])
+def _wrap(text) -> str:
+    return textwrap.fill(text, width=92)
+
+
+def _parser() -> argparse.ArgumentParser:
+    raw = argparse.RawDescriptionHelpFormatter
+    doc = __doc__.split("\n\n", 1)
+    parser = argparse.ArgumentParser(prog="drake-dock", description=doc[0],
+                                     epilog=doc[1], formatter_class=raw)
     parser.add_argument("--version", action="version", version=f"drake-dock {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True)
-    run_p = sub.add_parser("run", help="simulate a docking scenario and write its outputs")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    run_p = sub.add_parser(
+        "run", help="simulate one scenario and write its outputs", formatter_class=raw,
+        description=_wrap("Simulates a docking scenario until its outcome (captured, "
+                          "rebound, jammed or timeout; `drake-dock --help`) with a progress "
+                          "bar on stderr, prints a summary and writes the outputs into DIR."),
+        epilog=RUN_EPILOG)
     run_p.add_argument("scenario", nargs="?", default=str(PAPER_EXAMPLE),
-                       help="scenario YAML (default: the paper's example)")
-    run_p.add_argument("--out", required=True, help=OUT_HELP)
+                       help="scenario YAML; absent sections and fields take their defaults "
+                            "(docs/scenario.md; default: the paper's example)")
+    run_p.add_argument("--out", metavar="DIR", help=OUT_HELP)
     run_p.add_argument("--duration", type=float, default=None,
-                       help="override simulation.duration (s)")
+                       help="override simulation.duration, the timeout (s)")
     run_p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    study_p = sub.add_parser("study", help="run a study")
-    study_p.add_argument("which",
-                         choices=["speed-accuracy", "stability", "conditions", "roll",
-                                  "funnel"],
-                         help="speed-accuracy: drake_dock against Drake's compliant contact; "
-                              "stability: the five cases where methods fail; conditions: "
-                              "seeded conditions in the IDSS initial-contact box; roll: the "
-                              "coaxial approach over the whole relative-roll range; funnel: "
-                              "the capture range over the petal tips' clearance and the "
-                              "thrust (default scenario: models/apds_funnel.yaml)")
+    run_p.add_argument("--print-scenario", action="store_true",
+                       help="print the full scenario the run would use (every field, defaults "
+                            "filled in, --duration applied) as YAML, and exit without "
+                            "simulating")
+    study_p = sub.add_parser(
+        "study", help="run a study (`drake-dock study` lists them)", formatter_class=raw,
+        description="Runs a study and writes its files into DIR.",
+        epilog=studies_text())
+    study_p.add_argument("which", nargs="?", choices=list(STUDIES), metavar="NAME",
+                         help="the study (" + ", ".join(STUDIES) + "); absent: list them")
     study_p.add_argument("scenario", nargs="?", default=None,
                          help="scenario YAML (default: the paper's example; speed-accuracy: "
                               "the paper's example and an off-nominal condition)")
-    study_p.add_argument("--out", required=True, help=OUT_HELP)
+    study_p.add_argument("--out", metavar="DIR", help=OUT_HELP)
     study_p.add_argument("--quick", action="store_true",
                          help="a few points only (for CI)")
-    camp_p = sub.add_parser("campaign", help="run a seeded campaign of samples around a "
-                            "scenario on Dask (docs/campaigns.md)")
+    camp_p = sub.add_parser(
+        "campaign", help="run a seeded campaign of samples around a scenario on Dask",
+        formatter_class=raw,
+        description=_wrap("Runs a seeded campaign (a plan: a base scenario and the ranges of "
+                          "its varied fields) on a local Dask cluster or a running scheduler, "
+                          "one row per sample, and writes its rows, summary, figures and worst "
+                          "samples into DIR (docs/campaigns.md). Ctrl-C stops it (exit 130); "
+                          "the same command runs the rest."))
     camp_p.add_argument("plan", help="campaign plan YAML (e.g. models/idss_envelope.yaml)")
-    camp_p.add_argument("--out", required=True,
+    camp_p.add_argument("--out", required=True, metavar="DIR",
                         help="campaign directory: a new path, an empty directory, or a "
                              "campaign of the same plan, whose missing samples are run")
     camp_p.add_argument("--workers", type=int, default=None,
@@ -109,8 +189,51 @@ def main(argv=None) -> int:
     camp_p.add_argument("--resume", action="store_true",
                         help="DIR must hold a campaign of this plan; run its missing samples")
     camp_p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    args = parser.parse_args(argv)
+    return parser
+
+
+COMPILE_NOTE_AFTER = 2.0     # s of kernel preparation before the compile note is printed
+
+
+def prepare_kernels(stream=None) -> float:
+    """Compiles the numba kernels, or loads them from their cache
+    (`drake_dock.core.kernels.compile_cache`), before a run, so that the run's wall time and
+    its progress bar are the simulation's; a note on ``stream`` (stderr) says so when it takes
+    longer than COMPILE_NOTE_AFTER (a first run after an install or an update). Returns the
+    seconds it took."""
+    import threading
+    import time
+
+    from drake_dock.core.kernels.compile_cache import warm
+    stream = stream or sys.stderr
+
+    def note():
+        stream.write("drake-dock: compiling the numba kernels (after an install or an update "
+                     "only: about 90 s; later runs load them from the cache)\n")
+        stream.flush()
+    timer = threading.Timer(COMPILE_NOTE_AFTER, note)
+    timer.daemon = True
+    t0 = time.perf_counter()
+    timer.start()
+    try:
+        warm()
+    finally:
+        timer.cancel()
+    return time.perf_counter() - t0
+
+
+def _need_out(out, what):
+    if out is None:
+        raise InputError("--out", MISSING, f"give a directory for {what} (--out DIR: a new "
+                         f"path, an empty directory or a previous drake_dock output)")
+
+
+def main(argv=None) -> int:
+    args = _parser().parse_args(argv)
     if args.command == "study":
+        if args.which is None:
+            print(studies_text())
+            return 0
         return _study(args)
     if args.command == "campaign":
         return _campaign(args)
@@ -118,17 +241,32 @@ def main(argv=None) -> int:
     from drake_dock.docking.output import check_destination
     from drake_dock.run import format_summary, run
     from drake_dock.docking.scenario import load_scenario, validate
-    bar = None if args.no_progress else ProgressBar()
+    from drake_dock.docking.scenario import scenario_yaml
 
-    def work():
-        check_destination(args.out)
-        scenario = load_scenario(args.scenario)
+    def scenario():
+        s = load_scenario(args.scenario)
         if args.duration is not None:
             if not args.duration > 0:
                 raise InputError("--duration", args.duration, "> 0 s")
-            scenario.simulation.duration = args.duration
-            validate(scenario)
-        return [format_summary(run(scenario, args.out, progress=bar))]
+            s.simulation.duration = args.duration
+            validate(s)
+        return s
+    if args.print_scenario:
+        return _guarded(lambda: [scenario_yaml(scenario()).rstrip("\n")], None)
+    bar = None if args.no_progress else ProgressBar()
+
+    def work():
+        _need_out(args.out, "the run's outputs")
+        check_destination(args.out)
+        scenario_ = scenario()
+        kernels = prepare_kernels()
+        t0 = time.perf_counter()
+        out = run(scenario_, args.out, progress=bar, full=True, name=Path(args.scenario).stem)
+        outputs = time.perf_counter() - t0 - out.cost["wall_time_s"]
+        return [format_summary(out.summary, out.cost),
+                f"wall time: kernels {kernels:.1f} s (compiled after an install or an update, "
+                f"loaded from the cache after), simulation {out.cost['wall_time_s']:.1f} s, "
+                f"outputs {outputs:.1f} s"]
     return _guarded(work, args.out, None if bar is None else bar.close)
 
 
@@ -155,7 +293,8 @@ def _guarded(work, out, finish=None) -> int:
         warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     for line in lines:
         print(line)
-    print(f"wrote {out}")
+    if out is not None:
+        print(f"wrote {out}")
     return 0
 
 
@@ -200,6 +339,7 @@ def _study(args) -> int:
         from drake_dock.studies.speed_accuracy import write_study as write
 
     def work():
+        _need_out(args.out, f"the {args.which} study's files")
         check_destination(args.out)
         plan = Plan.quick() if args.quick else Plan.full()
 

@@ -7,8 +7,13 @@ class DrakeDockError(Exception):
     """Base class of every error raised on purpose by drake_dock."""
 
 
+MISSING = type("Missing", (), {"__repr__": lambda self: "missing"})()   # a value not given
+
+
 class InputError(DrakeDockError, ValueError):
-    """A bad input value: names the field, the value and the allowed range."""
+    """A bad input value: names the field and the value, then the reason (``why``, when it says
+    more than the allowed range), then the allowed range: "--out = '/home/me' is not allowed:
+    a non-empty directory that is not a drake_dock output; allowed: a new path, ..."."""
 
     def __init__(self, field: str, value, allowed: str, why: str = ""):
         self.field = field
@@ -17,9 +22,12 @@ class InputError(DrakeDockError, ValueError):
         shown = repr(value)
         if len(shown) > 200:          # a whole file read as one value, say
             shown = shown[:200] + "..."
-        msg = f"{field} = {shown} is not allowed: {allowed}"
-        if why:
-            msg += f" ({why})"
+        if value is MISSING:
+            msg = f"{field} is missing: {why + '; ' if why else ''}{allowed}"
+        elif why:
+            msg = f"{field} = {shown} is not allowed: {why}; allowed: {allowed}"
+        else:
+            msg = f"{field} = {shown} is not allowed: {allowed}"
         super().__init__(msg)
 
 

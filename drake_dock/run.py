@@ -1,6 +1,8 @@
 """Runs a docking scenario end to end and writes its outputs atomically into a directory:
-``timeseries.npz``, ``summary.json``, the figures (PNG), ``replay.html`` and ``drake.log`` (the
-lines Drake logged during the run, which are kept off the terminal).
+``summary.json`` (the numbers of the run), ``cost.json`` (what it cost the solver),
+``timeseries.npz``, the figures (PNG), ``replay.html`` and ``drake.log``: the lines Drake logged
+during the run, which are kept off the terminal, but for the replay's Meshcat start-up line
+(`QUIET`); without other lines no drake.log is written.
 
 A failed run (bad input, numerical failure) leaves no directory, or the previous complete one
 untouched (`drake_dock.docking.output.atomic_directory`). The destination is checked before anything is
@@ -19,19 +21,21 @@ import numpy as np
 
 from drake_dock.docking.replay import replay_html
 from drake_dock.docking.pairs import scenario_pairs
-from drake_dock.docking.results import (momenta, momentum_reference_point, relative_text, summary,
-                                        thrust_impulses, timeseries)
+from drake_dock.docking.results import (momenta, momentum_reference_point, near_timeseries,
+                                        relative_text, run_cost, summary, thrust_impulses,
+                                        timeseries)
 from drake_dock.docking.simulate import simulate
 from drake_dock.errors import NumericalError
-from drake_dock.docking.figures import initial_configuration_figure, run_figures
+from drake_dock.docking.figures import run_figures
+from drake_dock.docking.initial_figure import initial_configuration_figure
 from drake_dock.docking.output import atomic_directory, check_destination
 
 
 def _npz_bytes(arrays: dict) -> bytes:
-    """np.savez into memory. Zip entries carry a fixed timestamp, so equal arrays give equal
-    bytes (bitwise reproducible files)."""
+    """np.savez_compressed into memory. Zip entries carry a fixed timestamp, so equal arrays
+    give equal bytes (bitwise reproducible files)."""
     buf = io.BytesIO()
-    np.savez(buf, **arrays)
+    np.savez_compressed(buf, **arrays)
     return buf.getvalue()
 
 
@@ -48,6 +52,16 @@ def _non_finite(node, path=""):
         if bad is not None:
             return bad
     return None
+
+
+# Lines Drake logs that say nothing about the run: the address of the Meshcat server that
+# draws the replay, which is closed when the run ends.
+QUIET = ("Meshcat listening for connections",)
+
+
+def log_worth_keeping(lines) -> list:
+    """Drake's log lines but the `QUIET` ones."""
+    return [line for line in lines if not any(q in line for q in QUIET)]
 
 
 @contextlib.contextmanager
@@ -68,82 +82,105 @@ def drake_log():
         logger.propagate = saved
 
 
-def run(scenario, out_dir, *, progress=None, state=None, dd=None, full=False):
+def run(scenario, out_dir, *, progress=None, state=None, dd=None, full=False, name=None):
     """Simulates ``scenario`` and writes everything into ``out_dir``; returns the summary, or
-    with ``full`` a namespace (summary, timeseries, result: the `RunResult`, figures: the
-    `FigureRecord`s). ``dd``: a docking Diagram built by the caller (with a controller on
+    with ``full`` a namespace (summary, cost, timeseries, result: the `RunResult`, figures: the
+    `FigureRecord`s). ``name``: the scenario's name in the outputs (its file name without
+    extension, say; default "scenario"). ``dd``: a docking Diagram built by the caller (with a controller on
     ``chaser_wrench``, say; `drake_dock.docking.simulate.simulate`). Raises `InputError` for a
     destination that may not be replaced, before simulating, and `NumericalError` for a failed
     simulation or a non-finite summary value (nothing written)."""
     check_destination(out_dir)
     with drake_log() as log:
-        return _run(scenario, out_dir, progress, state, dd, full, log)
+        return _run(scenario, out_dir, progress, state, dd, full, log, name or "scenario")
 
 
-def _run(scenario, out_dir, progress, state, dd, full, log):
+def _run(scenario, out_dir, progress, state, dd, full, log, name):
     result = simulate(scenario, progress=progress, state=state, dd=dd)
     if hasattr(progress, "note"):
         progress.note(f"{result.outcome} at t = {result.end_time:.4f} s; writing the outputs "
                       f"(arrays, figures, replay)")
     ts = timeseries(result)
-    summ = summary(result, ts)
+    summ = {"scenario_name": name, **summary(result, ts)}
+    cost = run_cost(result, ts)
     bad = _non_finite(summ)
     if bad is not None:
         raise NumericalError(f"the run's summary value {bad} is not finite (an overflow of "
                              f"extreme inputs)", time=result.end_time)
     params = [getattr(scenario.bodies, n) for n in ts["body_names"]]
     about = momentum_reference_point(scenario, ts)
-    P, L, _, _ = momenta(ts, [p.mass for p in params], [p.inertia for p in params], about)
+    P, L, sP, sL = momenta(ts, [p.mass for p in params], [p.inertia for p in params], about)
     J, H = thrust_impulses(result, ts, about)       # conserved: momentum less the impulse
-    P, L = P - J, L - H
+    momentum = (P - J, L - H, sP, sL)
     nq = result.dd.dp.plant.num_positions()
-    html = replay_html(scenario, ts["t"], np.asarray(result.record.x)[:, :nq], ts=ts)
+    html = replay_html(scenario, ts["t"], np.asarray(result.record.x)[:, :nq], ts=ts, title=name)
     with atomic_directory(out_dir) as tmp:
-        (tmp / "timeseries.npz").write_bytes(_npz_bytes(ts))
-        records = run_figures(ts, summ, (P, L), tmp, focus_couples=result.initial.closing_pairs,
-                              pairs=scenario_pairs(scenario))
+        (tmp / "timeseries.npz").write_bytes(_npz_bytes(near_timeseries(ts)))
+        records = run_figures(ts, summ, momentum, tmp, pairs=scenario_pairs(scenario))
         poses = {n: (ts["R_WA"][0, j], ts["p_WA"][0, j])
                  for j, n in enumerate(ts["apds_names"].tolist())}
         cn = ts["couple_names"].tolist()
         first = {c: SimpleNamespace(p1=ts["p1_W"][0, cn.index(c)], p2=ts["p2_W"][0, cn.index(c)])
                  for c in result.initial.closing_pairs}
         records.append(initial_configuration_figure(scenario.geometry, poses, first, tmp))
-        summ["figures"] = [r.name for r in records]
+        summ = {**{k: v for k, v in summ.items() if k != "scenario"},
+                "figures": [r.name for r in records], "scenario": summ["scenario"]}
         (tmp / "replay.html").write_text(html)
         (tmp / "summary.json").write_text(json.dumps(summ, indent=2, allow_nan=False) + "\n")
-        (tmp / "drake.log").write_text("".join(line + "\n" for line in log))
+        (tmp / "cost.json").write_text(json.dumps(cost, indent=2) + "\n")
+        kept = log_worth_keeping(log)
+        if kept:
+            (tmp / "drake.log").write_text("".join(line + "\n" for line in kept))
     if full:
-        return SimpleNamespace(summary=summ, timeseries=ts, result=result, figures=records)
+        return SimpleNamespace(summary=summ, cost=cost, timeseries=ts, result=result,
+                               figures=records)
     return summ
 
 
-def format_summary(s) -> str:
+def _at(peak: dict) -> str:
+    return "" if peak["time_s"] is None else f" at {peak['time_s']:.3f} s"
+
+
+def format_summary(s, cost=None) -> str:
+    """The printed summary of a run: outcome, misalignment, loads, energy, conservation and
+    (with ``cost``) the simulation's wall time."""
     fm = s["final_misalignment"]
     led = s["energy_ledger"]
     md = s["momentum_drift_relative"]
-    return "\n".join([
-        f"{s['outcome']} at t = {s['end_time_s']:.6f} s ({s['outcome_reason']}); final "
-        f"misalignment: axial {fm['axial_m']:.4g} m, lateral {fm['lateral_m']:.3g} m, tilt "
-        f"{fm['tilt_deg']:.3g} deg",
-        f"impacts: {s['number_of_impacts']}; peak contact force {s['peak_contact_force_N']:.6g} N;"
-        f" largest impulse {s['largest_impulse_Ns']:.6g} N s",
-        f"momentum drift (relative): linear {relative_text(md['linear'])}, angular "
-        f"{relative_text(md['angular'])}",
-        f"energy: initial {led['initial_total_J']:.6g} J; dissipated by the damper "
-        f"{led['dissipated_damper_J']:.6g} J, friction {led['dissipated_friction_J']:.6g} J, "
-        f"impacts {led['dissipated_impacts_J']:.6g} J; ledger closure "
+    lo = s["loads"]
+    fi, mi = lo["interface_force_N"], lo["interface_moment_Nm"]
+    st, sf = lo["stewart_stroke_m"], lo["stewart_force_N"]
+    pc = lo["couple_normal_force_N"]
+    rel = s["relative_kinetic_energy_at_contact_J"]
+    lines = [
+        f"{s['outcome']} at t = {s['end_time_s']:.6f} s ({s['outcome_reason']})",
+        f"final misalignment: axial {1e3 * fm['axial_m']:.4g} mm, lateral "
+        f"{1e3 * fm['lateral_m']:.3g} mm, tilt {fm['tilt_deg']:.3g} deg",
+        f"interface loads at the target ring: force {fi['peak']:.4g} N{_at(fi)} (axial "
+        f"{fi['axial_peak']:.4g} N, lateral {fi['lateral_peak']:.4g} N), moment "
+        f"{mi['peak']:.4g} N m{_at(mi)}",
+        f"Stewart element: stroke {1e3 * st['peak']:.4g} mm{_at(st)}, force "
+        f"{sf['peak']:.4g} N{_at(sf)}",
+        f"contact: peak total force {lo['total_contact_force_N']['peak']:.4g} N; peak "
+        f"couple normal force {pc['peak']:.4g} N"
+        + (f" ({pc['couple']}: {s['couples'][pc['couple']]['description']})" if pc["couple"]
+           else "")
+        + f"; {s['number_of_impacts']} impacts, largest impulse "
+        f"{s['largest_impulse_Ns']:.4g} N s",
+        f"energy: relative kinetic energy at contact "
+        + ("none (no contact)" if rel is None else f"{rel:.4g} J")
+        + f" (centre-of-mass frame); in the inertial frame: initial {led['initial_total_J']:.4g}"
+        f" J, dissipated by the damper {led['dissipated_damper_J']:.4g} J, friction "
+        f"{led['dissipated_friction_J']:.4g} J, impacts {led['dissipated_impacts_J']:.4g} J,"
+        f" input work {led['input_work_J']:.4g} J; ledger closure "
         f"{relative_text(led['closure_error_relative'])}",
-        f"wall time {s['wall_time_s']:.2f} s for {s['end_time_s']:.4f} s simulated "
-        f"({s['derivative_evaluations']} derivative evaluations)",
-        time_shares_line(s["time_shares"]), *pair_type_lines(s["cost_by_pair_type"])])
-
-
-def pair_type_lines(cost) -> list:
-    """A line per pair type tracked or sought: its seeks and their wall time, and the
-    evaluations in which a pair of it was tracked."""
-    return [f"  {t}: {c['pairs']} pairs, {c['seeks']} seeks ({c['seek_time_s']:.3g} s), "
-            f"{c['screens']} screened, tracked in {c['tracked_evaluations']} evaluations"
-            for t, c in cost.items() if c["seeks"] or c["tracked_evaluations"]]
+        f"momentum drift (relative): linear {relative_text(md['linear'])}, angular "
+        f"{relative_text(md['angular'])}"]
+    if cost is not None:
+        lines.append(f"solver: {cost['derivative_evaluations']} derivative evaluations for "
+                     f"{cost['simulated_s']:.4f} s simulated in {cost['wall_time_s']:.2f} s "
+                     f"(more in cost.json)")
+    return "\n".join(lines)
 
 
 def time_shares_line(ts) -> str:

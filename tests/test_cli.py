@@ -1,6 +1,7 @@
 """Smoke tests of the command line, as a user runs it."""
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -17,10 +18,22 @@ def _run(args, **kw):
 
 
 def test_short_run_writes_outputs(tmp_path):
-    """A short run (before the first impact ends): every file is written, nothing else left."""
+    """A short run (before the first impact ends): every file is written, nothing else left;
+    each file written is named in `drake-dock run --help`."""
     out = tmp_path / "paper"
     r = _run(["run", "--out", str(out), "--duration", "0.005"])
     assert r.returncode == 0, r.stderr
+    # The printed wall time separates the kernels, the simulation (cost.json's) and the outputs.
+    kernels, simulation, outputs = map(float, re.search(
+        r"wall time: kernels ([0-9.]+) s .*, simulation ([0-9.]+) s, outputs ([0-9.]+) s",
+        r.stdout).groups())
+    cost = json.loads((out / "cost.json").read_text())
+    assert simulation == pytest.approx(cost["wall_time_s"], abs=0.051)
+    assert kernels >= 0 and outputs > 0
+    helped = _run(["run", "--help"]).stdout
+    for p in out.iterdir():
+        if p.name != MARKER:
+            assert (p.name if p.suffix != ".png" else "*.png") in helped, p.name
     summary = json.loads((out / "summary.json").read_text())
     assert summary["initial_ring_distance_m"] > summary["first_contact_ring_distance_m"]
     assert summary["captured"] is False and summary["end_time_s"] == 0.005
@@ -95,3 +108,71 @@ def test_binary_scenario_file_exit_2(tmp_path):
     assert r.returncode == 2, r.stderr
     assert "scenario file" in r.stderr and "UTF-8" in r.stderr and "Traceback" not in r.stderr
     assert not out.exists()
+
+
+def test_help_is_written_for_users():
+    """The top-level help says what each command does, the outcomes and the exit codes, in the
+    words the rest of the tool uses (the outcomes of `drake_dock.docking.outcome`)."""
+    from drake_dock.docking.outcome import OUTCOMES
+    r = _run(["--help"])
+    assert r.returncode == 0
+    text = r.stdout
+    assert "thin command line" not in text and "``" not in text
+    for command in ("run", "study", "campaign"):
+        assert f"\n    {command} " in text, command
+    for outcome in OUTCOMES:
+        assert f"\n  {outcome} " in text, outcome
+    for code in ("0", "2", "3", "130"):
+        assert f"\n  {code} " in text, code
+
+
+def test_study_alone_lists_the_studies():
+    """`drake-dock study` alone lists the studies and exits 0; each listed name is accepted by
+    `drake-dock study NAME` (which then asks for --out, exit 2, not argparse's choice error)."""
+    r = _run(["study"])
+    assert r.returncode == 0, r.stderr
+    listed = [line.split()[0] for line in r.stdout.split("studies:")[1].splitlines()
+              if line.startswith("  ") and not line.startswith("    ")]
+    assert listed == ["speed-accuracy", "stability", "conditions", "roll"]
+    for name in listed:
+        r = _run(["study", name])
+        assert r.returncode == 2 and r.stderr.startswith("drake-dock: bad input: --out is "
+                                                         "missing"), r.stderr
+
+
+def test_input_errors_lead_with_their_reason(tmp_path):
+    """The reason of a refusal comes right after the value, before the rules of what is
+    allowed; an empty scenario file says so."""
+    user = tmp_path / "results"
+    user.mkdir()
+    (user / "notes.txt").write_text("mine")
+    r = _run(["run", "--out", str(user), "--no-progress"])
+    msg = " ".join(r.stderr.split())
+    assert r.returncode == 2
+    after = msg.index(f"{user}'") + len(str(user))
+    assert msg.index("not a drake_dock output") < after + 60 < msg.index("; allowed:")
+    empty = tmp_path / "empty.yaml"
+    empty.write_text("# nothing yet\n")
+    r = _run(["run", str(empty), "--out", str(tmp_path / "out"), "--no-progress"])
+    msg = " ".join(r.stderr.split())
+    assert r.returncode == 2 and "holds no YAML content (empty, or only comments)" in msg
+    assert "NoneType" not in msg and not (tmp_path / "out").exists()
+
+
+def test_kernels_prepared_with_a_note_when_it_takes_long(monkeypatch):
+    """The kernels are compiled (or loaded) before the run; when that takes long (a first run
+    after an install) a note says so while it happens, and not otherwise."""
+    import io
+    import time
+
+    from drake_dock import cli
+    monkeypatch.setattr(cli, "COMPILE_NOTE_AFTER", 0.05)
+    monkeypatch.setattr("drake_dock.core.kernels.compile_cache.warm", lambda: time.sleep(0.5))
+    slow = io.StringIO()
+    assert cli.prepare_kernels(slow) >= 0.5
+    assert "compiling the numba kernels" in slow.getvalue()
+    monkeypatch.setattr("drake_dock.core.kernels.compile_cache.warm", lambda: None)
+    fast = io.StringIO()
+    assert cli.prepare_kernels(fast) < 0.05
+    time.sleep(0.1)                   # past the note's delay: it was cancelled
+    assert fast.getvalue() == ""

@@ -1,12 +1,17 @@
 """The tutorial notebook runs top to bottom (executed with nbclient, as a user's kernel) and
-shows what it promises: the paper's example captured, an inconsistent scenario edit refused,
-the controlled run's input work in its energy ledger, the timeseries read back from disk, the
-interface loads figure and the inline replay with its time readout."""
+shows what it promises: the off-axis approach stated, its outcome and loads read from
+summary.json and equal to the peaks recomputed from timeseries.npz, the couples in plain
+words, the plots, the thrust cell (off until scenarios have a thrust section), a campaign of six
+samples with a row each and the counts of its summary, and the inline replay with its time
+readout."""
+import collections
 import re
 from pathlib import Path
 
 import nbformat
 from nbclient import NotebookClient
+
+from drake_dock.docking.outcome import OUTCOMES
 
 NB = Path(__file__).resolve().parent.parent / "notebooks" / "tutorial.ipynb"
 
@@ -17,17 +22,32 @@ def test_tutorial_notebook_executes(tmp_path):
                    resources={"metadata": {"path": str(tmp_path)}}).execute()
     outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])]
     assert not [o for o in outputs if o.get("output_type") == "error"]
-    text = "".join(o.get("text", "") for o in outputs if o.get("output_type") == "stream")
-    assert "captured: True" in text
-    assert "refused: contact.mu_s" in text
-    # The thrust does work on the chaser, and the ledger still closes.
-    work, closure = re.search(r"controlled: captured at t = \S+ s; input work (\S+) J; "
-                              r"closure (\S+)", text).groups()
-    assert float(work) > 1.0 and float(closure) < 1e-6
-    assert "interface_loads.png" in text and "drake.log" in text
-    assert re.search(r"cc_T\d_C\d: peak lambda_n +\d", text)
+    text = "".join(o.get("text", "") for o in outputs
+                   if o.get("output_type") == "stream" and o.get("name") == "stdout")
+    errors = "".join(o.get("text", "") for o in outputs
+                     if o.get("output_type") == "stream" and o.get("name") == "stderr")
+    assert "INFO" not in errors and "Warning" not in errors, errors
+    # The approach stated, its outcome read.
+    assert "lateral_offset: [0.1, 0.0]" in text and "tilt_deg: [0.0, 4.0]" in text
+    assert re.search(r"^outcome: (\w+) \(", text, re.M).group(1) in OUTCOMES
+    # The summary's peaks are those of the time series.
+    force, at = re.search(r"peak force at the target ring: (\S+) N at (\S+) s", text).groups()
+    stroke = re.search(r"peak Stewart stroke: (\S+) mm", text).group(1)
+    assert re.search(rf"from the time series: peak force {re.escape(force)} N at "
+                     rf"{re.escape(at)} s, peak stroke {re.escape(stroke)} mm", text)
+    assert float(force) > 10.0
+    assert re.search(r"cc_Cring_Ttip3 +chaser ring inside circle / target petal 3 tip arc +"
+                     r"peak +\d", text)
+    assert re.search(r"^thrust: ", text, re.M)
+    # The campaign: six rows, counted as its summary counts them.
+    n, counts = re.search(r"^(\d+) samples: (.*)$", text, re.M).groups()
+    rows = re.findall(r"^ +\d\.\d{3} +\d+\.\d{2} +(\w+) ", text, re.M)
+    assert int(n) == len(rows) == 6
+    said = dict((k, int(v)) for k, v in (c.split() for c in counts.split(", ")))
+    assert said == dict(collections.Counter(rows))
     images = [o for o in outputs if "image/png" in o.get("data", {})]
-    assert len(images) >= 2
+    assert len(images) >= 3
     html = [o for o in outputs if "text/html" in o.get("data", {})]
-    assert html and "iframe" in html[-1]["data"]["text/html"]
-    assert "time-readout" in html[-1]["data"]["text/html"]
+    page = html[-1]["data"]["text/html"]
+    assert "iframe" in page and "time-readout" in page
+    assert "idss_box_corner: drake_dock replay" in page

@@ -93,7 +93,7 @@ def measure(result) -> dict:
     fm = s["final_misalignment"]
     row = {"outcome": s["outcome"], "reason": s["outcome_reason"],
            "capture_time": s["capture_time_s"], "end_time": s["end_time_s"],
-           "peak_contact_force": s["peak_contact_force_N"], "peak_stewart_stroke": stroke,
+           "peak_contact_force": s["loads"]["couple_normal_force_N"]["peak"], "peak_stewart_stroke": stroke,
            "peak_stewart_force": force, "final_axial": fm["axial_m"],
            "final_lateral": fm["lateral_m"], "final_tilt_deg": fm["tilt_deg"],
            "impacts": s["number_of_impacts"],

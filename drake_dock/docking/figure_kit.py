@@ -40,6 +40,7 @@ class AxesRecord:
     series: list
     notes: list
     legend_boxes: list    # pixel boxes of legends drawn inside this axes' box (none expected)
+    limits: dict = dataclasses.field(default_factory=dict)   # {"x": (lo, hi, scale), "y": ...}
 
 
 @dataclasses.dataclass
@@ -52,6 +53,30 @@ def negligible(y, scale) -> bool:
     """True when ``y`` is below `ROUND_OFF` of ``scale`` (exact zeros included)."""
     return float(np.max(np.abs(y), initial=0.0)) <= ROUND_OFF * float(scale)
 
+
+def largest(curves: dict) -> float:
+    """The largest magnitude among the curves (label -> values)."""
+    return max((float(np.max(np.abs(y), initial=0.0)) for y in curves.values()), default=0.0)
+
+
+def with_data(panels: list, scale=None) -> list:
+    """The panels [(curves, ...)] that have a curve above round-off (`negligible`) relative to
+    ``scale`` (default: each panel's own largest magnitude, so that only all-zero panels go);
+    a figure draws these only, and names the others in a note."""
+    return [p for p in panels
+            if any(not negligible(y, largest(p[0]) if scale is None else scale)
+                   for y in p[0].values()) and largest(p[0]) > 0]
+
+
+def decades(lo: float, hi: float, scale: str) -> float:
+    """How many decades an axis spans: log10(hi / lo) on a log axis; on a linear one, the
+    decades between its largest value and its span (12 means a span of 1e-12 of the values
+    shown: round-off drawn as data, matplotlib's offset notation)."""
+    lo, hi = sorted((float(lo), float(hi)))
+    if scale == "log":
+        return float(np.log10(hi / lo))
+    top = max(abs(lo), abs(hi))
+    return float(np.log10(top / (hi - lo))) if top > 0 and hi > lo else 0.0
 
 class Sheet:
     """One figure being drawn; ``series`` per axes in drawing order."""
@@ -114,7 +139,8 @@ class Sheet:
         axes, whose boxes the record keeps when they overlap the axes (they should not)."""
         fig = self.fig
         fig.tight_layout()
-        fig.canvas.draw()
+        # Saved at the figure's own dpi: the boxes below are those of the file's drawing.
+        fig.savefig(Path(out_dir) / name, dpi=DPI)
         height = fig.bbox.height
         records = []
         for ax in fig.axes:
@@ -124,9 +150,10 @@ class Sheet:
             overlaps = [_pixels(lg.get_window_extent(), height) for a, lg in legends
                         if a is ax and lg is not None
                         and _overlap(_pixels(lg.get_window_extent(), height), box)]
+            limits = {"x": (*ax.get_xlim(), ax.get_xscale()),
+                      "y": (*ax.get_ylim(), ax.get_yscale())}
             records.append(AxesRecord(box, self.drawn.get(ax, []), self.notes.get(ax, []),
-                                      overlaps))
-        fig.savefig(Path(out_dir) / name, dpi=DPI)
+                                      overlaps, limits))
         plt.close(fig)
         return FigureRecord(name, records)
 

@@ -36,3 +36,53 @@ def interface_loads(ts: dict, pairs) -> dict:
     F_W = f.sum(1)
     M_W = np.cross(point - c[:, None, :], f).sum(1)
     return {"F_A": np.einsum("nji,nj->ni", R, F_W), "M_A": np.einsum("nji,nj->ni", R, M_W)}
+
+
+def _peak(t, values) -> dict:
+    """{"peak": the largest of ``values`` (0 for none), "time_s": its first sample's time (None
+    when the peak is 0)}."""
+    values = np.asarray(values, float)
+    if not values.size or not values.max() > 0:
+        return {"peak": 0.0, "time_s": None}
+    k = int(np.argmax(values))
+    return {"peak": float(values[k]), "time_s": float(t[k])}
+
+
+def couple_force_magnitudes(ts: dict) -> np.ndarray:
+    """|f|[N, n_couples]: each couple's contact force (normal and friction), N."""
+    return np.linalg.norm(couple_forces_W(ts), axis=-1)
+
+
+def peak_loads(ts: dict, pairs) -> dict:
+    """The peaks a docking engineer reads, each with the time of its first sample: the contact
+    force and moment at the target's ring (magnitude; axial and lateral force; bending moment and
+    torque about the docking axis; `interface_loads`), the Stewart element's stroke
+    (translation, rotation) and force, the total contact force (the sum of the magnitudes of
+    the couples' forces, normal and friction) and the largest normal force of one couple.
+    Impulses are not forces: they are in the impacts."""
+    t = ts["t"]
+    loads = interface_loads(ts, pairs)
+    F, M = loads["F_A"], loads["M_A"]
+    lam = ts["lambda_n"]
+    couple = _peak(t, lam.max(1, initial=0.0))
+    names = ts["couple_names"].tolist()
+    if couple["time_s"] is not None:
+        k = int(np.argmax(lam.max(1)))
+        couple["couple"] = names[int(np.argmax(lam[k]))]
+    else:
+        couple["couple"] = None
+    return {
+        "interface_force_N": {**_peak(t, np.linalg.norm(F, axis=1)),
+                              "axial_peak": _peak(t, np.abs(F[:, 2]))["peak"],
+                              "lateral_peak": _peak(t, np.hypot(F[:, 0], F[:, 1]))["peak"]},
+        "interface_moment_Nm": {**_peak(t, np.linalg.norm(M, axis=1)),
+                                "bending_peak": _peak(t, np.hypot(M[:, 0], M[:, 1]))["peak"],
+                                "torque_about_axis_peak": _peak(t, np.abs(M[:, 2]))["peak"]},
+        "stewart_stroke_m": {**_peak(t, np.linalg.norm(ts["stewart_x"], axis=1)),
+                             "axial_peak": _peak(t, np.abs(ts["stewart_x"][:, 2]))["peak"],
+                             "rotation_peak_deg": float(np.degrees(_peak(
+                                 t, np.linalg.norm(ts["stewart_rpy"], axis=1))["peak"]))},
+        "stewart_force_N": _peak(t, np.linalg.norm(ts["stewart_force_W"], axis=1)),
+        "total_contact_force_N": _peak(t, couple_force_magnitudes(ts).sum(1)),
+        "couple_normal_force_N": couple,
+    }

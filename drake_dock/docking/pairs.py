@@ -39,6 +39,37 @@ class PairSpec:
     # +1 for a ring's outside circle against the other ring's face, which is solid on one side
     # only. None: taken from the side the patches are on when the pair becomes potential.
     sigma: float | None = None
+    description: str = ""   # in plain words (`describe_pair`), set by `apds_pairs`
+
+
+APDS_WORDS = {TARGET_APDS: "target", CHASER_APDS: "chaser"}
+
+
+def feature_words(P, patch) -> str:
+    """The feature of the APDS patches ``P`` (`apds.apds_patches`) that ``patch`` is, in plain
+    words: "ring inside circle", "petal 3 tip arc", "guide side 5 (petal 3)", ... Petal k
+    carries guide surface k, guide sides 2k - 1 and 2k and tip arc k; corner i is where guide
+    side i meets its tip arc."""
+    named = {id(P.ring): "ring inside circle", id(P.rim): "ring outside circle",
+             id(P.face): "ring face"}
+    for i, side in P.sides.items():
+        named[id(side)] = f"guide side {i} (petal {(i + 1) // 2})"
+    for k in P.surfaces:
+        named[id(P.surfaces[k])] = f"petal {k} guide surface"
+        named[id(P.tips[k])] = f"petal {k} tip arc"
+    for k, land in P.lands.items():
+        named[id(land)] = f"petal {k} tip land"
+    for corners in (P.corners, P.corner_points):
+        for i, c in corners.items():
+            named[id(c)] = f"petal {(i + 1) // 2} corner at guide side {i}"
+    return named[id(patch)]
+
+
+def describe_pair(P, pair: PairSpec) -> str:
+    """A pair in plain words from its bodies and patches: "chaser ring inside circle / target
+    petal 3 tip arc" (body 1's feature first)."""
+    return (f"{APDS_WORDS[pair.body1]} {feature_words(P, pair.patch1)} / "
+            f"{APDS_WORDS[pair.body2]} {feature_words(P, pair.patch2)}")
 
 
 def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
@@ -53,7 +84,8 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     they reach (C-C, `side_edge_pairs`), the tip arcs vs the other APDS's tip arcs they reach
     (C-C, `tip_tip_pairs`), the petal corners vs the other APDS's guide surfaces
     they reach (point-surface, `corner_surface_pairs`), and the two rings' outside circles (C-C,
-    cc_Crim_Trim, Body 1 the chaser's)."""
+    cc_Crim_Trim, Body 1 the chaser's). Each pair carries its ``description`` in plain words
+    (`describe_pair`)."""
     if which not in PAIR_SETS:
         raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)
@@ -80,7 +112,7 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         if g.Rp <= g.Rs:
             pairs += rim_petal_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
             pairs += rim_petal_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
-    return pairs
+    return [dataclasses.replace(p, description=describe_pair(P, p)) for p in pairs]
 
 
 def scenario_pairs(scenario) -> list[PairSpec]:

@@ -3,8 +3,11 @@
 The replay is drawn after the simulation from the recorded samples (so a visualiser's publish
 events never cut the simulation's steps): a display-only Diagram (plant, SceneGraph,
 MeshcatVisualizer) is posed at frame times spaced 1/fps apart in animation time, positions
-interpolated linearly between samples (quaternions renormalised). Animation time is simulation
-time times ``slow_motion``: the capture phase lasts a fraction of a second.
+interpolated linearly between samples (quaternions renormalised): one frame per display frame,
+whatever the samples. Animation time is simulation time times ``slow_motion``, by default the
+smallest of 1, 2, 5, 10, 20, 50, ... that makes the run last at least `MIN_SCREEN_SECONDS` on
+screen (`playback_slowdown`): the capture phase of the paper's example lasts 0.15 s. The page is
+titled after the scenario.
 
 The camera looks at the two APDS from the side, from outside the spacecraft hulls with a narrow
 field of view, so that the rings fill the view; the hulls are drawn translucent. Given the
@@ -12,6 +15,9 @@ run's timeseries, the contact points, force arrows, impact flashes and the time 
 `drake_dock.docking.replay_marks` are added.
 """
 from __future__ import annotations
+
+import html
+import math
 
 import numpy as np
 from pydrake.geometry import Meshcat, MeshcatParams, MeshcatVisualizer
@@ -24,6 +30,20 @@ from drake_dock.docking.pairs import scenario_pairs
 CAMERA_DISTANCE = 2.8     # m from the rings' midpoint, outside the hulls (radius 1.2 m)
 CAMERA_FOV = 26.0         # deg, vertical
 HULL_OPACITY = 0.3
+FPS = 30.0                # display frames per second of animation time
+MIN_SCREEN_SECONDS = 10.0
+
+
+def playback_slowdown(duration: float, least: float = MIN_SCREEN_SECONDS) -> float:
+    """The smallest of 1, 2, 5, 10, 20, 50, ... with ``duration`` times it at least ``least``
+    seconds (a run of 0.155 s plays at 1/100 speed, one of 5.2 s at 1/2)."""
+    if duration <= 0:
+        return 1.0
+    decade = 10.0 ** max(0, math.floor(math.log10(max(least / duration, 1.0))))
+    for step in (1.0, 2.0, 5.0, 10.0):
+        if duration * decade * step >= least:
+            return decade * step
+    return 10.0 * decade
 
 
 def make_meshcat() -> Meshcat:
@@ -75,9 +95,12 @@ def _frame_camera(meshcat, dp, q0, radius):
                             HULL_OPACITY)
 
 
-def replay_html(scenario, t, Q, *, fps=30.0, slow_motion=10.0, meshcat=None, ts=None) -> str:
+def replay_html(scenario, t, Q, *, fps=FPS, slow_motion=None, meshcat=None, ts=None,
+                title="scenario") -> str:
     """The HTML page replaying positions Q[N, nq] (the plant's layout) sampled at t[N]; with
-    the run's timeseries ``ts`` (same samples), the contact marks and the time readout."""
+    the run's timeseries ``ts`` (same samples), the contact marks and the time readout.
+    ``slow_motion``: animation seconds per simulated second (default `playback_slowdown`);
+    ``title``: the scenario's name, the page's title."""
     meshcat = meshcat or make_meshcat()
     builder = DiagramBuilder()
     dp = add_docking_plant(builder, scenario)
@@ -88,6 +111,8 @@ def replay_html(scenario, t, Q, *, fps=30.0, slow_motion=10.0, meshcat=None, ts=
     quats = [dp.plant.get_joint(j).position_start() for j in dp.plant.GetJointIndices()
              if dp.plant.get_joint(j).num_positions() == 7]
     t = np.asarray(t, float)
+    if slow_motion is None:
+        slow_motion = playback_slowdown(float(t[-1] - t[0]))
     n = int(np.floor((t[-1] - t[0]) * slow_motion * fps)) + 1
     t_anim = np.arange(n) / fps
     t_frame = t[0] + t_anim / slow_motion
@@ -106,5 +131,7 @@ def replay_html(scenario, t, Q, *, fps=30.0, slow_motion=10.0, meshcat=None, ts=
     meshcat.StopRecording()
     meshcat.PublishRecording()
     page = meshcat.StaticHtml()
+    page = page.replace("<title>Drake MeshCat</title>",
+                        f"<title>{html.escape(title)}: drake_dock replay</title>", 1)
     at = page.rfind("</body>")
     return page[:at] + overlay + page[at:] if at >= 0 else page + overlay

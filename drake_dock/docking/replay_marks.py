@@ -3,8 +3,11 @@ the contact force on the chaser APDS (length proportional to the force, `ARROW_M
 run's peak), a flash at the couples of each impact, and a readout of the simulation time and
 of the contact state (an HTML overlay that follows the animation's clock).
 
-The marks are animated in the meshcat recording (visibility, pose and scale per frame), frame
-k showing the state at simulation time t0 + k / (fps slow_motion).
+The marks are animated in the meshcat recording, frame k showing the state at simulation time
+t0 + k / (fps slow_motion). Only the couples in contact at some frame, or flashed by an impact,
+get marks; a visibility is written when it changes, a pose or scale only while visible (the
+recording stays small: a few megabytes for a run of seconds). The readout holds the last
+frame's time when the animation has ended.
 """
 from __future__ import annotations
 
@@ -60,7 +63,10 @@ def add_marks(meshcat, ts, pairs, t_frame, fps, slow_motion):
     peak = float(mag.max(initial=0.0)) or 1.0
     points = ts["p1_W"][k_of]       # the couple's point on body 1 (= on body 2 in contact)
     flash = _flash_frames(ts, t_frame, fps, slow_motion)
-    for j, c in enumerate(names):
+    touching = status >= IN_CONTACT
+    pushing = touching & (mag > 0.0)
+    for j in np.flatnonzero(touching.any(0) | flash.any(0)):
+        c = names[j]
         base = f"{ROOT}/{c}"
         meshcat.SetObject(f"{base}/point", Sphere(0.012), POINT_RGBA)
         meshcat.SetObject(f"{base}/arrow/shaft", Cylinder(0.006, 0.8), ARROW_RGBA)
@@ -69,22 +75,20 @@ def add_marks(meshcat, ts, pairs, t_frame, fps, slow_motion):
         meshcat.SetTransform(f"{base}/arrow/head",
                              RigidTransform(RollPitchYaw(np.pi, 0, 0), [0, 0, 1.0]))
         meshcat.SetObject(f"{base}/flash", Sphere(0.05), FLASH_RGBA)
-        for k in range(len(t_frame)):
-            touching = bool(status[k, j] >= IN_CONTACT)
-            pushing = touching and mag[k, j] > 0.0
-            anim.SetProperty(k, f"{base}/point", "visible", touching)
-            anim.SetTransform(k, f"{base}/point", RigidTransform(points[k, j]))
-            anim.SetProperty(k, f"{base}/flash", "visible", bool(flash[k, j]))
-            anim.SetTransform(k, f"{base}/flash", RigidTransform(points[k, j]))
-            anim.SetProperty(k, f"{base}/arrow", "visible", pushing)
-            if pushing:
+        for name, shown in (("point", touching[:, j]), ("flash", flash[:, j]),
+                            ("arrow", pushing[:, j])):
+            path = f"{base}/{name}"
+            for k in range(len(t_frame)):
+                if k == 0 or shown[k] != shown[k - 1]:
+                    anim.SetProperty(k, path, "visible", bool(shown[k]))
+                if not shown[k]:
+                    continue
+                if name != "arrow":
+                    anim.SetTransform(k, path, RigidTransform(points[k, j]))
+                    continue
                 length = ARROW_MIN + (ARROW_MAX - ARROW_MIN) * mag[k, j] / peak
-                anim.SetTransform(k, f"{base}/arrow",
-                                  RigidTransform(_along(f[k, j]), points[k, j]))
-                anim.SetProperty(k, f"{base}/arrow", "scale", [1.0, 1.0, float(length)])
-            else:
-                anim.SetTransform(k, f"{base}/arrow", RigidTransform(points[k, j]))
-                anim.SetProperty(k, f"{base}/arrow", "scale", [1.0, 1.0, ARROW_MIN])
+                anim.SetTransform(k, path, RigidTransform(_along(f[k, j]), points[k, j]))
+                anim.SetProperty(k, path, "scale", [1.0, 1.0, float(length)])
     return _readout_lines(ts, status, mag, flash, names)
 
 
@@ -97,6 +101,14 @@ def _flash_frames(ts, t_frame, fps, slow_motion):
         on = (t_frame >= tm - 0.5 / (fps * slow_motion)) & (t_frame < tm + window)
         flash[np.ix_(on, who)] = True
     return flash
+
+
+def marked_couples(ts, t_frame, fps, slow_motion) -> list:
+    """The couples that get marks: in contact at some frame or flashed by an impact."""
+    status = ts["status"][frame_samples(ts["t"], t_frame)]
+    flash = _flash_frames(ts, t_frame, fps, slow_motion)
+    names = ts["couple_names"].tolist()
+    return [names[j] for j in np.flatnonzero((status >= IN_CONTACT).any(0) | flash.any(0))]
 
 
 def _readout_lines(ts, status, mag, flash, names):
@@ -118,9 +130,9 @@ def overlay_html(t0, fps, slow_motion, lines) -> str:
     on screen (from the animation actions' clock) and the contact state of that frame."""
     data = json.dumps({"t0": t0, "fps": fps, "slow": slow_motion, "lines": lines})
     return f"""
-<div id="time-readout" style="position:fixed; left:12px; bottom:12px; z-index:10;
-  font:14px monospace; background:rgba(255,255,255,0.85); padding:6px 10px;
-  border-radius:4px; color:#111">t = -</div>
+<div id="time-readout" data-slow="{slow_motion:g}" style="position:fixed; left:12px;
+  bottom:12px; z-index:10; font:14px monospace; background:rgba(255,255,255,0.85);
+  padding:6px 10px; border-radius:4px; color:#111">t = -</div>
 <script>
 (function() {{
   const R = {data};
@@ -129,9 +141,13 @@ def overlay_html(t0, fps, slow_motion, lines) -> str:
     const a = (typeof viewer !== "undefined" && viewer.animator) ? viewer.animator : null;
     let ta = 0.0;
     if (a && a.actions.length) ta = Math.max(...a.actions.map(x => x.time));
+    // At the end meshcat rewinds the actions but leaves the last frame on screen and its
+    // time on the animator's scrubber (a.time): hold it.
+    if (a && ta === 0.0 && !a.playing && a.time > 0) ta = a.time;
     const k = Math.min(R.lines.length - 1, Math.max(0, Math.round(ta * R.fps)));
     const t = R.t0 + ta / R.slow;
-    box.textContent = "t = " + t.toFixed(4) + " s (1/" + R.slow + " speed)  " + R.lines[k];
+    box.textContent = "t = " + t.toFixed(4) + " s (" + (R.slow === 1 ? "real time" : "1/" +
+      R.slow + " speed") + ")  " + R.lines[k];
     box.dataset.time = t.toString();
     requestAnimationFrame(tick);
   }}

@@ -1,18 +1,19 @@
 """The arrays of timeseries.npz and the numbers of summary.json, from a `RunResult`.
 
-Field layout: t[N]; body_names[3]; p_WB[N,3,3], R_WB[N,3,3,3], v_WB[N,3,3], w_WB[N,3,3]
-(mass centres, world frame); apds_names[2]; p_WA[N,2,3], R_WA[N,2,3,3] (ring centre, e3 along the
-axis towards the other APDS); couple_names[12]; status[N,12] (the pair's `Mode`: 0 far,
-1 tracked, 2 sliding, 3 sticking); active[N,12] (tracked or in contact); gap[N,12];
-lambda_n[N,12]; lambda_t[N,12,2];
-u[N,12,3] (couple parameters, unused entries 0); p1_W[N,12,3], p2_W[N,12,3]; frame_W[N,12,3,3]
+Field layout (C: the couples; all of the scene's in memory, those that came near in
+timeseries.npz, `near_timeseries`): t[N]; body_names[3]; p_WB[N,3,3], R_WB[N,3,3,3], v_WB[N,3,3],
+w_WB[N,3,3] (mass centres, world frame); apds_names[2]; p_WA[N,2,3], R_WA[N,2,3,3] (ring centre,
+e3 along the axis towards the other APDS); couple_names[C]; status[N,C] (the pair's `Mode`: 0
+far, 1 tracked, 2 sliding, 3 sticking); active[N,C] (tracked or in contact); gap[N,C];
+lambda_n[N,C]; lambda_t[N,C,2];
+u[N,C,3] (couple parameters, unused entries 0); p1_W[N,C,3], p2_W[N,C,3]; frame_W[N,C,3,3]
 (columns ta, tb, n: the contact frame, n from the couple's body 2 to its body 1; the identity
 for far couples); stewart_x[N,3] (m), stewart_rpy[N,3] (rad) (the Stewart element's deflection,
 `drake_dock.docking.plant.stewart_deflection`); stewart_force_W[N,3] (N, its force on the
 target APDS in the world frame, `drake_dock.docking.plant.stewart_force`); sample_kind[N]
 (0 step end, 1 just before an impact, 2 just after); ring_distance[N]; energy[N,k] with
-energy_names[k]; impact_t[M], impact_couples[M,12] (bool), impact_normal_impulse[M,12],
-impact_tangential_impulse[M,12,2], impact_restitution[M]; thrust_force_W[N,3] (N, the
+energy_names[k]; impact_t[M], impact_couples[M,C] (bool), impact_normal_impulse[M,C],
+impact_tangential_impulse[M,C,2], impact_restitution[M]; thrust_force_W[N,3] (N, the
 post-contact thrust on the chaser, world frame; zero without a ``thrust`` section).
 """
 from __future__ import annotations
@@ -27,7 +28,9 @@ from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.outcome import misalignment
 from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
                                       stewart_force, stewart_potential)
+from drake_dock.docking.loads import peak_loads
 from drake_dock.docking.pairs import CHASER_APDS, cost_by_pair_type, scenario_pairs
+from drake_dock.docking.scenario import scenario_dict
 from drake_dock.docking.simulate import PRE_IMPACT
 from drake_dock.docking.thrust import ThrustSchedule
 
@@ -193,20 +196,56 @@ def relative_text(x, spec=".2e") -> str:
     return "undefined" if x is None else format(x, spec)
 
 
-def energy_ledger(ts: dict) -> dict:
-    """kinetic + Stewart potential + dissipated (damper, friction, impacts) - input work must
-    equal the initial total; closure is the largest |residual| over the run relative to it."""
+def centre_of_mass_kinetic_energy(ts: dict, masses) -> np.ndarray:
+    """|P|^2 / (2 M) [N] (J): the kinetic energy of the motion of the system's centre of mass
+    (P the total linear momentum, M the total mass). Contact cannot change it; only an input
+    (thrust) can."""
+    m = np.asarray(masses, float)
+    P = np.einsum("b,nbi->ni", m, ts["v_WB"])
+    return np.einsum("ni,ni->n", P, P) / (2.0 * m.sum())
+
+
+def first_contact_sample(ts: dict) -> int | None:
+    """The first sample at which a couple is in contact or an impact happens (the sample just
+    before it), or None for a run without contact."""
+    hits = np.flatnonzero((ts["status"] >= IN_CONTACT).any(1) | (ts["sample_kind"] == 1))
+    return int(hits[0]) if hits.size else None
+
+
+def relative_kinetic_energy_at_contact(ts: dict, masses) -> float | None:
+    """The kinetic energy in the system's centre-of-mass frame (the inertial kinetic energy
+    minus `centre_of_mass_kinetic_energy`) at the first contact (`first_contact_sample`): what
+    the contact, the damper and the Stewart spring can act on; 1/2 mu v^2 for two bodies
+    closing at v without rotation (mu the reduced mass). None without contact."""
+    k = first_contact_sample(ts)
+    if k is None:
+        return None
+    kinetic = ts["energy"][:, ts["energy_names"].tolist().index("kinetic")]
+    return float(kinetic[k] - centre_of_mass_kinetic_energy(ts, masses)[k])
+
+
+def energy_ledger(ts: dict, masses=None) -> dict:
+    """The ledger in the inertial (world) frame: kinetic + Stewart potential + dissipated
+    (damper, friction, impacts) - input work must equal the initial total; closure is the
+    largest |residual| over the run relative to it. With ``masses``, the part of the initial
+    total in the motion of the centre of mass (`centre_of_mass_kinetic_energy`), which no
+    contact dissipates."""
     E = dict(zip(ts["energy_names"].tolist(), ts["energy"].T))
     ke, pe = E["kinetic"], E["potential"]
     damper = -E["stewart_damper_work"]
     friction, impacts, inputs = E["friction_loss"], E["impact_loss"], E["input_work"]
     total0 = ke[0] + pe[0]
     residual = ke + pe + damper + friction + impacts - inputs - total0
-    return {"initial_total_J": float(total0), "kinetic_J": float(ke[-1]),
-            "stewart_potential_J": float(pe[-1]), "dissipated_damper_J": float(damper[-1]),
-            "dissipated_friction_J": float(friction[-1]),
-            "dissipated_impacts_J": float(impacts[-1]), "input_work_J": float(inputs[-1]),
-            "closure_error_relative": _relative(np.abs(residual).max(), abs(total0))}
+    out = {"frame": "inertial (world)", "initial_total_J": float(total0)}
+    if masses is not None:
+        out["initial_centre_of_mass_motion_J"] = float(
+            centre_of_mass_kinetic_energy(ts, masses)[0])
+    out.update({"kinetic_J": float(ke[-1]),
+                "stewart_potential_J": float(pe[-1]), "dissipated_damper_J": float(damper[-1]),
+                "dissipated_friction_J": float(friction[-1]),
+                "dissipated_impacts_J": float(impacts[-1]), "input_work_J": float(inputs[-1]),
+                "closure_error_relative": _relative(np.abs(residual).max(), abs(total0))})
+    return out
 
 
 def final_misalignment(ts: dict) -> dict:
@@ -219,38 +258,79 @@ def final_misalignment(ts: dict) -> dict:
     return {"axial_m": axial, "lateral_m": lateral, "tilt_deg": math.degrees(tilt)}
 
 
+def near_couples(ts: dict) -> np.ndarray:
+    """Indices of the couples that came near: tracked or in contact at some sample, or in an
+    impact. The others stayed far throughout (their rows hold no contact)."""
+    return np.flatnonzero((ts["status"] > Mode.FAR).any(0) | ts["impact_couples"].any(0))
+
+
+# The per-couple arrays of a timeseries and the axis that runs over the couples.
+PER_COUPLE = {"couple_names": 0, "status": 1, "active": 1, "gap": 1, "lambda_n": 1,
+              "lambda_t": 1, "u": 1, "p1_W": 1, "p2_W": 1, "frame_W": 1, "impact_couples": 1,
+              "impact_normal_impulse": 1, "impact_tangential_impulse": 1}
+
+
+def near_timeseries(ts: dict) -> dict:
+    """The timeseries with the per-couple arrays cut to the couples that came near
+    (`near_couples`), as timeseries.npz holds it: the other couples stayed far, their rows hold
+    no contact."""
+    near = near_couples(ts)
+    return {k: np.take(v, near, axis=PER_COUPLE[k]) if k in PER_COUPLE else v
+            for k, v in ts.items()}
+
+
+def couples_table(ts: dict, pairs) -> dict:
+    """{couple: its description in plain words (`drake_dock.docking.pairs.describe_pair`), the
+    share of samples in contact, its peak normal force, its impacts and their normal impulse}
+    for the couples that came near (`near_couples`)."""
+    words = {p.name: p.description for p in pairs}
+    names = ts["couple_names"].tolist()
+    out = {}
+    for j in near_couples(ts):
+        lam = ts["lambda_n"][:, j]
+        out[names[j]] = {
+            "description": words[names[j]],
+            "in_contact_share": float((ts["status"][:, j] >= IN_CONTACT).mean()),
+            "peak_normal_force_N": float(lam.max(initial=0.0)),
+            "impacts": int(ts["impact_couples"][:, j].sum()),
+            "normal_impulse_Ns": float(ts["impact_normal_impulse"][:, j].sum())}
+    return out
+
+
 def summary(result, ts: dict) -> dict:
+    """The numbers of a run for a docking engineer (summary.json): the outcome and its reason,
+    capture, the final misalignment, the peak loads (`drake_dock.docking.loads.peak_loads`),
+    the relative kinetic energy at contact, the energy ledger, the impacts, the momentum drift,
+    the first contact and the couples that came near (`couples_table`). The solver's cost is
+    apart (`run_cost`)."""
     s = result.scenario
     b = s.bodies
     params = [getattr(b, n) for n in ts["body_names"]]
+    masses = [p.mass for p in params]
     about = momentum_reference_point(s, ts)
-    P, L, sP, sL = momenta(ts, [p.mass for p in params], [p.inertia for p in params], about)
+    P, L, sP, sL = momenta(ts, masses, [p.inertia for p in params], about)
     J, H = thrust_impulses(result, ts, about)       # the only external forces
-    lam = ts["lambda_n"]
-    k_peak = np.unravel_index(np.argmax(lam), lam.shape) if lam.size else None
-    peak = float(lam[k_peak]) if k_peak is not None else 0.0
+    pairs = scenario_pairs(s)
     imp = ts["impact_normal_impulse"]
     return {
         "outcome": result.outcome,
         "outcome_reason": result.reason,
-        "final_misalignment": final_misalignment(ts),
         "captured": bool(result.captured),
         "capture_time_s": result.capture_time,
-        "capture_distance_m": s.simulation.capture_distance,
+        "end_time_s": result.end_time,
+        "final_misalignment": final_misalignment(ts),
         "capture_tolerances": {"axial_m": s.simulation.capture_distance,
                                "lateral_m": s.simulation.capture_lateral,
                                "tilt_deg": s.simulation.capture_tilt_deg},
-        "end_time_s": result.end_time,
+        "loads": peak_loads(ts, pairs),
+        "relative_kinetic_energy_at_contact_J": relative_kinetic_energy_at_contact(ts, masses),
+        "energy_ledger": energy_ledger(ts, masses),
         "number_of_impacts": len(result.impacts),
         "impact_times_s": ts["impact_t"].tolist(),
         "largest_impulse_Ns": float(imp.max()) if imp.size else 0.0,
-        "peak_contact_force_N": peak,
-        "peak_contact_force_couple": (str(ts["couple_names"][k_peak[1]]) if peak > 0 else None),
-        "peak_contact_force_time_s": (float(ts["t"][k_peak[0]]) if peak > 0 else None),
         "momentum_drift_relative": {
             "linear": _relative(np.linalg.norm(P - P[0] - J, axis=1).max(), sP),
             "angular": _relative(np.linalg.norm(L - L[0] - H, axis=1).max(), sL)},
-        "energy_ledger": energy_ledger(ts),
         "end_state": {
             "holding_couples": [dataclasses.asdict(h) for h in result.holding],
             "relative_kinetic_energy_J": (None if math.isnan(result.relative_kinetic_energy)
@@ -264,11 +344,22 @@ def summary(result, ts: dict) -> dict:
         "first_contact_lateral_offset_m": list(result.initial.contact_offset),
         "initial_ring_distance_m": result.initial.d0,
         "first_closing_couples": list(result.initial.closing_pairs),
+        "couples": couples_table(ts, pairs),
+        "scenario": scenario_dict(s),
+    }
+
+
+def run_cost(result, ts: dict) -> dict:
+    """What the run cost the solver (cost.json): the wall time of the simulation (compilation
+    and output writing excluded), the derivative evaluations, samples and mode changes, the
+    time shares and the cost per pair type (`drake_dock.docking.pairs.cost_by_pair_type`).
+    Wall times vary from run to run."""
+    return {
+        "wall_time_s": result.wall_time,
+        "simulated_s": result.end_time,
+        "derivative_evaluations": result.evaluations,
         "samples": int(len(ts["t"])),
         "mode_changes": result.mode_changes,
-        "derivative_evaluations": result.evaluations,
-        "wall_time_s": result.wall_time,
         "time_shares": result.timing,
         "cost_by_pair_type": cost_by_pair_type(result.timing),
     }
-

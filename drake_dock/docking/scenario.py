@@ -361,6 +361,33 @@ def _validate_simulator_config(c: SimulatorConfig, duration: float):
                          f"0 (as fast as possible) or >= {MIN_REALTIME_RATE:g}")
 
 
+# Writing ---------------------------------------------------------------------------------------
+def scenario_dict(node):
+    """A scenario (or any part of it) as plain data: every field, the defaults filled in and
+    None kept (null: a tolerance left out), in the order of the dataclasses; what
+    `load_scenario` reads back to an equal scenario."""
+    fields = _schema_fields(type(node))
+    if fields is not None:
+        return {name: scenario_dict(getattr(node, name)) for name in fields}
+    if isinstance(node, (list, tuple)):
+        return [scenario_dict(x) for x in node]
+    return node
+
+
+class _Dumper(yaml.SafeDumper):
+    """Sections and fields one a line, vectors on one line ([x, y, z])."""
+
+
+_Dumper.add_representer(list, lambda d, v: d.represent_sequence("tag:yaml.org,2002:seq", v,
+                                                                flow_style=True))
+
+
+def scenario_yaml(scenario: Scenario) -> str:
+    """The full scenario as YAML (`scenario_dict`): `drake-dock run --print-scenario`."""
+    return yaml.dump(scenario_dict(scenario), Dumper=_Dumper, sort_keys=False,
+                     default_flow_style=False, width=100)
+
+
 def load_scenario(filename=None, *, data: str | None = None) -> Scenario:
     """Loads and validates a scenario from a YAML file (default: the paper's example) or a
     string. Raises `InputError` (a ValueError) naming the field for any bad value, and for an
@@ -381,7 +408,11 @@ def load_scenario(filename=None, *, data: str | None = None) -> Scenario:
         raise InputError("scenario file", str(filename or "<string>"), "valid YAML",
                          str(e).splitlines()[0]) from None
     if raw is None:
-        raw = {}
+        raise InputError("scenario file", str(filename or "<string>"),
+                         f"a YAML mapping of sections "
+                         f"({', '.join(f.name for f in dataclasses.fields(Scenario))}); "
+                         f"`drake-dock run --print-scenario` prints a complete one",
+                         "the file holds no YAML content (empty, or only comments)")
     if not isinstance(raw, dict):
         raise InputError("scenario", raw, "a mapping of fields")
     _check_raw(raw, Scenario, "")

@@ -139,7 +139,7 @@ def run_condition(scenario, name: str, condition: dict) -> dict:
     pen = penetrations(s.geometry, ts)
     row.update(outcome=summ["outcome"], reason=summ["outcome_reason"],
                capture_time_s=summ["capture_time_s"], impacts=summ["number_of_impacts"],
-               peak_contact_force_N=summ["peak_contact_force_N"],
+               peak_contact_force_N=summ["loads"]["couple_normal_force_N"]["peak"],
                momentum_drift_linear=summ["momentum_drift_relative"]["linear"],
                momentum_drift_angular=summ["momentum_drift_relative"]["angular"],
                energy_closure=summ["energy_ledger"]["closure_error_relative"],

@@ -268,3 +268,22 @@ def test_numerical_error_from_the_run_maps_to_exit_3(tmp_path, capsys, monkeypat
     out = tmp_path / "results"
     msg = _one_paragraph_exit_3(capsys, main(["run", "--out", str(out), "--no-progress"]), out)
     assert "t = 0.0123 s" in msg and "cc_T1_C5" in msg
+
+
+def test_drake_log_holds_what_drake_logged_that_matters(tmp_path, capsys, monkeypatch):
+    """A warning Drake logs during a run goes into drake.log, off the terminal; the replay's
+    Meshcat start-up line does not."""
+    import logging
+
+    import drake_dock.run as run_module
+    real = run_module.timeseries
+
+    def warned(result):
+        logging.getLogger("drake").warning("a warning from Drake")
+        return real(result)
+    monkeypatch.setattr(run_module, "timeseries", warned)
+    out = tmp_path / "results"
+    assert main(["run", "--out", str(out), "--duration", "0.005", "--no-progress"]) == 0
+    captured = capsys.readouterr()
+    assert "a warning from Drake" not in captured.out + captured.err
+    assert (out / "drake.log").read_text() == "WARNING: a warning from Drake\n"

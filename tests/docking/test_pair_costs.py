@@ -1,4 +1,4 @@
-"""What each pair type cost in a run (`cost_by_pair_type` in summary.json): the types partition
+"""What each pair type cost in a run (`cost_by_pair_type` in cost.json): the types partition
 the declared pairs as the functions that declare them do, all seeking time is attributed to a
 pair, and a pair's tracked evaluations agree with the statuses recorded at the samples."""
 import collections
@@ -10,7 +10,7 @@ from drake_dock.docking.pairs import (CHASER_APDS, R_MATCHED, TARGET_APDS, apds_
                                       corner_pairs, cost_by_pair_type, edge_pairs, pair_type,
                                       side_edge_pairs, tip_surface_pairs)
 from drake_dock.docking.apds import apds_patches
-from drake_dock.docking.results import summary, timeseries
+from drake_dock.docking.results import run_cost, timeseries
 from drake_dock.docking.scenario import load_scenario
 from drake_dock.docking.simulate import simulate
 
@@ -40,7 +40,7 @@ def test_pair_types_partition_the_complete_set(geom):
 def complete_run():
     r = simulate(load_scenario(data="contact: {pairs: complete}"))
     ts = timeseries(r)
-    return r, ts, summary(r, ts)
+    return r, ts, run_cost(r, ts)
 
 
 def test_seeking_time_is_all_attributed_to_pairs(complete_run):
