@@ -63,11 +63,10 @@ ALL_FEATURES = ("ring", "guide side", "petal")
 
 
 def checked_features(g) -> tuple:
-    """(the feature name prefixes checked against the other APDS's petals, those checked
-    against its ring). Petals on the ring's outside circle (the paper's, Rp >= Rs) pass the
-    other ring's annulus in the paper's reading (docs/model.md), so petals and ring are not
-    checked against each other; petals standing on the ring's inside circle (Rp = Rs) pass
-    through the other ring's passage, and every feature is checked against both."""
+    """(feature name prefixes checked against the other APDS's petals, against its ring).
+    The paper's petals (Rp > Rs) pass the other ring's annulus (docs/model.md): petals and
+    ring are not checked against each other. Petals on the inside circle (Rp = Rs) pass
+    through its passage: every feature is checked against both."""
     if g.Rp <= g.Rs:
         return ALL_FEATURES, ALL_FEATURES
     return PETAL_FEATURES, RING_FEATURES

@@ -21,12 +21,8 @@ free edge (the distance of its foot to the guide sides, the tip arc and the root
 fixed to the ring, but the other APDS passes that ring's annulus in the paper's reading, so a
 point may come to the plate from below its root). Near an edge the second is the smaller: a
 guide side sliding on its partner's edge that rides up over the edge by 30 um lies 30 um deep,
-however far it is above the plate. A point inside the other ring's solid lies at its distance
-to the nearest face. Checked: guide sides (but their roots, on the outside circle), tip arcs and
-the ring's inside circle against the other APDS's petals; the ring's circles and face against
-the other ring. A petal passing through the other ring's annulus (so also the ring's face and
-outside circle against the other's petals) is the paper's reading (docs/model.md) and is not
-checked.
+however far it is above the plate. A point inside the other ring's solid (`ring_depth_of`)
+lies at its distance to the nearest face. What is checked: `checked_features`.
 
 Between two samples of the run the relative pose is interpolated (translation linearly,
 rotation along its geodesic) in sub-steps that move no feature point more than ``max_travel``.
@@ -49,11 +45,10 @@ ALL_FEATURES = ("ring", "guide side", "petal")
 
 
 def checked_features(g) -> tuple:
-    """(the feature name prefixes checked against the other APDS's petals, those checked
-    against its ring). Petals on the ring's outside circle (the paper's, Rp >= Rs) pass the
-    other ring's annulus in the paper's reading (docs/model.md), so petals and ring are not
-    checked against each other; petals standing on the ring's inside circle (Rp = Rs) pass
-    through the other ring's passage, and every feature is checked against both."""
+    """(feature name prefixes checked against the other APDS's petals, against its ring).
+    The paper's petals (Rp > Rs) pass the other ring's annulus (docs/model.md): petals and
+    ring are not checked against each other. Petals on the inside circle (Rp = Rs) pass
+    through its passage: every feature is checked against both."""
     if g.Rp <= g.Rs:
         return ALL_FEATURES, ALL_FEATURES
     return PETAL_FEATURES, RING_FEATURES

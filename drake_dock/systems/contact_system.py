@@ -68,7 +68,7 @@ from drake_dock.systems import witnesses
 from drake_dock.systems.contact_types import (COUPLE_FIELDS, COUPLE_OUTPUT_SIZE, COUPLE_SLICES,
                                               ContactModes, ContactOptions, ContactPair,
                                               Evaluation, Handover, PairState)
-from drake_dock.systems.evaluation import PlantEvaluator, near_pairs
+from drake_dock.systems.evaluation import PlantEvaluator, drifting, near_pairs
 from drake_dock.systems.memo import Memo
 from drake_dock.systems.outputs import CoupleRows
 from drake_dock.systems.profiling import Timing
@@ -334,14 +334,14 @@ class RigidContactSystem(LeafSystem):
     # ------------------------------------------------------------------ events
     def _on_step(self, context, state):
         """Per-step event: far pairs whose travel bound has used ``reseek_early`` of their
-        clearance, and tracked couples that drifted (`PlantEvaluator.drifting`), are sought
+        clearance, and tracked couples that drifted (`drifting`), are sought
         again at the start of this step (with every other transition due, as at a witness
         event). The clearance witness stays the guarantee; sought a little early, a pair needs
         no isolated event."""
         modes = self.get_modes(context)
         E = self._cache.Eval(context)
         early = self.options.reseek_early
-        if self.evaluator.drifting(E, modes.pairs):
+        if drifting(self.evaluator, E, modes.pairs):
             return self._on_event(context, None, state, early=early)
         index = modes.index()
         far = index.far

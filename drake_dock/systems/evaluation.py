@@ -184,13 +184,6 @@ class PlantEvaluator:
             udot[sl] = python_udot[sl]
         return evals, udot
 
-    def drifting(self, E, states) -> bool:
-        """Whether a tracked couple (not in contact) of the evaluation E projected by more than
-        ``drift_tol`` of its domain span: it is sought again (`Transitions.resolve`)."""
-        return any(c is not None and not states[i].mode.in_contact
-                   and (np.abs(c.drift) / self.spans[i]).max() > self.options.drift_tol
-                   for i, c in enumerate(E.evals))
-
     def row(self, i, ev, poses, ctx):
         """Pair i's `ContactRow` (`row_arrays`)."""
         W, bn, bt = self.row_arrays(i, ev, poses, ctx)
@@ -348,3 +341,11 @@ class PlantEvaluator:
             index = E.modes.index()
             E.bound[index.far] = self.far.bounds_of(index, pairs, E.poses)
         return E.bound[i]
+
+
+def drifting(ev: PlantEvaluator, E, states) -> bool:
+    """Whether a tracked couple (not in contact) of the evaluation E projected by more than
+    ``drift_tol`` of its domain span: it is sought again (`Transitions.resolve`)."""
+    return any(c is not None and not states[i].mode.in_contact
+               and (np.abs(c.drift) / ev.spans[i]).max() > ev.options.drift_tol
+               for i, c in enumerate(E.evals))
