@@ -180,7 +180,9 @@ def _resolve(path: str, base: Scenario) -> int:
         if part not in hints:
             raise InputError(f"vary.{path}", path, "the dotted path of a numeric scenario field "
                              "(e.g. initial.lateral_offset, contact.mu)", f"no field '{part}'")
-        node, schema = getattr(node, part), hints[part]
+        node, schema = getattr(node, part), _present(hints[part])
+        if node is None and dataclasses.is_dataclass(schema):
+            node = schema()                     # an optional section the base leaves out
     if schema is float:
         return 0
     if typing.get_origin(schema) is list and typing.get_args(schema) == (float,):
@@ -212,12 +214,26 @@ def _check_distribution(f: Field):
             raise InputError(where, pair, "[mean, sd] with sd > 0")
 
 
+def _present(schema):
+    """X of an optional section's type X | None; other types as they are."""
+    args = typing.get_args(schema)
+    if type(None) in args and len(args) == 2:
+        return next(a for a in args if a is not type(None))
+    return schema
+
+
 def set_field(scenario: Scenario, path: str, value):
-    """Sets the dotted field ``path`` of ``scenario`` (in place) to ``value``."""
+    """Sets the dotted field ``path`` of ``scenario`` (in place) to ``value``; an optional
+    section the scenario leaves out (``thrust``) is added with its defaults first."""
     *parents, last = path.split(".")
     node = scenario
     for p in parents:
-        node = getattr(node, p)
+        child = getattr(node, p)
+        if child is None:
+            kind = _present(typing.get_type_hints(type(node))[p])
+            child = kind()
+            setattr(node, p, child)
+        node = child
     setattr(node, last, value)
 
 

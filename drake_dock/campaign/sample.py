@@ -38,12 +38,13 @@ _DIAGRAMS: collections.OrderedDict = collections.OrderedDict()
 def build_key(scenario) -> str:
     """What `build_docking_diagram` reads from a scenario: the geometry, bodies, Stewart
     element, chaser APDS offset, contact law, simulator configuration (the LZB tolerance follows
-    it), capture distance and closing speed
-    (the energy scale of the error control). Samples that differ only elsewhere (the
-    misalignment, the roll, the duration) share a Diagram."""
-    s = scenario
+    it), the capture rule's tolerances, the thrust and the closing speed (the energy scale of
+    the error control). Samples that differ only elsewhere (the misalignment, the roll, the
+    duration) share a Diagram."""
+    s, sim = scenario, scenario.simulation
     return repr((s.geometry, s.bodies, s.stewart, s.chaser_apds_offset, s.contact,
-                 repr(s.simulator_config), s.simulation.capture_distance, s.initial.chaser_speed))
+                 repr(s.simulator_config), sim.capture_distance, sim.capture_lateral,
+                 sim.capture_tilt_deg, s.thrust, s.initial.chaser_speed))
 
 
 def diagram_for(scenario):

@@ -47,12 +47,19 @@ def test_the_good_plan_and_the_shipped_idss_plan_load(tmp_path):
     assert [f.path for f in load_plan(plan)[2]] == ["initial.lateral_offset",
                                                     "initial.target_yaw_deg"]
     idss, base, fields = load_plan(MODELS_DIR / "idss_envelope.yaml")
-    # The paper example with the plan's `set`: capture on the axial distance alone.
+    # The paper example with the plan's `set`: every pair, and post-contact thrust.
+    from drake_dock.docking.scenario import ThrustParams
     paper = load_scenario(PAPER_EXAMPLE)
-    assert paper.simulation.capture_lateral is not None
-    paper.simulation.capture_lateral = paper.simulation.capture_tilt_deg = None
+    assert paper.contact.pairs == "paper" and paper.thrust is None
+    paper.contact.pairs = "complete"
+    paper.thrust = ThrustParams(force=300.0, duration=3.0)
     assert base == paper
     assert sum(f.dims for f in fields) == 11         # the eleven random initial parameters
+    funnel, base_f, fields_f = load_plan(MODELS_DIR / "idss_envelope_funnel.yaml")
+    assert base_f.geometry == load_scenario(MODELS_DIR / "apds_funnel.yaml").geometry
+    assert base_f.thrust == paper.thrust and base_f.contact.pairs == "complete"
+    assert [f.path for f in fields_f] == [f.path for f in fields]
+    assert (funnel.samples, funnel.seed) == (idss.samples, idss.seed)
 
 
 @pytest.mark.parametrize("set_, field, named", [
@@ -106,3 +113,39 @@ def test_bad_options_exit_2_naming_them(tmp_path, capsys, extra, field):
     assert main(["campaign", str(plan), "--out", str(out), *extra]) == 2
     assert f"{field} = " in " ".join(capsys.readouterr().err.split())
     assert not out.exists()
+
+
+def test_a_plan_varies_the_thrust_of_a_base_without_one(tmp_path):
+    """A plan may vary the keys of the optional `thrust` section on a base scenario that has
+    none: the section is added with its defaults, then the sampled key is set."""
+    from drake_dock.campaign.plan import load_plan, set_field
+    from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+    plan = tmp_path / "plan.yaml"
+    plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE)
+                    + "  thrust.force: {uniform: [100.0, 400.0]}\n")
+    fields = load_plan(plan)[2]
+    assert "thrust.force" in [f.path for f in fields]
+    s = load_scenario(PAPER_EXAMPLE)
+    set_field(s, "thrust.force", 250.0)
+    assert s.thrust.force == 250.0 and s.thrust.delay == 0.0 and s.thrust.duration is None
+
+
+def test_the_diagram_key_holds_what_the_diagram_reads():
+    """`build_key` changes with every field the docking Diagram reads (the capture rule's
+    tolerances and the thrust among them), and not with the approach (misalignment, roll)."""
+    from drake_dock.campaign.plan import set_field
+    from drake_dock.campaign.sample import build_key
+    from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+    base = load_scenario(PAPER_EXAMPLE)
+    for path, value in (("simulation.capture_lateral", 0.02),
+                        ("simulation.capture_tilt_deg", 1.0),
+                        ("simulation.capture_distance", 0.004), ("thrust.force", 100.0),
+                        ("contact.mu", 0.2), ("geometry.Rs", 0.45)):
+        s = load_scenario(PAPER_EXAMPLE)
+        set_field(s, path, value)
+        assert build_key(s) != build_key(base), path
+    for path, value in (("initial.lateral_offset", [0.05, 0.0]),
+                        ("initial.target_yaw_deg", 2.0), ("simulation.duration", 3.0)):
+        s = load_scenario(PAPER_EXAMPLE)
+        set_field(s, path, value)
+        assert build_key(s) == build_key(base), path
