@@ -339,9 +339,19 @@ def ring_rim(g: ApdsGeometry) -> Circle:
     return Circle(g.R, 0.0)
 
 
+# How far the ring face's contact annulus reaches past the rim (m): the rim as a rounded edge
+# (`ring_face`).
+FACE_OVERHANG = 1e-3
+
+
 def ring_face(g: ApdsGeometry) -> Annulus:
-    """The ring's face, the annulus Rs <= rho <= R at zeta = 0; u = (rho, theta), normal +e3."""
-    return Annulus(g.Rs, g.R, 0.0)
+    """The ring's face, the annulus Rs <= rho <= R + `FACE_OVERHANG` at zeta = 0; u = (rho,
+    theta), normal +e3. Two rings meet face on face with their rims nearly one over the other;
+    a sharp rim against the other's equal rim has no isolated couple there. The face reaching
+    a millimetre past the rim stands for a rounded edge: another ring's rim coming over it
+    touches the face's plane, a little before the material (docs/model.md, "Facing and the
+    contact pairs")."""
+    return Annulus(g.Rs, g.R + FACE_OVERHANG, 0.0)
 
 
 # The petal corner's sphere (the paper gives no rounding): radius r through the corner, its

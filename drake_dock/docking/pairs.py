@@ -108,7 +108,6 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
         pairs += corner_surface_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
         pairs += corner_land_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS), R_MATCHED)
         pairs += corner_land_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS), R_MATCHED.T)
-        pairs.append(PairSpec("cc_Crim_Trim", "CC", CHASER_APDS, P.rim, TARGET_APDS, P.rim))
         if g.Rp <= g.Rs:
             pairs += rim_petal_pairs(P, ("C", CHASER_APDS), ("T", TARGET_APDS))
             pairs += rim_petal_pairs(P, ("T", TARGET_APDS), ("C", CHASER_APDS))
@@ -299,11 +298,6 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
     target's face (cs_Crim_Tface) and the target's rim (cc_Crim_Trim)."""
     names = {p.name for p in pairs}
     out = []
-    if {"cc_Crim_Trim", "cs_Crim_Tface"} <= names:
-        # The chaser's rim leaves the target's face over its outer edge (rho = R, u = (rho,
-        # theta)): the target's rim, its parameter theta.
-        out.append(("cc_Crim_Trim", "cs_Crim_Tface",
-                    SurfaceEdge(0, True, lambda th: th, lambda th: th)))
     for j in (1, 2, 3):
         for k in (1, 2, 3):
             # A chaser tip arc over target tip arc k and target guide surface k.
