@@ -172,12 +172,12 @@ def test_complete_set_names_and_patches(geom):
     pairs), the chaser's tip arcs against the target's tip arcs they can reach (6 pairs),
     the petal corners against the other's guide surfaces they can reach (24
     point-surface pairs, each corner a bare point), the petal corners against the other's tip
-    lands they come over (12 point-surface pairs) and the two rims (1 pair, the chaser's
-    Body 1)."""
+    lands they come over (12 point-surface pairs); no rim on rim (the faces reach past the
+    rims)."""
     paper, complete = apds_pairs(geom), apds_pairs(geom, "complete")
     assert [p.name for p in complete[:12]] == [p.name for p in paper] and len(paper) == 12
     new = {p.name: p for p in complete[12:]}
-    assert len(new) == len(complete) - 12 == 123
+    assert len(new) == len(complete) - 12 == 122
     P = apds_patches(geom)
     for x, y, bx, by in (("C", "T", "chaser_apds", "target_apds"),
                          ("T", "C", "target_apds", "chaser_apds")):
@@ -213,10 +213,11 @@ def test_complete_set_names_and_patches(geom):
             assert np.array_equal(patch.position(u), expected.position(u))
     assert new["cc_Tring_Ctip2"].body1 == "target_apds"
     assert new["cs_Crim_Tface"].kind == "CS" and new["cs_Crim_Tface"].body2 == "target_apds"
-    rims = new["cc_Crim_Trim"]
-    assert (rims.kind, rims.body1, rims.body2) == ("CC", "chaser_apds", "target_apds")
-    for patch in (rims.patch1, rims.patch2):
-        assert (patch.radius, patch.height) == (geom.R, 0.0)
+    face = new["cs_Crim_Tface"]
+    assert (face.patch1.radius, face.patch1.height) == (geom.R, 0.0) and face.sigma == 1.0
+    # The face's contact annulus reaches past the rim (a rounded edge); no rim-on-rim pair.
+    assert face.patch2.lower[0] == geom.Rs and face.patch2.upper[0] > geom.R
+    assert not [n for n in new if n.startswith("cc_") and n.count("rim") == 2]
     for name, b1, c1, b2, c2 in (("cc_T4_C1", "chaser_apds", P.sides[1], "target_apds",
                                   P.sides[4]),
                                  ("cc_T2_Ctip3", "target_apds", P.sides[2], "chaser_apds",
@@ -466,14 +467,14 @@ def test_tip_tip_pairs_follow_the_closed_form(geom):
 
 
 def test_declared_handovers_map_each_edge_onto_its_surface(geom):
-    """Every hand-over of the complete set (`pair_handovers`, 25): the two pairs share Body 1's
+    """Every hand-over of the complete set (`pair_handovers`, 24): the two pairs share Body 1's
     curve, and along the edge curve (the edge pair's patch 2) the surface point at the mapped
     parameters (`surface_params`) is the edge's point, 21 samples to 1e-12 m, and maps back."""
     from drake_dock.core.handover import surface_params
     from drake_dock.docking.pairs import pair_handovers
     pairs = {p.name: p for p in apds_pairs(geom, "complete")}
     found = pair_handovers(geom, list(pairs.values()))
-    assert len(found) == 25
+    assert len(found) == 24
     for e_name, s_name, edge in found:
         e, s = pairs[e_name], pairs[s_name]
         assert (e.kind, s.kind) == ("CC", "CS") and e.patch1 is s.patch1

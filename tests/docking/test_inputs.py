@@ -108,11 +108,11 @@ def test_contact_static_friction_defaults_to_sliding_friction():
 
 def test_contact_pairs_names_the_contact_set(paper_scenario):
     """contact.pairs: ``paper`` (the paper's 12 pairs, which the paper's example states) or
-    ``complete`` (135 pairs, the default); anything else is named by its field."""
+    ``complete`` (134 pairs, the default); anything else is named by its field."""
     from drake_dock.docking.pairs import scenario_pairs
     assert paper_scenario.contact.pairs == "paper" and len(scenario_pairs(paper_scenario)) == 12
     s = load_scenario(data="contact: {pairs: complete}")
-    assert len(scenario_pairs(s)) == 135
+    assert len(scenario_pairs(s)) == 134
     assert load_scenario(data="contact: {mu: 0.1}").contact.pairs == "complete"
     _fails("contact: {pairs: all}", "contact.pairs")
     _fails("contact: {pairs: 12}", "contact.pairs")

@@ -25,7 +25,7 @@ def test_the_outputs_are_small(box_corner):
 
 def test_timeseries_holds_the_couples_that_came_near(box_corner):
     """timeseries.npz: deflate-compressed; its couples are those of the summary's table (the
-    couples tracked, in contact or in an impact), far fewer than the 135 declared, each row equal
+    couples tracked, in contact or in an impact), far fewer than the 134 declared, each row equal
     to the run's in-memory row of that couple, matched by name."""
     full, out = box_corner
     ts = full.timeseries
