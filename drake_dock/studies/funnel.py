@@ -43,12 +43,12 @@ from drake_dock.studies.conditions import PENETRATION_LIMIT, penetrations
 
 @dataclasses.dataclass
 class FunnelPlan:
-    thrusts: tuple = (0.0, 150.0, 300.0)     # N, from the first contact for thrust_duration s
-    thrust_duration: float = 5.0
+    thrusts: tuple = (0.0, 300.0)            # N, from the first contact for thrust_duration s
+    thrust_duration: float = 3.0
     paper: bool = True                       # the paper's geometry (c = 0)
     rim_passages: tuple = (0.5,)             # Rs with the petals on the outside circle
     funnel_passage: float = 0.55             # Rs = Rp of the funnel family
-    funnel_heights: tuple = (0.05, 0.1, 0.15, 0.2)   # H of the funnel family (m)
+    funnel_heights: tuple = (0.05, 0.1, 0.15)   # H of the funnel family (m)
     directions_deg: tuple = (30.0, 90.0)
     closing_speed: float = 0.1               # m/s (the IDSS box's fastest)
     roll_deg: float = 2.0
@@ -80,12 +80,14 @@ def geometries(base, plan: FunnelPlan) -> list:
         g = dataclasses.replace(base, **kw)
         out.append((label, g.validate("geometry")))
     if plan.paper:
-        add("paper (Rs 0.4, petals on R)", Rs=0.4, H=0.2, petal_root_radius=None)
+        add("paper (Rs 0.4, petals on R)", Rs=0.4, H=0.2, petal_root_radius=None,
+            petal_inset_deg=0.0)
     for rs in plan.rim_passages:
-        add(f"petals on R, Rs {rs:g}", Rs=rs, H=0.2, petal_root_radius=None)
+        add(f"petals on R, Rs {rs:g}", Rs=rs, H=0.2, petal_root_radius=None,
+            petal_inset_deg=0.0)
     for h in plan.funnel_heights:
         add(f"funnel Rs = Rp {plan.funnel_passage:g}, H {h:g}", Rs=plan.funnel_passage, H=h,
-            petal_root_radius=plan.funnel_passage)
+            petal_root_radius=plan.funnel_passage)      # the base's petal inset
     return out
 
 
