@@ -69,7 +69,8 @@ def couple_forces_figure(ts, out, pairs=()):
 def energy_ledger_figure(ts, summary, out):
     """Left: the kinetic energy. Right, on its own axis: where the kinetic energy lost went
     (Stewart potential gained, damper, friction, impacts, stacked), against the kinetic
-    energy lost plus the input work (black dashed): the ledger closes when they meet."""
+    energy lost plus the work of the thrust on the chaser (its inputs; black dashed, the work
+    itself dotted): the ledger closes when they meet."""
     t = ts["t"]
     E = dict(zip(ts["energy_names"].tolist(), ts["energy"].T))
     sinks = {"Stewart potential": E["potential"] - E["potential"][0],
@@ -85,7 +86,11 @@ def energy_ledger_figure(ts, summary, out):
         if np.ptp(sinks[label]) > 0:
             sh.add(a_l, label, col)
     lost = E["kinetic"][0] - E["kinetic"] + E["input_work"]
-    a_l.plot(t, lost, "k--", lw=1.2, label="kinetic energy lost + input work")
+    driven = np.ptp(E["input_work"]) > 0
+    if driven:                  # post-contact thrust (and any wrench on the chaser's input)
+        a_l.plot(t, E["input_work"], color="0.45", ls=":", lw=1.5, label="work of the thrust")
+    a_l.plot(t, lost, "k--", lw=1.2, label="kinetic energy lost + work of the thrust"
+             if driven else "kinetic energy lost")
     a_l.set_ylabel("energy [J]")
     legends = [(a_l, legend_beside(a_l))]
     for ax in (a_k, a_l):
