@@ -16,7 +16,9 @@ import warnings
 
 from drake_dock import __version__
 from drake_dock.errors import DrakeDockError, InputError
-from drake_dock.docking.scenario import PAPER_EXAMPLE
+from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE
+
+FUNNEL = MODELS_DIR / "apds_funnel.yaml"
 
 
 class ProgressBar:
@@ -81,14 +83,18 @@ def main(argv=None) -> int:
     run_p.add_argument("--no-progress", action="store_true", help="no progress bar")
     study_p = sub.add_parser("study", help="run a study")
     study_p.add_argument("which",
-                         choices=["speed-accuracy", "stability", "conditions", "roll"],
+                         choices=["speed-accuracy", "stability", "conditions", "roll",
+                                  "crosscheck"],
                          help="speed-accuracy: drake_dock against Drake's compliant contact; "
                               "stability: the five cases where methods fail; conditions: "
                               "seeded conditions in the IDSS initial-contact box; roll: the "
-                              "coaxial approach over the whole relative-roll range")
+                              "coaxial approach over the whole relative-roll range; "
+                              "crosscheck: IDSS-box conditions run by drake_dock and by "
+                              "Drake's compliant contact, outcomes compared")
     study_p.add_argument("scenario", nargs="?", default=None,
                          help="scenario YAML (default: the paper's example; speed-accuracy: "
-                              "the paper's example and an off-nominal condition)")
+                              "the paper's example and an off-nominal condition; crosscheck: "
+                              "models/apds_funnel.yaml)")
     study_p.add_argument("--out", required=True, help=OUT_HELP)
     study_p.add_argument("--quick", action="store_true",
                          help="a few points only (for CI)")
@@ -180,6 +186,11 @@ def _study(args) -> int:
         from drake_dock.studies.roll import run_rolls as run_plan
         from drake_dock.studies.roll import summary_lines as lines
         from drake_dock.studies.roll import write_rolls as write
+    elif args.which == "crosscheck":
+        from drake_dock.studies.crosscheck import CrosscheckPlan as Plan
+        from drake_dock.studies.crosscheck import run_crosscheck as run_plan
+        from drake_dock.studies.crosscheck import summary_lines as lines
+        from drake_dock.studies.crosscheck import write_crosscheck as write
     elif args.which == "stability":
         from drake_dock.studies.stability import StabilityPlan as Plan
         from drake_dock.studies.stability import run_stability as run_plan
@@ -200,7 +211,8 @@ def _study(args) -> int:
         if args.which == "speed-accuracy":
             result = run_study(study_scenes(args.scenario), plan, log)
         else:
-            result = run_plan(load_scenario(args.scenario or PAPER_EXAMPLE), plan, log)
+            default = FUNNEL if args.which == "crosscheck" else PAPER_EXAMPLE
+            result = run_plan(load_scenario(args.scenario or default), plan, log)
         write(result, args.out)
         return lines(result)
     return _guarded(work, args.out)
