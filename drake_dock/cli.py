@@ -35,6 +35,8 @@ from drake_dock import __version__
 from drake_dock.errors import MISSING, DrakeDockError, InputError
 from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE
 
+FUNNEL = MODELS_DIR / "apds_funnel.yaml"
+
 RUN_EPILOG = """files written into DIR:
   summary.json      the outcome and its reason, capture time, final misalignment, peak loads
                     at the target ring, Stewart stroke and force, contact forces, relative
@@ -62,6 +64,9 @@ STUDIES = {
     "funnel": "the capture range (the largest lateral offset that captures) over the petal "
               "tips' clearance and the post-contact thrust (default scenario: "
               "models/apds_funnel.yaml)",
+    "crosscheck": "IDSS-box conditions run by drake_dock and by Drake's compliant contact, "
+                  "outcomes and capture times compared (default scenario: "
+                  "models/apds_funnel.yaml)",
 }
 STUDY_USAGE = "drake-dock study NAME [SCENARIO.yaml] --out DIR [--quick]"
 
@@ -165,7 +170,8 @@ def _parser() -> argparse.ArgumentParser:
                          help="the study (" + ", ".join(STUDIES) + "); absent: list them")
     study_p.add_argument("scenario", nargs="?", default=None,
                          help="scenario YAML (default: the paper's example; speed-accuracy: "
-                              "the paper's example and an off-nominal condition)")
+                              "the paper's example and an off-nominal condition; funnel and "
+                              "crosscheck: models/apds_funnel.yaml)")
     study_p.add_argument("--out", metavar="DIR", help=OUT_HELP)
     study_p.add_argument("--quick", action="store_true",
                          help="a few points only (for CI)")
@@ -327,6 +333,11 @@ def _study(args) -> int:
         from drake_dock.studies.funnel import run_funnel as run_plan
         from drake_dock.studies.funnel import summary_lines as lines
         from drake_dock.studies.funnel import write_funnel as write
+    elif args.which == "crosscheck":
+        from drake_dock.studies.crosscheck import CrosscheckPlan as Plan
+        from drake_dock.studies.crosscheck import run_crosscheck as run_plan
+        from drake_dock.studies.crosscheck import summary_lines as lines
+        from drake_dock.studies.crosscheck import write_crosscheck as write
     elif args.which == "stability":
         from drake_dock.studies.stability import StabilityPlan as Plan
         from drake_dock.studies.stability import run_stability as run_plan
@@ -348,8 +359,7 @@ def _study(args) -> int:
         if args.which == "speed-accuracy":
             result = run_study(study_scenes(args.scenario), plan, log)
         else:
-            default = (MODELS_DIR / "apds_funnel.yaml" if args.which == "funnel"
-                       else PAPER_EXAMPLE)
+            default = FUNNEL if args.which in ("funnel", "crosscheck") else PAPER_EXAMPLE
             result = run_plan(load_scenario(args.scenario or default), plan, log)
         write(result, args.out)
         return lines(result)
