@@ -58,7 +58,7 @@ class FunnelPlan:
 
     @classmethod
     def quick(cls):
-        return cls(thrusts=(300.0,), paper=False, rim_passages=(), funnel_heights=(0.2,),
+        return cls(thrusts=(300.0,), paper=False, rim_passages=(), funnel_heights=(0.15,),
                    directions_deg=(90.0,), steps=1, checks=True)
 
     @classmethod
