@@ -100,7 +100,7 @@ def energy_ledger_figure(ts, summary, out):
     com = led.get("initial_centre_of_mass_motion_J")
     sh.fig.suptitle(f"Energy ledger (inertial frame): initial {led['initial_total_J']:.4g} J"
                     + ("" if com is None else f", of which {com:.4g} J in the motion of the "
-                       f"centre of mass") + f"; losses on the right (closure "
+                       f"centre of mass") + f"\nlosses on the right (closure "
                     f"{relative_text(led['closure_error_relative'], '.1e')} of the initial "
                     f"energy)")
     return sh.save(out, "energy_ledger.png", legends)
