@@ -51,6 +51,12 @@ def couple_sigma(kind: str, declared: float | None, gap: float, radius: float = 
     return 1.0 if gap >= 0.0 else -1.0
 
 
+# A couple of a pair whose side is declared (`couple_sigma`) found up to this far (m) on the
+# wrong side at a seek is a contact that came about between two seeks (the tracked and far
+# couples next to it moved on): it is tracked and takes part in the event's impact and modes.
+DECLARED_DEPTH = 1e-4
+
+
 def patches_cross(gap: float, distance: float, sigma: float, gap_tol: float) -> bool:
     """Rule: the contact-form couple is not the closest one (|g| > d) or lies on the wrong side of
     n (sigma g < 0), beyond ``gap_tol``: the patches cross each other past a patch end."""

@@ -196,7 +196,11 @@ class Transitions:
             gap = raw.gap
             sigma = hybrid.couple_sigma(p.kind, p.sigma, gap,
                                         p.patch1.radius if p.kind == "PS" else 0.0)
-            crossing = hybrid.patches_cross(gap, c.distance, sigma, opt.impact_gap_tol)
+            # A declared side (a ring face, solid on one side): a couple found a little on the
+            # wrong side is a contact made between two seeks, not patches crossing past an end.
+            crossing = hybrid.patches_cross(
+                gap, c.distance, sigma,
+                opt.impact_gap_tol if p.sigma is None or initial else hybrid.DECLARED_DEPTH)
         if initial and p.sigma is not None and (
                 (usable and sigma * gap < -opt.impact_gap_tol)
                 or (crossing and c.distance <= opt.impact_gap_tol)):
