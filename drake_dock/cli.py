@@ -5,8 +5,12 @@ the energy ledger, figures and a 3D replay out.
 outcomes of a run (the first that holds ends it):
   captured   the latches can engage: the rings within simulation.capture_distance axially,
              capture_lateral across and capture_tilt_deg in tilt
-  rebound    the rings separate with no couple in contact
-  jammed     the distance to capture has not fallen by 1 mm in simulation.jam_time
+  missed     the chaser passes beside the target (ring centres over 2 R apart across the
+             axis) or beyond its ring plane (over a petal height H behind it)
+  rebound    the rings separate: their distance above its start and growing, with no
+             thrust still to act (a couple may still graze)
+  jammed     the distance to capture has not fallen by 1 mm in simulation.jam_time while
+             no thrust is to act; the reason names the couples that hold the rings
   timeout    simulation.duration reached
 
 exit codes:

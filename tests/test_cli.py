@@ -8,6 +8,7 @@ import sys
 import pytest
 from pathlib import Path
 
+from drake_dock.cli import STUDIES
 from drake_dock.docking.output import MARKER, atomic_directory
 
 EXE = [sys.executable, "-m", "drake_dock.cli"]
@@ -133,7 +134,7 @@ def test_study_alone_lists_the_studies():
     assert r.returncode == 0, r.stderr
     listed = [line.split()[0] for line in r.stdout.split("studies:")[1].splitlines()
               if line.startswith("  ") and not line.startswith("    ")]
-    assert listed == ["speed-accuracy", "stability", "conditions", "roll"]
+    assert listed == list(STUDIES)
     for name in listed:
         r = _run(["study", name])
         assert r.returncode == 2 and r.stderr.startswith("drake-dock: bad input: --out is "

@@ -36,7 +36,7 @@ def test_tutorial_notebook_executes(tmp_path):
     assert re.search(rf"from the time series: peak force {re.escape(force)} N at "
                      rf"{re.escape(at)} s, peak stroke {re.escape(stroke)} mm", text)
     assert float(force) > 10.0
-    assert re.search(r"^cc_\w+ +(chaser|target) ring inside circle / .* +peak +\d", text, re.M)
+    assert re.search(r"^ *cc_\w+ +(chaser|target) ring inside circle / .* +peak +\d", text, re.M)
     # The thrust: 300 N, an impulse and a work that its force and windows bound.
     force_, impulse, work = map(float, re.search(
         r"^thrust: (\S+) N .* impulse (\S+) N s, work (\S+) J", text, re.M).groups())

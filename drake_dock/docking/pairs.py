@@ -83,9 +83,12 @@ def apds_pairs(g: ApdsGeometry, which: str = "paper") -> list[PairSpec]:
     (point-curve, `corner_pairs`), the guide sides vs the non-partner sides and tip arcs
     they reach (C-C, `side_edge_pairs`), the tip arcs vs the other APDS's tip arcs they reach
     (C-C, `tip_tip_pairs`), the petal corners vs the other APDS's guide surfaces
-    they reach (point-surface, `corner_surface_pairs`), and the two rings' outside circles (C-C,
-    cc_Crim_Trim, Body 1 the chaser's). Each pair carries its ``description`` in plain words
-    (`describe_pair`)."""
+    they reach (point-surface, `corner_surface_pairs`), the petal corners vs the other APDS's
+    tip lands (`corner_land_pairs`), and, where the petals stand on the ring's inside circle
+    (petal_root_radius <= Rs), the ring's outside circle vs the other APDS's guide sides and
+    surfaces (`rim_petal_pairs`). A rim meets the other ring only on its face (the ring solid's
+    outer edge is chamfered: docs/model.md, "APDS geometry"). Each pair carries its
+    ``description`` in plain words (`describe_pair`)."""
     if which not in PAIR_SETS:
         raise InputError("contact.pairs", which, f"one of {', '.join(PAIR_SETS)}")
     P = apds_patches(g)
@@ -294,8 +297,8 @@ def pair_handovers(g: ApdsGeometry, pairs) -> list:
     (`drake_dock.core.handover`): a ring's inside circle passes between guide surface k
     (cs_<X>ring_<Y>k) and its sides 2k - 1, 2k (cc_<X>ring_<Y><i>) and its tip arc
     (cc_<X>ring_<Y>tip<k>), `petal_edges`; a chaser tip arc j between target surface k
-    (cs_Ctip<j>_T<k>) and its tip arc (cc_Ctip<j>_Ttip<k>); the chaser's rim between the
-    target's face (cs_Crim_Tface) and the target's rim (cc_Crim_Trim)."""
+    (cs_Ctip<j>_T<k>) and its tip arc (cc_Ctip<j>_Ttip<k>); a ring's outside circle between
+    guide surface k (cs_<X>rim_<Y>k) and its sides (cc_<X>rim_<Y><i>)."""
     names = {p.name for p in pairs}
     out = []
     for j in (1, 2, 3):

@@ -239,8 +239,9 @@ class Transitions:
             ev.set_scratch(q, v)
             ps, tw = ev.frame_kinematics(ctx)
             for i, st in enumerate(states):
-                if st.mode != Mode.FAR:
-                    evs[i] = ev.couple(i, u[ev.couple_slice(i)], ps, tw, st.sigma, t)
+                if st.mode != Mode.FAR:     # a tracked couple that drifts is sought again
+                    evs[i] = ev.couple(i, u[ev.couple_slice(i)], ps, tw, st.sigma, t,
+                                       st.mode.in_contact)
             return ps
 
         def gaps_and_rates():

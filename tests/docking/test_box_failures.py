@@ -14,7 +14,9 @@ import pytest
 import yaml
 
 from drake_dock.cli import main
-from drake_dock.docking.scenario import MODELS_DIR
+from drake_dock.docking.results import summary, timeseries
+from drake_dock.docking.scenario import MODELS_DIR, load_scenario
+from drake_dock.docking.simulate import simulate
 
 
 def _run(tmp_path, data: dict, name: str, *extra) -> dict:
@@ -52,13 +54,16 @@ def test_five_centimetres_off_at_twice_the_speed_jams_at_the_lips(tmp_path):
                                                    "chaser_speed": 0.2}}, "offset_5cm"))
 
 
-def test_box_corner_pushed_at_500_newtons_runs_past_the_old_failure(tmp_path):
+def test_box_corner_pushed_at_500_newtons_runs_past_the_old_failure():
     """models/idss_box_corner.yaml with 500 N of thrust from the first contact: the chaser is
     pushed sideways off the lip. Run past 3.04 s, where a Painleve inconsistency ended it, the
-    run is a named outcome with the momentum balanced by the thrust's impulse."""
+    run is a named outcome with the momentum balanced by the thrust's impulse (the run alone,
+    without its figures and replay)."""
     data = yaml.safe_load((MODELS_DIR / "idss_box_corner.yaml").read_text())
     data["thrust"] = {"force": 500.0, "duration": 5.0}
-    s = _run(tmp_path, data, "corner_500N", "--duration", "3.2")
+    data.setdefault("simulation", {})["duration"] = 3.2
+    result = simulate(load_scenario(data=yaml.safe_dump(data)))
+    s = summary(result, timeseries(result))
     assert s["outcome"] in ("timeout", "missed", "jammed")
     assert s["end_time_s"] >= 3.04 or s["outcome"] == "missed"
     assert s["momentum_drift_relative"]["linear"] < 1e-8

@@ -225,14 +225,22 @@ def circle(r, n=2048, z=0.0):
 def test_a_ring_pushed_into_the_other_ring_lies_at_its_distance_to_the_nearest_face(
         geom, feature, points, offset, height, depth):
     """The chaser lowered from 5 mm above the target's ring face to ``height``, offset along x:
-    its deepest point lies min(-height, ring_depth + height, rho - Rs, R - rho) inside the
-    target's ring, rho the point's radius in the target's frame (and the reverse likewise);
+    its deepest point lies min(-z, ring_depth + z, rho - Rs, (R + z - rho) / sqrt 2) inside the
+    target's ring (the last term its 45 deg outer chamfer), z the sample's height and rho the
+    point's radius in the target's frame, deepest over the samples (and the reverse likewise);
     within the ring's chord error."""
     X = {"inside": circle(geom.Rs), "outside": circle(geom.R),
          "face": np.concatenate([circle(r, 256) for r in np.linspace(geom.Rs, geom.R, 9)[1:-1]])}
-    t, R_WA, p_WA = facing_path(np.linspace(5e-3, height, 26), (offset, 0.0))
+    heights = np.linspace(5e-3, height, 26)
+    t, R_WA, p_WA = facing_path(heights, (offset, 0.0))
     found = deepest_penetration_mesh(geom, t, R_WA, p_WA, NAMES, features={feature: X[points]})
-    assert found.depth == pytest.approx(depth, abs=sagittas(geom)["ring"])
+    rho = {"inside": geom.Rs + offset, "outside": geom.R - offset, "face": geom.Rs}[points]
+    if points == "face":                            # every face point lies on the solid's annulus
+        expected = max(min(-z, depth) for z in heights)
+    else:
+        expected = max(min(-z, rho - geom.Rs, (geom.R + z - rho) * math.sqrt(0.5))
+                       for z in heights)
+    assert found.depth == pytest.approx(expected, abs=sagittas(geom)["ring"])
     assert found.solid.endswith("apds ring")
 
 

@@ -215,7 +215,7 @@ def test_a_fast_sideways_approach_is_placed_at_its_consistent_first_contact():
     h = a.height(lam)
     aim = np.array(ic.lateral_offset) + h * np.array(ic.lateral_velocity) / ic.chaser_speed
     np.testing.assert_allclose(a.aim, aim, atol=1e-6)
-    lam_scan, names, _ = full_scan(ApdsGeometry(), a)
+    lam_scan, names, _ = full_scan(ApdsGeometry(), a, which=s.contact.pairs)
     assert lam == lam_scan and closing == names
 
 
@@ -237,15 +237,15 @@ def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there(monkey
     a, lam, closing = contact_approach(s)
     np.testing.assert_allclose(np.array(a.aim) - a.height(lam) * slope, offset, rtol=0,
                                atol=1e-8 * np.linalg.norm(slope))
-    lam_scan, names, _ = full_scan(s.geometry, a)
+    lam_scan, names, _ = full_scan(s.geometry, a, which=s.contact.pairs)
     assert lam == lam_scan and closing == names
-    pair, = [pr for pr in apds_pairs(s.geometry, "paper") if pr.name == "cs_Cring_T1"]
+    pair, = [pr for pr in apds_pairs(s.geometry, s.contact.pairs) if pr.name == "cs_Cring_T1"]
     failing = Approach(a.yaw, a.tilt, (-0.052305884320687224, -0.09989067043207144),
                        a.direction)
     lam_fail = 0.23063723414045384
     gap, _, dist = seek_gaps([pair], failing, lam_fail, [None])
     assert gap[0] == np.inf and 0 < dist[0] < 1e-4
-    converged = search.first_contact_or_faces(s.geometry, failing)
+    converged = search.first_contact_or_faces(s.geometry, failing, s.contact.pairs)
     original, failed = search._seek, []
 
     def seek(pr, approach, x, ref):
@@ -257,7 +257,8 @@ def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there(monkey
     monkeypatch.setattr(search, "_seek", seek)
     search._first_contact.cache_clear()
     try:
-        assert search.first_contact_or_faces(s.geometry, failing) == converged and failed
+        assert (search.first_contact_or_faces(s.geometry, failing, s.contact.pairs)
+                == converged and failed)
     finally:
         search._first_contact.cache_clear()
 
