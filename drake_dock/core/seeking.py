@@ -19,6 +19,10 @@ from drake_dock.core.couple import closest_point_conditions, point_curve_side
 from drake_dock.core.patches import Circle
 from drake_dock.errors import SeekingError
 
+# m: a Newton finish that creeps this near touching is a touch (`newton_closest`; the compiled
+# seek keeps the same rule, `drake_dock.core.kernels.seek`).
+CREEP_TOUCH = 1e-6
+
 
 @dataclasses.dataclass
 class Couple:
@@ -309,10 +313,12 @@ def newton_closest(P1, P2, u1, u2, *, tol=1e-14, max_iter=CLOSEST_MAX_ITER, dist
     else:
         # A nearly flat valley (a ring almost coaxial with a cone) can keep the iteration
         # creeping at a gradient of 1e-13: a point whose projected gradient is 1e-10 of
-        # |J| |d| is accepted (the distance is stationary there to second order). Otherwise
-        # report with the residual so that the caller can name the couple.
+        # |J| |d| is accepted (the distance is stationary there to second order), and so is
+        # one within CREEP_TOUCH of touching (a circle that pierces a face near its edge, where
+        # the minima form a curve: the contact-form finish and the modes take it as a touch).
+        # Otherwise report with the residual so that the caller can name the couple.
         norm_gfree = math.sqrt(sum(a * a for a in gfree))
-        if norm_gfree > 1e-10 * norm_J * norm_d:
+        if norm_gfree > 1e-10 * norm_J * norm_d and norm_d > CREEP_TOUCH:
             raise SeekingError(f"closest-couple Newton did not converge in {max_iter} iterations "
                                f"(projected gradient {norm_gfree:.3e})")
     u = np.array(u)

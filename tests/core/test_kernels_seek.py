@@ -3,6 +3,10 @@
 the APDS pairs at several poses and on small scenes. The couple itself agrees to the seek's own
 tolerance (1e-6 of the domain span here): where the distance is flat along a valley, a grid tie
 broken the other way ends the Newton finish at another point of the same valley."""
+import json
+import math
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -57,3 +61,38 @@ def test_undescribed_patch_is_not_supported():
     seg = Segment((0, 0, 0), (1, 0, 0))
     assert not compiled.supported(posed(curve, np.eye(3), np.zeros(3)),
                                   posed(seg, np.eye(3), np.zeros(3)))
+
+
+CREEPING = json.loads(Path(__file__).with_name("creeping_seeks.json").read_text())
+
+
+def _circle_to_annulus(P1, P2, s):
+    """Distance (closed form) of the circle's point at s to the annulus: |z| over it, else to
+    its nearer edge circle; in the annulus's frame."""
+    x = P2.R.T @ (np.asarray(P1.position(np.array([s]))) - P2.p)
+    rho, z = math.hypot(x[0], x[1]), x[2] - P2.patch.height
+    lo, hi = P2.patch.lower[0], P2.patch.upper[0]
+    return math.hypot(z, rho - min(max(rho, lo), hi))
+
+
+@pytest.mark.parametrize("case", CREEPING, ids=lambda c: c["pair"])
+def test_a_circle_through_a_face_near_its_edge_is_a_touch(case):
+    """The target's rim piercing the chaser's face a few um from its inside edge (IDSS plan
+    sample 0 on the paper's geometry): the minima form a curve and Newton creeps from one start.
+    Both seeks take it as a touch within CREEP_TOUCH, at the distance of a bounded 1-D
+    minimisation of the closed-form point-to-annulus distance over the circle."""
+    from scipy.optimize import minimize_scalar
+    pair = next(p for p in apds_pairs(ApdsGeometry(), "complete") if p.name == case["pair"])
+    P1 = posed(pair.patch1, np.array(case["R1"]), np.array(case["o1"]))
+    P2 = posed(pair.patch2, np.array(case["R2"]), np.array(case["o2"]))
+    rtol, beyond = case["kw"]
+    got = compiled.seek_couple(P1, P2, distance_rtol=rtol, rtol_beyond=beyond)
+    ref = seek_couple(P1, P2, distance_rtol=rtol, rtol_beyond=beyond)
+    grid = np.linspace(0.0, 2 * math.pi, 4001)
+    k = int(np.argmin([_circle_to_annulus(P1, P2, s) for s in grid]))
+    best = minimize_scalar(lambda s: _circle_to_annulus(P1, P2, s),
+                           bounds=(grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]),
+                           method="bounded", options={"xatol": 1e-12})
+    assert got.distance <= compiled.CREEP_TOUCH and ref.distance <= compiled.CREEP_TOUCH
+    assert got.distance == pytest.approx(best.fun, abs=1e-7)
+    assert ref.distance == pytest.approx(best.fun, abs=1e-7)

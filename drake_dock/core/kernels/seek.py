@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from drake_dock.core.kernels.jets import PETAL, jet, patch_spec, petal_point, petal_row, position
-from drake_dock.core.seeking import CLOSEST_MAX_ITER, FLAT, Couple
+from drake_dock.core.seeking import CLOSEST_MAX_ITER, CREEP_TOUCH, FLAT, Couple
 from drake_dock.errors import SeekingError
 
 EPS8 = 8 * np.finfo(float).eps
@@ -444,14 +444,19 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
                                   *_domain(pb, n_coarse), levels, n_fine, candidates,
                                   -1.0 if distance_rtol is None else float(distance_rtol),
                                   float(rtol_beyond))
-    if status.any():
-        raise SeekingError(f"closest-couple Newton did not converge in {CLOSEST_MAX_ITER} "
-                           "iterations")
-    best, dist = 0, np.inf
+    # The nearest couple. A start whose Newton did not converge (it creeps: a nearly flat
+    # valley, e.g. a ring's circle almost parallel to the other ring's face, or a circle that
+    # touches or pierces a face, where the minima form a curve) counts where it is not the
+    # nearest, or where it ended within CREEP_TOUCH of touching (the contact-form finish and
+    # the modes then take it as a touch); else it is an error.
+    best, dist = -1, np.inf
     for c in range(U.shape[0]):
         d = float(np.linalg.norm(X1[c] - X2[c]))
-        if c == 0 or d < dist:
+        if d < dist:
             best, dist = c, d
+    if status[best] and dist > CREEP_TOUCH:
+        raise SeekingError(f"closest-couple Newton did not converge in {CLOSEST_MAX_ITER} "
+                           f"iterations (at distance {dist:.3g} m)")
     return Couple(U[best, :1], U[best, 1:], X1[best], X2[best], dist, int(its[best]),
                   bool(interior[best]))
 
