@@ -11,8 +11,9 @@ import numpy as np  # noqa: E402
 from drake_dock.campaign.progress import ORDER  # noqa: E402
 
 BINS = 8
-_MARKERS = {"captured": ("o", "tab:green"), "rebound": ("^", "tab:orange"),
-            "jammed": ("s", "tab:purple"), "timeout": ("D", "tab:gray"), "error": ("x", "k")}
+_MARKERS = {"captured": ("o", "tab:green"), "missed": ("v", "tab:brown"),
+            "rebound": ("^", "tab:orange"), "jammed": ("s", "tab:purple"),
+            "timeout": ("D", "tab:gray"), "error": ("x", "k")}
 
 
 def axis_values(columns: dict, path: str) -> np.ndarray:
