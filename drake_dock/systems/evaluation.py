@@ -114,7 +114,7 @@ class PlantEvaluator:
             twists.append((V.rotational(), V.translational()))
         return poses, twists
 
-    def couple(self, i, u, poses, twists, sigma, time, strict=True):
+    def couple(self, i, u, poses, twists, sigma, time, strict):
         """Pair i's couple at u (Eq. 47); with ``strict`` (a couple in contact), `DriftError`
         when its projection step exceeds ``drift_tol`` of the domain span."""
         p = self.pairs[i]
