@@ -68,9 +68,9 @@ def main():
 
     def couples():
         for i, st in enumerate(modes.pairs):
-            ev.couple(i, u[ev.couple_slice(i)], poses, twists, st.sigma, 0.0)
+            ev.couple(i, u[ev.couple_slice(i)], poses, twists, st.sigma, 0.0, True)
 
-    evs = [ev.couple(i, u[ev.couple_slice(i)], poses, twists, st.sigma, 0.0)
+    evs = [ev.couple(i, u[ev.couple_slice(i)], poses, twists, st.sigma, 0.0, True)
            for i, st in enumerate(modes.pairs)]
 
     def rows():

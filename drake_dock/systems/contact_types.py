@@ -85,6 +85,9 @@ class ContactOptions:
                                      # "error", stop with it
     compiled: bool = True            # the couples, seeks, constraint solve and mode selection
                                      # by the compiled kernels (False: in Python)
+    engine: bool = True              # with compiled, and every body free: one compiled call
+                                     # per evaluation (`drake_dock.systems.engine`; False:
+                                     # the plant as calculator)
     lzb_compiled: bool = True        # LZB impacts by the compiled kernel (`solve_lzb`'s
                                      # compiled; False: scipy's DOP853, the reference;
                                      # docs/performance.md, "The compiled LZB")

@@ -14,14 +14,25 @@ from drake_dock.core.constraints import (SLIDE, STICK, ContactRow, friction_powe
                                          solve_given_modes)
 from drake_dock.core.couple import evaluate_couple, float_pose, float_vec
 from drake_dock.core.hybrid import Mode
+from drake_dock.core.kernels.constraints import raise_status
 from drake_dock.core.kernels.couples import DRIFT_REL as KERNEL_DRIFT_REL
 from drake_dock.core.kernels.couples import GAP as KERNEL_GAP
+from drake_dock.core.kernels.couples import ROW
+from drake_dock.core.kernels.engine import evaluate as engine_evaluate
+from drake_dock.core.kernels.solve import OK as ENGINE_OK
 from drake_dock.errors import DriftError, SingularCoupleError
+from drake_dock.systems import engine
 from drake_dock.systems.contact_types import Evaluation
+from drake_dock.systems.engine import ModePack, Poses
 from drake_dock.systems.far_pairs import FarPairs
 from drake_dock.systems.handovers import HandoverLinks
 
 KV = JacobianWrtVariable.kV
+
+
+def _floating_body_indices(plant):
+    from pydrake.multibody.tree import BodyIndex
+    return [BodyIndex(i) for i in range(1, plant.num_bodies())]
 
 
 def frame_list(pairs):
@@ -84,6 +95,15 @@ class PlantEvaluator:
         if options.compiled:
             from drake_dock.core.kernels import constraints as solver
             self.solver = solver
+        # The whole evaluation in one compiled call when every body moves freely and the
+        # kernels describe every pair (`drake_dock.systems.engine`).
+        self.engine = None
+        if self.kernel is not None and options.engine:
+            bodies = engine.free_bodies(plant, self.frames, self.ctx)
+            if bodies is not None:
+                self.engine = (bodies, engine.couple_set(self.kernel))
+                self._body_v = {plant.get_body(i).index(): int(j) for i, j in zip(
+                    _floating_body_indices(plant), bodies.vs)}
         self.far = FarPairs(pairs, self.fidx)
         # The point-curve pairs: their side witness (`witnesses`).
         self.side_pairs = frozenset(i for i, p in enumerate(self.pairs) if p.kind == "PC")
@@ -296,6 +316,8 @@ class PlantEvaluator:
         pairs not far, `near_pairs`)."""
         self.evaluations += 1
         near = near_pairs(modes) if near is None else near
+        if self.engine is not None and not any(i in self._in_python for i in near):
+            return self._evaluate_engine(t, x, modes, inputs, near)
         q, v, u = x[:self.nq], x[self.nq:self.nq + self.nv], x[self.nq + self.nv:self.ie]
         ctx = self.set_scratch(q, v)
         poses, twists = self.frame_kinematics(ctx)
@@ -330,6 +352,67 @@ class PlantEvaluator:
             [E.friction_power, E.applied_power, E.external_power, *E.extra_power])
             / self.energy_scale])
         return E
+
+    def _input_force(self, inputs):
+        """The generalized force of the inputs on free bodies: a body's wrench [torque, force]
+        (world frame, at its origin) is its generalized force."""
+        generalized, wrenches = inputs
+        tau = np.zeros(self.nv) if generalized is None else np.array(generalized, dtype=float)
+        for body, w in wrenches:
+            j = self._body_v[body.index()]
+            tau[j:j + 6] += w
+        return tau
+
+    def _mode_pack(self, modes, near):
+        """`engine.ModePack` of the modes, kept on their index (computed once when sealed)."""
+        derived = modes.index().derived
+        pack = derived.get("engine")
+        if pack is None or (pack[0] is not near and pack[0] != near):
+            pack = derived["engine"] = (near, ModePack(len(self.pairs), near, modes.pairs,
+                                                       self.kernel.pc.tolist()))
+        return pack[1]
+
+    def _evaluate_engine(self, t, x, modes, inputs, near) -> Evaluation:
+        """`evaluate` in one compiled call (`drake_dock.core.kernels.engine`); the plant gives
+        its force elements' generalized force."""
+        q, v, u = x[:self.nq], x[self.nq:self.nq + self.nv], x[self.nq + self.nv:self.ie]
+        ctx = self.set_scratch(q, v)
+        fe = self._forces_fe     # set, not added, by CalcForceElementsContribution
+        self.plant.CalcForceElementsContribution(ctx, fe)
+        tau_el = self.plant.CalcGeneralizedForces(ctx, fe)
+        pack = self._mode_pack(modes, near)
+        k, F = len(self.pairs), len(self.frames)
+        R, o = np.empty((F, 3, 3)), np.empty((F, 3))
+        w, vf = np.empty((F, 3)), np.empty((F, 3))
+        out = np.zeros((k, ROW))
+        xdot = np.empty(self.ie + 3 + len(self.extra_powers))
+        gf, lam_n, lam_t = np.empty(self.nv), np.empty(k), np.empty((k, 2))
+        opt = self.options
+        status, cond, bad_pc, bad_drift, fpow, p_el, p_in = engine_evaluate(
+            *self.engine, q, v, u, modes.index().sigma, pack.active, pack.rows, pack.codes,
+            pack.held_dir, pack.has_dir, tau_el, self._input_force(inputs), self.law.mu,
+            self.mu_s, opt.baumgarte, opt.v_slip, opt.drift_feedback, opt.drift_tol,
+            self.energy_scale, R, o, w, vf, out, xdot, lam_n, lam_t, gf)
+        if bad_pc >= 0:
+            raise SingularCoupleError("point-curve couple: the point lies on the curve "
+                                      "(|d| = 0), its normal is undefined", time=t,
+                                      couples=[self.pairs[bad_pc].name])
+        if bad_drift >= 0:
+            raise DriftError(f"couple drift {out[bad_drift, KERNEL_DRIFT_REL]:.3e} of the domain "
+                             f"span exceeds drift_tol = {opt.drift_tol:g}", time=t,
+                             couples=[self.pairs[bad_drift].name])
+        if status != ENGINE_OK:
+            raise_status(status, cond, pack.codes, [self.pairs[i].name for i in pack.rows], t)
+        evals = [None] * k
+        couple_eval = self.kernel.couple_eval
+        for i in near:
+            evals[i] = couple_eval(out, i)
+        extra = np.array([f(q, v) for _, f in self.extra_powers], dtype=float)
+        xdot[self.ie + 3:] = extra / self.energy_scale
+        nqv = self.nq + self.nv
+        return Evaluation(q, v, xdot[:self.nq], xdot[self.nq:nqv], xdot[nqv:self.ie], evals,
+                          lam_n, lam_t, gf, fpow, p_el, p_in, np.full(k, np.nan), {},
+                          Poses(R, o), extra, modes, xdot)
 
     def bound(self, E, i, st):
         """The travel bound of far pair i at the evaluation E, computed when a witness or an

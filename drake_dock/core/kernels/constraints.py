@@ -197,16 +197,22 @@ def solve_packed(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, *, ti
     vdot, lam_n, lam_t, gf = np.empty(nv), np.empty(k), np.empty((k, 2)), np.empty(nv)
     st, cond = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
                            lam_t, gf)
-    if st == NONFINITE:
+    if st != OK:
+        raise_status(st, cond, modes, names, time)
+    return vdot, lam_n, lam_t, gf
+
+
+def raise_status(status, cond, modes, names, time):
+    """The typed error of a solve's status other than OK (NONFINITE or SINGULAR) for the mode
+    codes ``modes`` of the couples ``names``."""
+    if status == NONFINITE:
         raise NumericalError(f"contact constraint equations not finite for modes "
                              f"{tuple(NAME[m] for m in modes)}", time=time,
                              couples=[c for c, m in zip(names, modes) if m != DETACH])
-    if st != OK:
-        raise SingularContactError(
-            f"contact constraint equations singular and inconsistent (cond = {cond:.3e}) for "
-            f"modes {tuple(NAME[m] for m in modes)}", time=time,
-            couples=[c for c, m in zip(names, modes) if m != DETACH])
-    return vdot, lam_n, lam_t, gf
+    raise SingularContactError(
+        f"contact constraint equations singular and inconsistent (cond = {cond:.3e}) for "
+        f"modes {tuple(NAME[m] for m in modes)}", time=time,
+        couples=[c for c, m in zip(names, modes) if m != DETACH])
 
 
 def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None):
