@@ -32,12 +32,16 @@ from typing import Callable
 class SurfaceEdge:
     """Curve E is the boundary of surface S where S's parameter ``fixed`` (0 or 1) is at its
     lower (``upper`` False) or upper bound; along it S's other parameter is ``to_surface(e)``
-    and, inversely, E's parameter is ``to_edge(f)``."""
+    and, inversely, E's parameter is ``to_edge(f)``. ``kernel_map`` states ``to_surface`` for
+    the compiled hand-over guard (`drake_dock.core.kernels.engine.handover_guard`):
+    ("affine", alpha, beta) for f = alpha e + beta, or ("component", c) for f = coordinate c
+    of E's point E(e) in its frame."""
 
     fixed: int
     upper: bool
     to_surface: Callable[[float], float]
     to_edge: Callable[[float], float]
+    kernel_map: tuple | None = None
 
     @property
     def free(self) -> int:

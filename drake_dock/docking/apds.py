@@ -293,13 +293,15 @@ def petal_edges(g: ApdsGeometry, k: int) -> dict:
     out = {}
     for i, upper in ((2 * k - 1, False), (2 * k, True)):
         side, phi, sigma = guide_side(g, i), side_root(g, i), side_sigma(i)
+        # zeta on the side is its point's z coordinate.
         out[i] = SurfaceEdge(0, upper, lambda th, side=side: side.parts(th)[1][0],
                              lambda z, phi=phi, sigma=sigma: phi + sigma * (
-                                 math.asin(m.A / (g.Rp - z * m.cot1)) - g.alpha2))
+                                 math.asin(m.A / (g.Rp - z * m.cot1)) - g.alpha2),
+                             ("component", 2))
     t1 = math.asin(m.A / (g.Rp - g.H * m.cot1)) - g.alpha2
     w = m.width - 2 * t1
     out["tip"] = SurfaceEdge(1, True, lambda th: (th - m.phi0 - t1) / w,
-                             lambda s: m.phi0 + t1 + s * w)
+                             lambda s: m.phi0 + t1 + s * w, ("affine", 1.0 / w, -(m.phi0 + t1) / w))
     return out
 
 

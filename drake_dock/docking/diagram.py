@@ -17,16 +17,19 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
+
 from pydrake.geometry import MeshcatVisualizer, SceneGraph
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 from pydrake.systems.framework import (DiagramBuilder, EventStatus, LeafSystem, PublishEvent,
                                        WitnessFunctionDirection)
 
+from drake_dock.core.kernels.free_bodies import frame_poses
 from drake_dock.systems.contact_system import (ContactOptions, ContactPair, Handover,
                                                 RigidContactSystem)
 from drake_dock.systems.simulator import tolerances
 from drake_dock.docking.outcome import CaptureRule, misalignment
-from drake_dock.docking.plant import DockingPlant, StewartDamperPower, make_docking_plant
+from drake_dock.docking.plant import DockingPlant, make_docking_plant
 from drake_dock.docking.pairs import pair_handovers, scenario_pairs
 from drake_dock.docking.thrust import ThrustSchedule, ThrustSystem
 
@@ -63,9 +66,16 @@ class CaptureMonitor(LeafSystem):
         self.dp = dp
         self.rule = rule
         self.capture_distance = float(rule.axial)
-        self._pc = dp.plant.CreateDefaultContext()
         self._nq = dp.plant.num_positions()
         self._last = (None, None)           # (positions as bytes, their misalignment)
+        # The two ring frames' poses from q in compiled code (`free_bodies.frame_poses`).
+        frames = (dp.apds_frames["target_apds"], dp.apds_frames["chaser_apds"])
+        bodies = [f.body() for f in frames]
+        self._qs = np.array([b.floating_positions_start() for b in bodies], dtype=np.int64)
+        self._fb = np.arange(2, dtype=np.int64)
+        X = [f.GetFixedPoseInBodyFrame() for f in frames]
+        self._R_BF = np.array([x.rotation().matrix() for x in X])
+        self._p_BF = np.array([x.translation() for x in X])
         n = dp.plant.num_positions() + dp.plant.num_velocities()
         self._state = self.DeclareVectorInputPort("state", n)
         self.DeclareVectorOutputPort("ring_distance", 1,
@@ -83,8 +93,9 @@ class CaptureMonitor(LeafSystem):
         if key != self._last[0]:
             # Drake asks again at equal positions (the witness at a step's end, the monitor,
             # the ring distance output): the last answer is kept.
-            self.dp.plant.SetPositions(self._pc, q)
-            self._last = (key, misalignment(*ring_poses(self.dp, self._pc)))
+            R, o = np.empty((2, 3, 3)), np.empty((2, 3))
+            frame_poses(self._qs, q, self._fb, self._R_BF, self._p_BF, R, o)
+            self._last = (key, misalignment(R[0], o[0], R[1], o[1]))
         return self._last[1]
 
     def distance(self, context) -> float:
@@ -101,6 +112,12 @@ class CaptureMonitor(LeafSystem):
 
     def witness_values(self, context) -> dict:
         return {"capture": self.to_go(context) - self.rule.axial}
+
+    def witness_layout(self, context):
+        return ("capture",)
+
+    def witness_array(self, context):
+        return np.array([self.to_go(context) - self.rule.axial])
 
 
 def contact_options(scenario, options: ContactOptions | None = None) -> ContactOptions:
@@ -135,7 +152,7 @@ def build_docking_diagram(scenario, meshcat=None, options=None,
     contact = builder.AddSystem(RigidContactSystem(
         dp.plant, pairs, scenario.contact, options,
         wrench_bodies=("chaser",) + ((("chaser_thrust", "chaser"),) if schedule else ()),
-        extra_powers=[("stewart_damper_work", StewartDamperPower(dp))],
+        dampers=[("stewart_damper_work", dp.bushing)],
         energy_scale=0.5 * scenario.bodies.chaser.mass * scenario.initial.chaser_speed ** 2
         or 1.0, handovers=[Handover(*h) for h in pair_handovers(scenario.geometry, specs)]
         if handovers else []))

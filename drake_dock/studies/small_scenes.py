@@ -99,7 +99,7 @@ def disk_on_incline(theta, *, mass=2.0, radius=0.3, mu=0.3, mu_s=None, restituti
             "rim_edge", "CC", rim, circle, plant.world_frame(),
             Segment([plane_end, -5.0, 0.0], [plane_end, 5.0, 0.0])))
         handovers.append(Handover("rim_edge", "rim_plane", SurfaceEdge(
-            0, True, lambda e: 10.0 * e, lambda f: 0.1 * f)))
+            0, True, lambda e: 10.0 * e, lambda f: 0.1 * f, ("affine", 10.0, 0.0))))
     system = RigidContactSystem(plant, pairs, ContactLaw(mu=mu, mu_s=mu_s,
                                                          restitution=restitution), options,
                                 handovers=handovers)

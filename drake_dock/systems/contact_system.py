@@ -63,15 +63,22 @@ from pydrake.systems.framework import (EventStatus, LeafSystem, UnrestrictedUpda
 
 from drake_dock.core.contact_law import ContactLaw
 from drake_dock.core.hybrid import Mode
-from drake_dock.errors import DriftError, InputError, ZenoError
+from drake_dock.core.kernels import couples as C
+from drake_dock.core.kernels import model as K
+from drake_dock.errors import (DriftError, InputError, NumericalError, SingularCoupleError,
+                               ZenoError)
 from drake_dock.systems import witnesses
 from drake_dock.systems.contact_types import (COUPLE_FIELDS, COUPLE_OUTPUT_SIZE, COUPLE_SLICES,
                                               ContactModes, ContactOptions, ContactPair,
-                                              Evaluation, Handover, PairState)
-from drake_dock.systems.evaluation import PlantEvaluator, drifting, near_pairs
+                                              Handover, PairState)
+from drake_dock.systems.engine import Engine, frame_list
+from drake_dock.systems.evaluation import Evaluation
+from drake_dock.systems.far_pairs import FarPairs
+from drake_dock.systems.handovers import HandoverLinks
 from drake_dock.systems.memo import Memo
 from drake_dock.systems.outputs import CoupleRows
 from drake_dock.systems.profiling import Timing
+from drake_dock.systems.reseek import reseek_far
 from drake_dock.systems.transitions import Transitions
 from drake_dock.systems.witnesses import FAR_WITNESS
 
@@ -102,50 +109,58 @@ def check_pairs(plant, pairs, energy_scale):
 
 
 class RigidContactSystem(LeafSystem):
-    """See the module docstring. ``plant`` is a finalized continuous-time MultibodyPlant (it
-    need not be part of the diagram); ``pairs`` the declared `ContactPair`s; ``wrench_bodies``
-    names bodies that get an input port ``<body>_wrench`` (6-vector [torque, force], world
-    frame, applied at the body origin), or holds (port name, body) for a further such port
-    (the wrenches on a body add up; their work is the ``input_work`` integral). ``extra_powers`` is a sequence of (name, f) with
-    f(q, v) -> power (W); each is integrated as continuous state and appended to the
-    ``energy`` output (e.g. the power of a damper, for an energy ledger). The energy integrals
-    are state in units of ``energy_scale`` (J): Drake's error control compares every state's
-    absolute error with the accuracy, so that integrals in joules of a run with kJ of kinetic
-    energy, not its motion, would set the step (the docking diagram passes the chaser's
-    kinetic energy; the ``energy`` output is in joules). ``handovers`` are the declared
-    `Handover`s between edge pairs and surface pairs (`drake_dock.core.handover`)."""
+    """See the module docstring. ``plant`` is a finalized continuous-time MultibodyPlant of free
+    bodies (it need not be part of the diagram; `drake_dock.systems.engine` says what it may
+    hold); ``pairs`` the declared `ContactPair`s; ``wrench_bodies`` names bodies that get an
+    input port ``<body>_wrench`` (6-vector [torque, force], world frame, applied at the body
+    origin), or holds (port name, body) for a further such port (the wrenches on a body add
+    up; their work is the ``input_work`` integral). ``dampers`` is a sequence of (name,
+    bushing): the work of each LinearBushingRollPitchYaw element's damping is integrated as
+    continuous state and appended to the ``energy`` output under its name (for an energy
+    ledger). The energy integrals are state in units of ``energy_scale`` (J): Drake's error
+    control compares every state's absolute error with the accuracy, so that integrals in
+    joules of a run with kJ of kinetic energy, not its motion, would set the step (the docking
+    diagram passes the chaser's kinetic energy; the ``energy`` output is in joules).
+    ``handovers`` are the declared `Handover`s between edge pairs and surface pairs
+    (`drake_dock.core.handover`)."""
 
     #: evaluations kept for reuse (`Memo`)
-    eval_memo_size = 16
+    eval_memo_size = 4
 
     def __init__(self, plant, pairs, law: ContactLaw = ContactLaw(),
-                 options: ContactOptions = ContactOptions(), wrench_bodies=(),
-                 extra_powers=(), energy_scale: float = 1.0, handovers=()):
+                 options: ContactOptions = ContactOptions(), wrench_bodies=(), dampers=(),
+                 energy_scale: float = 1.0, handovers=()):
         super().__init__()
         check_pairs(plant, pairs, energy_scale)
         law.validate("law")
         self.plant, self.pairs, self.law, self.options = plant, list(pairs), law, options
         self.energy_scale = float(energy_scale)
-        self.extra_powers = list(extra_powers)
-        self.evaluator = ev = PlantEvaluator(plant, pairs, law, options, self.extra_powers,
-                                             self.energy_scale, handovers)
+        self.frames, self.fidx = frame_list(self.pairs)
+        self.spans = [np.concatenate([p.patch1.span, p.patch2.span]) for p in self.pairs]
+        self.far = FarPairs(self.pairs, self.fidx)
+        self.links = HandoverLinks(self.pairs, handovers)
+        self.engine = ev = Engine(plant, self.pairs, law, options, self.frames, self.fidx,
+                                  self.links, self.far, dampers, self.energy_scale)
         self.nq, self.nv, self.nu, self.ie = ev.nq, ev.nv, ev.nu, ev.ie
+        # The point-curve pairs: their side witness (`witnesses`).
+        self.side_pairs = frozenset(i for i, p in enumerate(self.pairs) if p.kind == "PC")
         self.timing = Timing([p.name for p in pairs])
-        self.transitions = Transitions(ev, self.timing)
-        self._rows = CoupleRows(ev)
+        self.transitions = Transitions(self, self.timing)
+        self._rows = CoupleRows(self)
 
         # State: x = [q, v, u*, friction loss, work of plant forces, work of inputs,
-        #             integrals of extra_powers].
+        #             work of each damper].
         self.energy_names = ["kinetic", "potential", "friction_loss", "plant_work",
-                             "input_work", "impact_loss"] + [n for n, _ in self.extra_powers]
-        self.DeclareContinuousState(self.ie + 3 + len(self.extra_powers))
+                             "input_work", "impact_loss"] + list(ev.damper_names)
+        self.DeclareContinuousState(ev.nx)
         self._mode_index = self.DeclareAbstractState(AbstractValue.Make(
             ContactModes([PairState() for _ in pairs]).seal()))
         self._gf_port = self.DeclareVectorInputPort("generalized_force", self.nv)
         self._wrench_ports = {}
         for b in wrench_bodies:
             name, b = (f"{b}_wrench", b) if isinstance(b, str) else b
-            self._wrench_ports[name] = (plant.GetBodyByName(b),
+            body = plant.GetBodyByName(b)
+            self._wrench_ports[name] = (int(body.floating_velocities_start_in_v()),
                                         self.DeclareVectorInputPort(name, 6))
         self._cache = self.DeclareCacheEntry(
             "contact evaluation", ValueProducer(
@@ -165,10 +180,11 @@ class RigidContactSystem(LeafSystem):
             lambda context, state: self._on_event(context, None, state))
         if options.reseek_early > 0:
             self.DeclarePerStepUnrestrictedUpdateEvent(self._on_step)
-        self._w, self._w_far = witnesses.declare(self, pairs, self._witness,
+        self._w, self._w_far = witnesses.declare(self, pairs, self._witness_value,
+                                                 self._far_value,
                                                  UnrestrictedUpdateEvent(self._on_event))
-        # Evaluations by `PlantEvaluator.key`, reused under other modes through
-        # `Evaluation.under`; event results by (time, state, mode_changes).
+        # Evaluations by (time, state, modes, inputs); event results by (time, state,
+        # mode_changes).
         self._evaluations = Memo(self.eval_memo_size)
         self._events = Memo(1)
 
@@ -189,33 +205,42 @@ class RigidContactSystem(LeafSystem):
     def get_couple_output_port(self, name):
         return self._couple_ports[[p.name for p in self.pairs].index(name)]
 
+    def couple_slice(self, i) -> slice:
+        return slice(int(self.engine.uoff[i]), int(self.engine.uoff[i + 1]))
+
     @property
     def evaluations(self) -> int:
         """The number of evaluations computed (not reused) so far."""
-        return self.evaluator.evaluations
+        return self.engine.evaluations
 
     def eval(self, context) -> Evaluation:
         return self._cache.Eval(context)
 
     # ------------------------------------------------------------------ evaluation
-    def _inputs(self, context):
-        gf = self._gf_port.Eval(context) if self._gf_port.HasValue(context) else None
-        return gf, [(body, port.Eval(context)) for body, port in self._wrench_ports.values()
-                    if port.HasValue(context)]
+    def input_force(self, context) -> np.ndarray:
+        """The inputs' generalized force: the ``generalized_force`` input plus each body
+        wrench [torque, force] (world frame, at the body's origin), which is a free body's
+        generalized force."""
+        tau = (self._gf_port.Eval(context).copy() if self._gf_port.HasValue(context)
+               else np.zeros(self.nv))
+        for j, port in self._wrench_ports.values():
+            if port.HasValue(context):
+                tau[j:j + 6] += port.Eval(context)
+        return tau
 
     def _calc_eval(self, context, value):
-        with self.timing.measure("contact_dynamics"):
-            t, modes, inputs = context.get_time(), self.get_modes(context), self._inputs(context)
-            x = context.get_continuous_state_vector().CopyToVector()
-            near = near_pairs(modes)
-            key = self.evaluator.key(t, x, modes, inputs, near)
-            value.set_value(self._evaluations.get(
-                key, lambda: self._evaluate(t, x, modes, inputs, near),
-                refresh=lambda E: E if E.modes is modes else E.under(modes)))
+        t, modes = context.get_time(), self.get_modes(context)
+        x = context.get_continuous_state_vector().CopyToVector()
+        tau = self.input_force(context)
+        key = (t, x.tobytes(), modes_key(modes), tau.tobytes())
+        value.set_value(self._evaluations.get(key, lambda: self._evaluate(t, x, modes, tau)))
 
-    def _evaluate(self, t, x, modes, inputs, near) -> Evaluation:
-        self.timing.count_tracked([self.pairs[i].name for i in near])
-        return self.evaluator.evaluate(t, x, modes, inputs, near)
+    def _evaluate(self, t, x, modes, tau) -> Evaluation:
+        with self.timing.measure("contact_dynamics"):
+            E = self.engine.evaluate(t, x, modes, tau)
+        self.timing.count_tracked_indices(modes.index().far_not)
+        check_evaluation(self, E, t)
+        return E
 
     def DoCalcTimeDerivatives(self, context, derivatives):
         derivatives.get_mutable_vector().SetFromVector(self._cache.Eval(context).xdot)
@@ -227,21 +252,16 @@ class RigidContactSystem(LeafSystem):
     def _out_gf(self, context, out):
         out.SetFromVector(self._cache.Eval(context).contact_force)
 
+    def energy(self, E, modes) -> np.ndarray:
+        """[kinetic, potential (gravity and the bushings' springs), friction loss, work of the
+        plant's forces, work of the inputs, impact loss, work of each damper] (J,
+        `energy_names`) at the evaluation E under ``modes``."""
+        w = E.x[self.ie:] * self.energy_scale
+        return np.concatenate([[E.kinetic_energy, E.potential_energy, w[0], w[1], w[2],
+                                modes.impact_loss], w[3:]])
+
     def _out_energy(self, context, out):
-        """[kinetic, potential (plant elements that implement it), friction loss, work of the
-        plant's forces, work of the inputs, impact loss, integrals of extra_powers]
-        (`energy_names`)."""
-        E = self._cache.Eval(context)
-        x = context.get_continuous_state_vector().CopyToVector()
-        ctx = self.evaluator.set_scratch(E.q, E.v)
-        ke = 0.5 * E.v @ self.plant.CalcMassMatrix(ctx) @ E.v
-        try:
-            pe = self.plant.CalcPotentialEnergy(ctx)
-        except RuntimeError:
-            pe = math.nan
-        w = x[self.ie:] * self.energy_scale
-        out.SetFromVector(np.concatenate([[ke, pe, w[0], w[1], w[2],
-                                           self.get_modes(context).impact_loss], w[3:]]))
+        out.SetFromVector(self.energy(self._cache.Eval(context), self.get_modes(context)))
 
     def _out_first_contact(self, context, out):
         """The time of the first impact (s; every contact starts with one), +inf before it."""
@@ -249,24 +269,12 @@ class RigidContactSystem(LeafSystem):
         out.SetFromVector([impacts[0]["t"] if impacts else math.inf])
 
     def _out_couple(self, context, out, i):
-        y = np.zeros(COUPLE_OUTPUT_SIZE)
-        self._rows.fill(y, context.get_continuous_state_vector().CopyToVector(),
-                        self._cache.Eval(context), self.get_modes(context).pairs[i], i)
-        out.SetFromVector(y)
+        out.SetFromVector(self.couple_table(context)[i])
 
     def couple_table(self, context) -> np.ndarray:
         """All couples' outputs at once, row i the value of port ``couple_<pairs[i].name>``
         (for loggers: one call instead of one port evaluation per couple)."""
-        E = self._cache.Eval(context)
-        x = context.get_continuous_state_vector().CopyToVector()
-        Y = np.zeros((len(self.pairs), COUPLE_OUTPUT_SIZE))
-        states = self.get_modes(context).pairs
-        far = [i for i, c in enumerate(E.evals) if c is None]
-        for i, c in enumerate(E.evals):
-            if c is not None:
-                self._rows.fill(Y[i], x, E, states[i], i)
-        self._rows.fill_far(Y, x, E, states, far)
-        return Y
+        return self._rows.table(self._cache.Eval(context))
 
     # ------------------------------------------------------------------ witnesses
     def DoGetWitnessFunctions(self, context):
@@ -278,91 +286,183 @@ class RigidContactSystem(LeafSystem):
         derived = modes.index().derived
         hit = derived.get("armed")
         if hit is None:
-            hit = derived["armed"] = witnesses.armed(modes.pairs, self.evaluator.links.of_edge,
-                                                     self.evaluator.side_pairs)
+            hit = derived["armed"] = witnesses.armed(modes.pairs, self.links.of_edge,
+                                                     self.side_pairs)
         return hit
 
+    def armed_witnesses(self, context) -> "ArmedWitnesses":
+        """The witnesses `DoGetWitnessFunctions` returns now as arrays (`ArmedWitnesses`),
+        kept on the modes' index."""
+        modes = self.get_modes(context)
+        derived = modes.index().derived
+        hit = derived.get("armed_arrays")
+        if hit is None:
+            hit = derived["armed_arrays"] = ArmedWitnesses.of(self._armed(context), modes,
+                                                              self.pairs)
+        return hit
+
+    def witness_layout(self, context) -> tuple:
+        """The names of the armed witnesses (it changes whenever their set changes)."""
+        return self.armed_witnesses(context).names
+
+    def witness_array(self, context) -> np.ndarray:
+        """The values of the witnesses `DoGetWitnessFunctions` returns now, in the order of
+        `armed_witnesses` (the far pairs' first when armed)."""
+        E = self._cache.Eval(context)
+        a = self.armed_witnesses(context)
+        w = E.wv[a.pair, a.code]
+        return np.concatenate([[E.far_witness], w]) if a.far else w
+
+    def witness_rate_array(self, context) -> np.ndarray:
+        """The time derivative of each witness of `witness_array` where known, NaN elsewhere:
+        g' = v_n for the gap witnesses of the tracked couples."""
+        E = self._cache.Eval(context)
+        a = self.armed_witnesses(context)
+        d = np.full(len(a.pair), np.nan)
+        d[a.gap] = E.out[a.pair[a.gap], C.VN]
+        return np.concatenate([[np.nan], d]) if a.far else d
+
+    def witness_second_rate_array(self, context, mask) -> np.ndarray:
+        """Second time derivatives of the witnesses of `witness_array` in ``mask`` (gap
+        witnesses of tracked couples), g'' = W^3 . v' + b_n (Eq. 52) at the evaluation's
+        accelerations: a couple leaving an impact has no history in the new epoch from which
+        `WitnessApproach` could predict its landing. NaN elsewhere."""
+        E = self._cache.Eval(context)
+        a = self.armed_witnesses(context)
+        kin = self.engine.kinematics(E.q, E.v)
+        out = np.full(len(mask), np.nan)
+        off = 1 if a.far else 0
+        for j in np.flatnonzero(mask).tolist():
+            i = int(a.pair[j - off])
+            row = self.engine.row(i, E.evals[i], kin)
+            out[j] = float(row.Wn @ E.vdot + row.bn)
+        return out
+
     def witness_values(self, context) -> dict:
-        """The values of the witnesses `DoGetWitnessFunctions` returns now, by description
-        (used by `drake_dock.systems.stepping.WitnessApproach` to predict their zeros)."""
-        return {FAR_WITNESS if i is None else f"{self.pairs[i].name} {kind}":
-                self._witness(context, i, kind) for i, kind in self._armed(context)}
+        """The values of the witnesses `DoGetWitnessFunctions` returns now, by description."""
+        return dict(zip(self.armed_witnesses(context).names,
+                        self.witness_array(context).tolist()))
 
     def witness_rates(self, context) -> dict:
-        """Time derivatives of the gap witnesses of the tracked couples, by description:
-        g' = v_n (for `drake_dock.systems.stepping.WitnessApproach`)."""
-        out = {}
-        E = None
-        modes = self.get_modes(context)
-        for i in modes.index().near:
-            if modes.pairs[i].mode == Mode.TRACKED:
-                E = E or self._cache.Eval(context)
-                out[f"{self.pairs[i].name} gap"] = E.evals[i].vn
-        return out
+        """`witness_rate_array` by description, the known rates only."""
+        names = self.armed_witnesses(context).names
+        return {n: r for n, r in zip(names, self.witness_rate_array(context).tolist())
+                if not math.isnan(r)}
 
     def witness_second_rates(self, context, names) -> dict:
-        """Second time derivatives of the gap witnesses ``names`` (of tracked couples), g'' =
-        W^3 . v' + b_n (Eq. 52) at the evaluation's accelerations: a couple leaving an impact
-        has no history in the new epoch from which `WitnessApproach` could predict its
-        landing."""
-        E = self._cache.Eval(context)
-        ctx = self.evaluator.set_scratch(E.q, E.v)
-        out = {}
-        for i, p in enumerate(self.pairs):
-            if f"{p.name} gap" in names and E.evals[i] is not None:
-                row = self.evaluator.row(i, E.evals[i], E.poses, ctx)
-                out[f"{p.name} gap"] = float(row.Wn @ E.vdot + row.bn)
-        return out
+        """`witness_second_rate_array` by description, for the witnesses ``names``."""
+        all_names = self.armed_witnesses(context).names
+        mask = np.array([n in names for n in all_names])
+        return {n: r for n, r, m in zip(all_names,
+                                        self.witness_second_rate_array(context, mask).tolist(),
+                                        mask) if m}
 
     def witness_epoch(self, context) -> int:
         """Changes whenever an event has changed the state or the modes (a witness's history
         from before it is not continued by its values after it)."""
         return self.get_modes(context).mode_changes
 
-    def _witness(self, context, i, kind):
-        """The value of witness ``kind`` of pair i, kept on the evaluation (Drake evaluates
-        every witness at both ends of every step, and `WitnessApproach` asks for them again:
-        each is computed once per evaluation)."""
-        E = self._cache.Eval(context)
-        key = (i, kind)
-        w = E.witness.get(key)
-        if w is None:
-            st = None if i is None else self.get_modes(context).pairs[i]
-            w = E.witness[key] = witnesses.value(kind, self.evaluator, E, st, i)
-        return w
+    def _witness_value(self, context, i, code):
+        """The value of pair i's witness of kind ``code`` (`engine.W_GAP` ...), computed by
+        the evaluation (Drake evaluates every witness at both ends of every step)."""
+        return float(self._cache.Eval(context).wv[i, code])
+
+    def _far_value(self, context):
+        return self._cache.Eval(context).far_witness
 
     # ------------------------------------------------------------------ events
     def _on_step(self, context, state):
         """Per-step event: far pairs whose travel bound has used ``reseek_early`` of their
-        clearance, and tracked couples that drifted (`drifting`), are sought
-        again at the start of this step (with every other transition due, as at a witness
-        event). The clearance witness stays the guarantee; sought a little early, a pair needs
-        no isolated event."""
-        modes = self.get_modes(context)
+        clearance are sought again at the start of this step (`Transitions.reseek_far`); a
+        couple that drifted beyond ``drift_tol`` (a tracked one is sought again, one in contact
+        projected) takes an event with every other transition due, as at a witness event.
+        The clearance witness stays the guarantee; sought a little early, a pair needs no
+        isolated event."""
         E = self._cache.Eval(context)
+        if E.drifting < 0 and not E.due:
+            return EventStatus.DidNothing()
         early = self.options.reseek_early
-        if drifting(self.evaluator, E, modes.pairs):
-            return self._on_event(context, None, state, early=early)
-        index = modes.index()
-        far = index.far
-        if not index.sought.any():
-            return EventStatus.DidNothing()
-        if E.modes is modes:        # E's own bounds, all far pairs' at once
-            self.evaluator.bound(E, int(far[0]), modes.pairs[far[0]])
-            bound = E.bound[far]
-        else:
-            bound = self.evaluator.far.bounds(far.tolist(), E.poses, modes.pairs)
-        if not (index.sought & (bound >= early * index.clearance)).any():
-            return EventStatus.DidNothing()
+        if E.drifting < 0:
+            x = context.get_continuous_state_vector().CopyToVector()
+            done = reseek_far(self.transitions, context.get_time(), x,
+                              self.get_modes(context), E, early)
+            if done is not None:
+                state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(done[0])
+                state.get_mutable_abstract_state(self._mode_index).set_value(done[1])
+                return EventStatus.Succeeded()
         return self._on_event(context, None, state, early=early)
 
     def _on_event(self, context, event, state, early=1.0):
         x = context.get_continuous_state_vector().CopyToVector()
         t, modes = context.get_time(), self.get_modes(context)
+        if event is None and modes.mode_changes == 0:
+            self._evaluations.clear()           # a run starts: nothing of another is reused
         x_new, modes_new = self._events.get(
             (t, x.tobytes(), modes.mode_changes),
-            lambda: self.transitions.resolve(t, x, modes, self._inputs(context),
+            lambda: self.transitions.resolve(t, x, modes, self.input_force(context),
                                              lambda: self._cache.Eval(context), early))
         state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(x_new)
         state.get_mutable_abstract_state(self._mode_index).set_value(copy.deepcopy(modes_new))
         return EventStatus.Succeeded()
+
+
+class ArmedWitnesses:
+    """The armed witnesses of a set of modes as arrays: their names (the far pairs' first,
+    when ``far``), and of the pairs' witnesses their pair, kind code and whether a gap
+    witness of a tracked couple (``gap``, a mask)."""
+
+    __slots__ = ("names", "pair", "code", "far", "gap")
+
+    def __init__(self, names, pair, code, far, gap):
+        self.names, self.pair, self.code, self.far, self.gap = names, pair, code, far, gap
+
+    @classmethod
+    def of(cls, armed, modes, pairs) -> "ArmedWitnesses":
+        per = [(i, kind) for i, kind in armed if i is not None]
+        names = tuple(FAR_WITNESS if i is None else
+                      f"{pairs[i].name} {witnesses.WITNESSES[kind][0]}" for i, kind in armed)
+        pair = np.array([i for i, _ in per], dtype=np.intp)
+        code = np.array([witnesses.CODE[kind] for _, kind in per], dtype=np.intp)
+        gap = np.array([kind == "gap" and modes.pairs[i].mode == Mode.TRACKED
+                        for i, kind in per], dtype=bool)
+        return cls(names, pair, code, any(i is None for i, _ in armed), gap)
+
+
+def modes_key(modes) -> tuple:
+    """What an evaluation reads of the modes, as a hashable key (kept on their index): per pair
+    not far its mode, sigma and held sliding direction; the far pairs' data by the events and
+    reseeks that set them (within one run)."""
+    derived = modes.index().derived
+    key = derived.get("key")
+    if key is None:
+        pairs = modes.pairs
+        key = derived["key"] = (
+            tuple((i, int(pairs[i].mode), pairs[i].sigma,
+                   None if pairs[i].slide_dir is None else np.asarray(pairs[i].slide_dir,
+                                                                      float).tobytes())
+                  for i in modes.index().near), modes.mode_changes, modes.reseeks)
+    return key
+
+
+def check_evaluation(system, E, t):
+    """The typed error of an evaluation that reports one (`engine.evaluate`'s status): a
+    point-curve couple's point on its curve, a bushing at its gimbal lock, a constraint solve
+    that is singular or not finite. (A couple that drifted beyond ``drift_tol`` is projected
+    again at the next step's start, `_on_step`; at an event it raises `DriftError` if the
+    projection does not bring it back, `Transitions.couples_of`.)"""
+    sc, pairs = E.sc, system.pairs
+    bad = int(sc[K.S_BAD_PC])
+    if bad >= 0:
+        raise SingularCoupleError("point-curve couple: the point lies on the curve (|d| = 0), "
+                                  "its normal is undefined", time=t, couples=[pairs[bad].name])
+    if int(sc[K.S_BUSH]) != 0:
+        raise NumericalError("a bushing (LinearBushingRollPitchYaw) is at its gimbal lock "
+                             "(pitch +-90 deg) or not finite", time=t,
+                             couples=[p.name for i, p in enumerate(pairs)
+                                      if E.modes.pairs[i].mode.in_contact])
+    status = int(sc[K.S_STATUS])
+    if status != 0:            # solve.OK
+        from drake_dock.core.kernels.constraints import raise_status
+        rows = [i for i in E.modes.index().near if E.modes.pairs[i].mode.in_contact]
+        codes = [0 if E.modes.pairs[i].mode == Mode.STICKING else 1 for i in rows]
+        raise_status(status, float(sc[K.S_COND]), codes, [pairs[i].name for i in rows], t)

@@ -14,7 +14,7 @@ from drake_dock.core.hybrid import Mode
 from drake_dock.errors import InputError
 
 __all__ = ["COUPLE_FIELDS", "COUPLE_OUTPUT_SIZE", "COUPLE_SLICES", "ContactLaw", "ContactModes",
-           "ContactOptions", "ContactPair", "Evaluation", "Handover", "ModesIndex",
+           "ContactOptions", "ContactPair", "Handover", "ModesIndex",
            "PairState", "SurfaceEdge"]
 
 # Layout of each couple's output port; "status" is the pair's `Mode` (0 far, 1 tracked,
@@ -83,11 +83,6 @@ class ContactOptions:
     painleve: str = "impact"         # no consistent mode (`PainleveInconsistency`): "impact",
                                      # an impact without collision (`drake_dock.core.iwc`), or
                                      # "error", stop with it
-    compiled: bool = True            # the couples, seeks, constraint solve and mode selection
-                                     # by the compiled kernels (False: in Python)
-    engine: bool = True              # with compiled, and every body free: one compiled call
-                                     # per evaluation (`drake_dock.systems.engine`; False:
-                                     # the plant as calculator)
     lzb_compiled: bool = True        # LZB impacts by the compiled kernel (`solve_lzb`'s
                                      # compiled; False: scipy's DOP853, the reference;
                                      # docs/performance.md, "The compiled LZB")
@@ -156,7 +151,8 @@ class ContactModes:
     pairs: list                     # a tuple once sealed
     impacts: list = dataclasses.field(default_factory=list)   # dicts: t, couples, impulses
     impact_loss: float = 0.0
-    mode_changes: int = 0
+    mode_changes: int = 0           # events that resolved transitions
+    reseeks: int = 0                # steps whose start sought far pairs again, nothing else
 
     def __setattr__(self, name, value):
         if "_index" in self.__dict__:
@@ -173,7 +169,8 @@ class ContactModes:
         index = self.__dict__.get("_index")
         if index is None:
             return self.working_copy()
-        new = ContactModes(self.pairs, list(self.impacts), self.impact_loss, self.mode_changes)
+        new = ContactModes(self.pairs, list(self.impacts), self.impact_loss, self.mode_changes,
+                           self.reseeks)
         new.__dict__["_index"] = index
         return new
 
@@ -186,9 +183,9 @@ class ContactModes:
     def working_copy(self) -> "ContactModes":
         """A copy whose pair states an event may change (not sealed)."""
         return ContactModes(copied_states(self.pairs), list(self.impacts), self.impact_loss,
-                            self.mode_changes)
+                            self.mode_changes, self.reseeks)
 
-    def seal(self) -> "ContactModes":
+    def seal(self, index: "ModesIndex | None" = None) -> "ContactModes":
         """Marks these modes as final: a context holds them, and neither they nor their pair
         states change again (a change raises; the pairs become a tuple). What the evaluations
         and witnesses read of them (`index`) is then computed once, not in a pass over every
@@ -196,7 +193,7 @@ class ContactModes:
         self.pairs = tuple(self.pairs)
         for st in self.pairs:
             st.__dict__["_sealed"] = True
-        self.__dict__["_index"] = ModesIndex.of(self.pairs)
+        self.__dict__["_index"] = ModesIndex.of(self.pairs) if index is None else index
         return self
 
     def index(self) -> "ModesIndex":
@@ -205,9 +202,21 @@ class ContactModes:
         return ModesIndex.of(self.pairs) if index is None else index
 
 
+def _patched(a, at, values):
+    b = a.copy()
+    b[at] = values
+    b.flags.writeable = False
+    return b
+
+
 def _read_only(a):
     a.flags.writeable = False
     return a
+
+
+# What `ModesIndex.derived` keeps that depends only on which pairs are near and far and on
+# their modes (not on far-pair data).
+LAYOUT_DERIVED = ("armed", "armed_arrays", "far_u")
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -226,45 +235,32 @@ class ModesIndex:
     sought: np.ndarray
     sigma: np.ndarray
     derived: dict
+    far_not: np.ndarray = None     # ``near`` as an array
+
+    def with_far(self, changed, states) -> "ModesIndex":
+        """This index for ``states`` where only the far pairs ``changed`` (still far) have new
+        far-pair data: the same pairs near and far, their clearances, distances and whether
+        sought patched; what the contact system derived of the modes' layout (the armed
+        witnesses) kept, the rest of ``derived`` dropped."""
+        at = np.searchsorted(self.far, changed)
+        keep = {k: v for k, v in self.derived.items() if k in LAYOUT_DERIVED}
+        return ModesIndex(self.near, self.far,
+                          _patched(self.clearance, at, [states[i].clearance for i in changed]),
+                          _patched(self.distance, at, [states[i].distance for i in changed]),
+                          _patched(self.sought, at, [states[i].ref_X21 is not None
+                                                     for i in changed]),
+                          self.sigma, keep, self.far_not)
 
     @staticmethod
     def of(states) -> "ModesIndex":
         FAR = Mode.FAR
         far = [i for i, st in enumerate(states) if st.mode == FAR]
+        near = tuple(i for i, st in enumerate(states) if st.mode != FAR)
         return ModesIndex(
-            tuple(i for i, st in enumerate(states) if st.mode != FAR),
+            near,
             _read_only(np.array(far, dtype=np.intp)),
             _read_only(np.array([states[i].clearance for i in far], dtype=float)),
             _read_only(np.array([states[i].distance for i in far], dtype=float)),
             _read_only(np.array([states[i].ref_X21 is not None for i in far], dtype=bool)),
-            np.array([st.sigma for st in states], dtype=float), {})
-
-
-@dataclasses.dataclass
-class Evaluation:
-    """One evaluation of the contact dynamics at a context (`drake_dock.systems.evaluation`)."""
-
-    q: np.ndarray
-    v: np.ndarray
-    qdot: np.ndarray
-    vdot: np.ndarray
-    udot: np.ndarray
-    evals: list            # CoupleEval or None (far) per pair
-    lam_n: np.ndarray
-    lam_t: np.ndarray
-    contact_force: np.ndarray
-    friction_power: float
-    applied_power: float
-    external_power: float
-    bound: np.ndarray      # relative travel bound per far pair (NaN until asked)
-    witness: dict          # witness values computed at this evaluation, by (pair, kind)
-    poses: list
-    extra_power: np.ndarray
-    modes: object = None   # the ContactModes this evaluation was made with
-    xdot: np.ndarray = None  # the state's time derivative
-
-    def under(self, modes) -> Evaluation:
-        """This evaluation under other modes that differ only in far-pair data (a far pair
-        sought again at a step start): fresh travel bounds and witness values."""
-        return dataclasses.replace(self, modes=modes, witness={},
-                                   bound=np.full(len(self.bound), np.nan))
+            np.array([st.sigma for st in states], dtype=float), {},
+            _read_only(np.array(near, dtype=np.intp)))

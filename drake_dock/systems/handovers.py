@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 
 from drake_dock.core import handover as rule
-from drake_dock.core.couple import evaluate_couple
 
 
 class HandoverLinks:
@@ -82,10 +81,10 @@ def applied(due: dict) -> dict:
     return {j: i for i, (j, _) in due.items() if j not in due and targets.count(j) == 1}
 
 
-def accepts(ev, i, to, n, poses, twists) -> bool:
-    """Rules for a hand-over due from pair i of the `PlantEvaluator` ``ev`` (couple normal n)
-    to pair j (``to`` = (j, j's couple on the edge)), on j's couple there (Eq. 47, with the
-    sigma that keeps n):
+def accepts(ev, i, to, n, kin) -> bool:
+    """Rules for a hand-over due from pair i of the `RigidContactSystem` ``ev`` (couple normal
+    n; the bodies' `Kinematics` kin) to pair j (``to`` = (j, j's couple on the edge)), on j's
+    couple there (Eq. 47, with the sigma that keeps n):
     - j's couple must be regular (conditioning above ``conditioning_min``): a ring coaxial
       with a petal's cone has no isolated couple with it, and a singular couple would jump at
       its first projection.
@@ -100,15 +99,11 @@ def accepts(ev, i, to, n, poses, twists) -> bool:
     When a rule fails, pair i keeps its couple; a surface couple past its edge is then sought
     again, as at any domain end."""
     j, uj = to
-    p = ev.pairs[j]
-    a, b = ev.fidx[j]
-    still = (np.zeros(3),) * 2
-    raw = evaluate_couple(p.kind, p.patch1, poses[a], still, p.patch2, poses[b], still, uj,
-                          1.0, project=False)
-    cj = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2, poses[b],
-                         twists[b], uj, rule.carried_sigma(n, raw.n))
+    eng = ev.engine
+    raw = eng.couple(j, uj, kin.still(), 1.0, project=False)
+    cj = eng.couple(j, uj, kin, rule.carried_sigma(n, raw.n))
     if cj.conditioning <= ev.options.conditioning_min:
         return False
-    if (np.abs(cj.drift) / ev.spans[j]).max() > ev.options.drift_tol:
+    if (np.abs(cj.drift) / eng.model.spans[j, :len(cj.drift)]).max() > ev.options.drift_tol:
         return False
     return i not in ev.links.of_edge or ev.links.outward_rate(j, i, cj.udot) < 0.0

@@ -1,6 +1,6 @@
 """The impulsive transitions of a contact set, logged in its `ContactModes`: the LZB impact of
 the couples hit (Sect. 6, with the Zeno guard) and the impact without collision at a Painleve
-paradox (`drake_dock.core.iwc`). ``ev`` is the `PlantEvaluator`. Each entry of the log holds
+paradox (`drake_dock.core.iwc`). ``ev`` is the `RigidContactSystem`. Each entry of the log holds
 v_plus, the velocity just after its impulse, and impact_loss_plus, the impact loss booked by
 then (`Transitions.resolve` turns them into the states just before and after it)."""
 from __future__ import annotations
@@ -24,21 +24,21 @@ def admit(ev, t, modes, couples):
                         couples=couples)
 
 
-def lzb_impact(ev, t, modes, ctx, poses, evs, S, v):
-    """The LZB impact of the couples S (their `CoupleEval`s in evs), logged in ``modes``
-    (`admit`); returns (v+, the couples' v_n+, the approach speed)."""
+def lzb_impact(ev, t, modes, kin, evs, S, v):
+    """The LZB impact of the couples S (their couples in evs, the bodies' `Kinematics` kin),
+    logged in ``modes`` (`admit`); returns (v+, the couples' v_n+, the approach speed)."""
     opt, law = ev.options, ev.law
     names = [ev.pairs[i].name for i in S]
     admit(ev, t, modes, names)
-    rows = [ev.row(i, evs[i], poses, ctx) for i in S]
+    rows = [ev.engine.row(i, evs[i], kin) for i in S]
     Wn = np.column_stack([r.Wn for r in rows])
     Wt = np.column_stack([r.Wt for r in rows])
-    M = ev.plant.CalcMassMatrix(ctx)
+    M = ev.engine.mass_matrix(kin)
     approach = float(-min(r.vn for r in rows))
     e = hybrid.zeno_restitution(approach, law.restitution, opt.zeno_speed)
     def solve(compiled):
         return solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt, mu=law.mu,
-                         mu_s=ev.mu_s, law=law.impact_law, rtol=opt.impact_rtol,
+                         mu_s=law.static_mu, law=law.impact_law, rtol=opt.impact_rtol,
                          compiled=compiled)
     try:
         try:
@@ -72,7 +72,7 @@ def without_collision(ev, t, modes, M, rows, v, paradox):
     admit(ev, t, modes, [r.name for r in rows])
     Wn = np.column_stack([r.Wn for r in rows])
     Wt = np.column_stack([r.Wt for r in rows])
-    res = impact_without_collision(M, Wn, Wt, v, ev.mu_s)
+    res = impact_without_collision(M, Wn, Wt, v, ev.law.static_mu)
     if res is None:
         raise PainleveInconsistency(
             "no consistent contact mode (Painleve inconsistency), and the impact without "

@@ -19,6 +19,9 @@ that depend on nothing outside its key (an evaluation's witness values)."""
         self.size = size
         self._items = {}
 
+    def clear(self):
+        self._items.clear()
+
     def get(self, key, compute, refresh=None):
         hit = self._items.get(key)
         if hit is not None:

@@ -5,6 +5,8 @@ import contextlib
 import dataclasses
 from time import perf_counter
 
+import numpy as np
+
 PARTS = ("seeking", "contact_dynamics", "impacts")
 
 
@@ -25,9 +27,20 @@ class Timing:
     seek_time: dict = dataclasses.field(default_factory=dict)  # s per pair: seeks, screens
     tracked: dict = dataclasses.field(default_factory=dict)    # evaluations with the pair tracked
 
+    _tracked: object = None
+
     def reset(self):
         self.seeking = self.contact_dynamics = self.impacts = 0.0
         self.seeks, self.screens, self.seek_time, self.tracked = {}, {}, {}, {}
+        self._tracked = None
+
+    def tracked_counts(self) -> dict:
+        """Per pair, the evaluations in which it was tracked."""
+        counts = {n: self.tracked.get(n, 0) for n in self.pairs}
+        if self._tracked is not None:
+            for n, c in zip(self.pairs, self._tracked.tolist()):
+                counts[n] += c
+        return counts
 
     @contextlib.contextmanager
     def measure(self, part: str, pair: str | None = None):
@@ -47,6 +60,13 @@ class Timing:
         for n in names:
             self.tracked[n] = self.tracked.get(n, 0) + 1
 
+    def count_tracked_indices(self, index):
+        """One evaluation with the pairs at the positions ``index`` (an array into ``pairs``)
+        tracked."""
+        if self._tracked is None or len(self._tracked) != len(self.pairs):
+            self._tracked = np.zeros(len(self.pairs), dtype=np.int64)
+        self._tracked[index] += 1
+
     def count_seek(self, pair: str):
         self.seeks[pair] = self.seeks.get(pair, 0) + 1
 
@@ -64,4 +84,4 @@ class Timing:
                 "seeks_per_pair": {n: self.seeks.get(n, 0) for n in self.pairs},
                 "screens_per_pair": {n: self.screens.get(n, 0) for n in self.pairs},
                 "seek_time_per_pair": {n: self.seek_time.get(n, 0.0) for n in self.pairs},
-                "tracked_evaluations_per_pair": {n: self.tracked.get(n, 0) for n in self.pairs}}
+                "tracked_evaluations_per_pair": self.tracked_counts()}

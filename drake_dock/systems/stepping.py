@@ -15,61 +15,48 @@ bisection (to 0.95 w, inside the window) isolates it. The secant converges super
 steps. Events, their times and the integration's error control are Drake's own; only the
 maximum step size changes, and it returns to its configured value after each event.
 
-Sources are systems with ``witness_values(context) -> {name: value}`` (the values of the
-witness functions they return now, all with direction positive-then-non-positive) and
-optionally ``witness_epoch(context)``, which changes whenever an event changes their state or
-modes (values from different epochs are not joined by a secant), and ``witness_rates(context)
--> {name: dw/dt}`` with ``witness_second_rates(context, names) -> {name: d2w/dt2}`` for
-witnesses whose derivatives they know (a couple's gap): those are also predicted by their
-Taylor parabola, the second derivative taken from the last two rates, or asked for at the
-first point of an epoch (just after an impact, where no history predicts the landing).
+Sources are systems with ``witness_array(context)`` (the values of the witness functions
+they return now, all with direction positive-then-non-positive, as an array), ``witness_layout(
+context)`` (a value, compared with ==, that changes whenever the set of witnesses changes), and optionally
+``witness_epoch(context)``, which changes whenever an event changes their state or modes
+(values from different epochs are not joined by a secant), ``witness_rate_array(context)``
+(each witness's time derivative where the source knows it, NaN elsewhere: a couple's gap) and
+``witness_second_rate_array(context, mask)`` (second derivatives of the witnesses in ``mask``):
+those are also predicted by their Taylor parabola, the second derivative taken from the last
+two rates, or asked for at the first point of an epoch (just after an impact, where no history
+predicts the landing). The predictions are compiled (`drake_dock.core.kernels.leads`), over
+all witnesses at once.
 """
 import math
 
+import numpy as np
 
-def _lead(pts) -> float:
-    """Time from the last of ``pts`` [(t, w), ...] (up to three, w > 0 at the last) to the
-    predicted zero of w: the earlier of the secant through the last two and of the parabola
-    through the last three (a witness falling ever faster, such as the gap of a couple
-    accelerating towards contact, is reached earlier than its secant says). inf if neither
-    predicts a zero ahead."""
-    lead = math.inf
-    if len(pts) < 2:
-        return lead
-    (t1, w1), (t2, w2) = pts[-2], pts[-1]
-    s12 = (w2 - w1) / (t2 - t1)
-    if s12 < 0.0:
-        lead = w2 / -s12
-    if len(pts) == 3:
-        t0, w0 = pts[0]
-        s01 = (w1 - w0) / (t1 - t0)
-        c = (s12 - s01) / (t2 - t0)            # w(t2 + h) = w2 + b h + c h^2
-        b = s12 + c * (t2 - t1)
-        if c != 0.0:
-            disc = b * b - 4.0 * c * w2
-            if disc >= 0.0:
-                r = math.sqrt(disc)
-                # roots h = (-b -+ r) / (2c), written without cancellation
-                q = -0.5 * (b + math.copysign(r, b))
-                roots = [h for h in (q / c, w2 / q if q != 0.0 else math.inf) if h > 0.0]
-                if roots:
-                    lead = min(lead, min(roots))
-    return lead
+from drake_dock.core.kernels.leads import earliest_zero, lead_jet as _lead_jet
 
 
-def _lead_jet(w, wd, wdd) -> float:
-    """Time to the first zero of w + wd h + wdd h^2 / 2 (the witness's own derivatives), inf if
-    none ahead."""
-    a, b, c = 0.5 * wdd, wd, w
-    if a == 0.0:
-        return -c / b if b < 0.0 else math.inf
-    disc = b * b - 4.0 * a * c
-    if disc < 0.0:
-        return math.inf
-    r = math.sqrt(disc)
-    q = -0.5 * (b + math.copysign(r, b))
-    roots = [h for h in (q / a, c / q if q != 0.0 else math.inf) if h > 0.0]
-    return min(roots) if roots else math.inf
+class _History:
+    """A source's last three points (times, values, rates) of one epoch and witness layout."""
+
+    __slots__ = ("key", "T", "W", "D", "n")
+
+    def __init__(self, key, t, w, d):
+        self.key = key
+        self.T = np.full(3, np.nan)
+        self.W = np.zeros((3, len(w)))
+        self.D = np.full((3, len(w)), np.nan)
+        self.n = 0
+        self.add(t, w, d)
+
+    def add(self, t, w, d):
+        """The point at t (replacing the last one at the same time or later)."""
+        if self.n and not self.T[2] < t:
+            self.n -= 1
+            self.T[1:], self.W[1:], self.D[1:] = self.T[:2].copy(), self.W[:2].copy(), \
+                self.D[:2].copy()
+        self.T[:2], self.W[:2], self.D[:2] = self.T[1:].copy(), self.W[1:].copy(), \
+            self.D[1:].copy()
+        self.T[2], self.W[2], self.D[2] = t, w, d
+        self.n = min(self.n + 1, 3)
 
 
 class WitnessApproach:
@@ -95,51 +82,30 @@ class WitnessApproach:
         self._shortened = 0
         self.shortened_steps = 0
 
-    def _values(self, root):
-        out, rates = {}, {}
-        for s in self.sources:
-            c = s.GetMyContextFromRoot(root)
-            epoch = s.witness_epoch(c) if hasattr(s, "witness_epoch") else 0
-            for k, w in s.witness_values(c).items():
-                out[(id(s), k)] = (epoch, float(w))
-            if hasattr(s, "witness_rates"):
-                for k, wd in s.witness_rates(c).items():
-                    rates[(id(s), k)] = float(wd)
-        return out, rates
-
-    def _second_rates(self, root, keys):
-        out = {}
-        for s in self.sources:
-            names = [k for sid, k in keys if sid == id(s)]
-            if names:
-                c = s.GetMyContextFromRoot(root)
-                out.update({(id(s), k): v for k, v in s.witness_second_rates(c, names).items()})
-        return out
-
     def predicted_zero(self, root) -> float:
         """Earliest predicted zero time (inf if none); updates the history."""
         t = root.get_time()
         best = math.inf
-        values, rates = self._values(root)
         hist = {}
-        need = []      # witnesses with a rate but no earlier rate in this epoch
-        for key, (epoch, w) in values.items():
-            h = self._hist.get(key)
-            pts = [p for p in h[1] if p[0] < t] if h is not None and h[0] == epoch else []
-            pts = (pts + [(t, w, rates.get(key))])[-3:]
-            hist[key] = (epoch, pts)
-            if w > 0.0:
-                best = min(best, t + _lead([p[:2] for p in pts]))
-                if key in rates:
-                    if len(pts) > 1 and pts[-2][2] is not None:
-                        # The second derivative from the last two rates.
-                        (t1, _, r1), (t2, _, r2) = pts[-2], pts[-1]
-                        best = min(best, t + _lead_jet(w, r2, (r2 - r1) / (t2 - t1)))
-                    else:
-                        need.append(key)
-        if need:
-            for key, wdd in self._second_rates(root, need).items():
-                best = min(best, t + _lead_jet(values[key][1], rates[key], wdd))
+        for s in self.sources:
+            c = s.GetMyContextFromRoot(root)
+            epoch = s.witness_epoch(c) if hasattr(s, "witness_epoch") else 0
+            key = (epoch, s.witness_layout(c))
+            w = s.witness_array(c)
+            d = (s.witness_rate_array(c) if hasattr(s, "witness_rate_array")
+                 else np.full(len(w), np.nan))
+            h = self._hist.get(id(s))
+            if h is None or h.key[0] != key[0] or h.key[1] != key[1]:
+                h = _History(key, t, w, d)
+            else:
+                h.add(t, w, d)
+            hist[id(s)] = h
+            need = np.zeros(len(w), dtype=np.bool_)
+            best = min(best, earliest_zero(h.T, h.W, h.D, h.n, need))
+            if need.any():
+                wdd = s.witness_second_rate_array(c, need)
+                for j in np.flatnonzero(need).tolist():
+                    best = min(best, t + _lead_jet(float(w[j]), float(d[j]), float(wdd[j])))
         self._hist = hist
         return best
 

@@ -5,17 +5,17 @@ from __future__ import annotations
 import numpy as np
 
 from drake_dock.core import handover, hybrid
-from drake_dock.core.constraints import select_modes
-from drake_dock.core.couple import evaluate_couple, point_curve_side
+from drake_dock.core.couple import point_curve_side
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import constraints as compiled_constraints
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
-from drake_dock.errors import (InputError, PainleveInconsistency, SeekingError,
+from drake_dock.errors import (DriftError, InputError, PainleveInconsistency, SeekingError,
                                SingularCoupleError)
 from drake_dock.systems import handovers, impacts
 from drake_dock.systems.contact_types import copied_states
+from drake_dock.systems.evaluation import Kinematics
 from drake_dock.systems.handovers import applied
 
 
@@ -26,25 +26,49 @@ def _reseek(p, c, margin, R2, conditioning_min) -> bool:
         p.kind == "PC" and point_curve_side(p.patch2, R2, c.u[0], c.n) <= 0.0)
 
 
+def couples_of(ev, kin, u, states, which, t, strict=False):
+    """The couples (`CoupleRow`) of the pairs ``which`` of the `RigidContactSystem` ``ev`` at
+    u with their states' sigma; a point-curve couple whose point lies on its curve raises
+    `SingularCoupleError`; with ``strict``, a couple in contact that projected by more than
+    ``drift_tol`` of its span raises `DriftError`."""
+    sigma = np.array([st.sigma for st in states])
+    couples = ev.engine.couples(kin, u, sigma, which)
+    for i, c in couples.items():
+        if ev.pairs[i].kind == "PC" and np.isnan(c.gap):
+            raise SingularCoupleError("point-curve couple: the point lies on the curve "
+                                      "(|d| = 0), its normal is undefined", time=t,
+                                      couples=[ev.pairs[i].name])
+        if strict and states[i].mode.in_contact:
+            rel = np.abs(c.drift) / ev.engine.model.spans[i, :len(c.drift)]
+            if rel.max() > ev.options.drift_tol:
+                raise DriftError(f"couple drift {rel.max():.3e} of the domain span "
+                                 f"exceeds drift_tol = {ev.options.drift_tol:g}", time=t,
+                                 couples=[ev.pairs[i].name])
+    return couples
+
+
 class Transitions:
-    """The transitions of the pairs of a `PlantEvaluator` ``ev``, timed into ``timing``."""
+    """The transitions of the pairs of a `RigidContactSystem` ``ev`` (its engine's calculators),
+    timed into ``timing``."""
 
     def __init__(self, ev, timing):
         self.ev, self.timing = ev, timing
         self.pairs, self.law, self.options = ev.pairs, ev.law, ev.options
+        self.eng = ev.engine
 
     def resolve(self, t, x, modes, inputs, current, early=1.0):
         """All the transitions due at time t and state x from `ContactModes` ``modes``;
-        returns (x, modes). ``current()`` gives the evaluation at (t, x, modes). Far pairs are
-        sought again when their travel bound reaches ``early`` x their clearance."""
+        returns (x, modes). ``inputs`` is the inputs' generalized force; ``current()`` gives
+        the evaluation at (t, x, modes). Far pairs are sought again when their travel bound
+        reaches ``early`` x their clearance."""
         ev, opt = self.ev, self.options
         modes = modes.working_copy()
         modes.mode_changes += 1
         q = x[:ev.nq]
         v = x[ev.nq:ev.nq + ev.nv].copy()
         u = x[ev.nq + ev.nv:ev.ie].copy()
-        ctx = ev.set_scratch(q, v)
-        poses, twists = ev.frame_kinematics(ctx)
+        kin = self.eng.kinematics(q, v)
+        poses = kin.poses
         initial = all(st.ref_X21 is None and st.mode == Mode.FAR for st in modes.pairs)
         # 1. Seeking: at initialisation, for far pairs whose clearance is used up, and for
         #    couples at a domain end or with a singular Jacobian; hand-overs between an edge
@@ -52,7 +76,7 @@ class Transitions:
         #    them or as it leaves them, never half-way, so that it does not depend on the
         #    pairs' order: the couples are evaluated and the hand-overs applied first, then the
         #    pairs are sought, then the carried clearances are set.
-        couples, handed = self._handovers(modes.pairs, poses, twists, u)
+        couples, handed = self._handovers(modes.pairs, kin, u, t)
         far = [i for i, st in enumerate(modes.pairs) if st.mode == Mode.FAR]
         travel = dict(zip(far, ev.far.bounds(far, poses, modes.pairs).tolist()))
         sought = []         # (pair, `seek`'s return) of each seek
@@ -81,32 +105,30 @@ class Transitions:
         # 2. Impacts and 3. modes.
         n_impacts = len(modes.impacts)
         with self.timing.measure("impacts"):
-            v = self.impacts_and_modes(t, modes, ctx, q, v, u, inputs, current, handed)
+            v = self.impacts_and_modes(t, modes, q, v, u, inputs, current, handed)
         x_new = x.copy()
         x_new[ev.nq:ev.nq + ev.nv] = v
         x_new[ev.nq + ev.nv:ev.ie] = u
         impacts.states_around(ev, modes, n_impacts, x, x_new)
         return x_new, modes.seal()
 
-    def _handovers(self, states, poses, twists, u) -> tuple[dict, dict]:
+    def _handovers(self, states, kin, u, t) -> tuple[dict, dict]:
         """The couples of the pairs that are not far (written into u) and their hand-overs
         (`HandoverLinks.target` on the states the event found, `applied`), made (`hand_over`):
         returns ({pair: its couple}, {pair handed to: pair it continues})."""
-        ev, due, couples = self.ev, {}, {}
-        for i, st in enumerate(states):
-            if st.mode == Mode.FAR:
-                continue
-            p, sl = self.pairs[i], ev.couple_slice(i)
-            a, b = ev.fidx[i]
-            c = couples[i] = evaluate_couple(p.kind, p.patch1, poses[a], twists[a], p.patch2,
-                                             poses[b], twists[b], u[sl], st.sigma)
-            u[sl] = c.u
-            to = ev.links.target(i, c.u, c.n, poses[b][0], states)
-            if to is not None and handovers.accepts(ev, i, to, c.n, poses, twists):
+        ev, due = self.ev, {}
+        near = [i for i, st in enumerate(states) if st.mode != Mode.FAR]
+        couples = couples_of(self.ev, kin, u, states, near, t)
+        poses = kin.poses
+        for i in near:
+            c = couples[i]
+            u[ev.couple_slice(i)] = c.u
+            to = ev.links.target(i, c.u, c.n, poses[ev.fidx[i][1]][0], states)
+            if to is not None and handovers.accepts(ev, i, to, c.n, kin):
                 due[i] = to
         handed = applied(due)
         for j, i in handed.items():
-            self.hand_over(i, j, due[i][1], couples[i].n, poses, states, u)
+            self.hand_over(i, j, due[i][1], couples[i].n, kin, states, u)
         return couples, handed
 
     def screen(self, i, poses, states) -> bool:
@@ -130,15 +152,14 @@ class Transitions:
             self.timing.count_screen(self.pairs[i].name)
         return True
 
-    def hand_over(self, i, j, uj, n, poses, states, u):
+    def hand_over(self, i, j, uj, n, kin, states, u):
         """Pair i's couple (normal n) continues as pair j's couple uj: j takes i's mode and the
         sigma that keeps n (`drake_dock.core.handover`); i is far, its nearest point carried
         by j (clearance half ``track_distance``, as `hybrid.after_seek` for a carried couple)."""
-        ev, p = self.ev, self.pairs[j]
-        a, b = ev.fidx[j]
+        ev = self.ev
         u[ev.couple_slice(j)] = uj
-        raw = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
-                              poses[b], (np.zeros(3),) * 2, uj, 1.0, project=False)
+        raw = self.eng.couple(j, uj, kin.still(), 1.0, project=False)
+        poses = kin.poses
         si, sj = states[i], states[j]
         sj.mode, sj.sigma, sj.slide_dir = si.mode, handover.carried_sigma(n, raw.n), None
         si.mode, si.clearance = hybrid.after_seek(abs(raw.gap), False, False, True,
@@ -177,7 +198,7 @@ class Transitions:
         a, b = ev.fidx[i]
         try:
             P1, P2 = posed(p.patch1, *poses[a]), posed(p.patch2, *poses[b])
-            seek = (compiled_seek.seek_couple if opt.compiled and compiled_seek.supported(P1, P2)
+            seek = (compiled_seek.seek_couple if compiled_seek.supported(P1, P2)
                     else seek_couple)
             c = seek(P1, P2, distance_rtol=opt.seek_rtol, rtol_beyond=opt.track_distance)
         except SeekingError as e:
@@ -191,8 +212,7 @@ class Transitions:
         usable, uc = f.usable, f.u
         crossing = hybrid.intersecting(c.distance, f.finish_failed, opt.impact_gap_tol)
         if usable:
-            raw = evaluate_couple(p.kind, p.patch1, poses[a], (np.zeros(3),) * 2, p.patch2,
-                                  poses[b], (np.zeros(3),) * 2, uc, 1.0, project=False)
+            raw = self.eng.couple(i, uc, Kinematics.at_rest(poses), 1.0, project=False)
             gap = raw.gap
             sigma = hybrid.couple_sigma(p.kind, p.sigma, gap,
                                         p.patch1.radius if p.kind == "PS" else 0.0)
@@ -225,24 +245,23 @@ class Transitions:
         st.mode, st.slide_dir = mode, None
         return c.distance, crossing, was_contact, due
 
-    def impacts_and_modes(self, t, modes, ctx, q, v, u, inputs, current, handed=None):
+    def impacts_and_modes(self, t, modes, q, v, u, inputs, current, handed=None):
         """2. The LZB impact of the couples hit (Sect. 6) and 3. the modes of the contact set
         (Eq. 48-52), then the velocity projection onto the new constraints; returns v.
         ``handed`` maps a pair handed a couple to the pair it continues, whose forces it
-        takes."""
+        takes; ``inputs`` is the inputs' generalized force."""
         handed = handed or {}
-        ev, opt = self.ev, self.options
+        ev, opt, eng = self.ev, self.options, self.eng
         states = modes.pairs
         evs = {}
+        near = [i for i, st in enumerate(states) if st.mode != Mode.FAR]
 
         def evaluate_all(v):
-            ev.set_scratch(q, v)
-            ps, tw = ev.frame_kinematics(ctx)
-            for i, st in enumerate(states):
-                if st.mode != Mode.FAR:     # a tracked couple that drifts is sought again
-                    evs[i] = ev.couple(i, u[ev.couple_slice(i)], ps, tw, st.sigma, t,
-                                       st.mode.in_contact)
-            return ps
+            # A tracked couple that drifts is sought again; one in contact raises.
+            kin = eng.kinematics(q, v)
+            evs.clear()
+            evs.update(couples_of(self.ev, kin, u, states, near, t, strict=True))
+            return kin
 
         def gaps_and_rates():
             return ([evs[i].gap if i in evs else np.nan for i in range(len(states))],
@@ -253,32 +272,31 @@ class Transitions:
         if any(st.mode.in_contact for st in states):
             E = current()
             src = {i: handed.get(i, i) for i, st in enumerate(states) if st.mode.in_contact}
-            leaving = {i: hybrid.modes_left(st.mode, E.lam_n[src[i]], E.lam_t[src[i]], ev.mu_s)
+            leaving = {i: hybrid.modes_left(st.mode, E.lam_n[src[i]], E.lam_t[src[i]], ev.law.static_mu)
                        for i, st in enumerate(states) if st.mode.in_contact}
-        poses = evaluate_all(v)
+        kin = evaluate_all(v)
         gap, vn = gaps_and_rates()
         hit = hybrid.impact_hits([st.mode for st in states], gap, vn, opt.impact_gap_tol)
         closed = []
         if hit:
             S = hybrid.impact_set(hit, [st.mode for st in states], vn)
-            v, vn_plus, approach = impacts.lzb_impact(ev, t, modes, ctx, poses, evs, S, v)
+            v, vn_plus, approach = impacts.lzb_impact(ev, t, modes, kin, evs, S, v)
             for i, c in zip(S, hybrid.closed_after_impact(vn_plus, approach)):
                 if c:
                     closed.append(i)       # closed at the end of the impact: in contact
                 else:
                     states[i].track()      # separating
             modes.impacts[-1]["pairs_plus"] = copied_states(states)
-            poses = evaluate_all(v)
+            kin = evaluate_all(v)
             gap, vn = gaps_and_rates()
         new, cand = hybrid.contact_candidates([st.mode for st in states], gap, vn, bool(hit),
                                               closed, opt.impact_gap_tol, opt.v_slip)
         for st, m in zip(states, new):
             if m != st.mode:
                 st.track()
-        ev.set_scratch(q, v)
-        rows = [ev.row(i, evs[i], poses, ctx) for i in cand]
-        M, Minv, a0, _, _ = ev.free_acceleration(ctx, v, inputs)
-        select = compiled_constraints.select_modes if opt.compiled else select_modes
+        rows = [eng.row(i, evs[i], kin) for i in cand]
+        M, Minv, a0 = eng.dynamics(q, v, inputs)[:3]
+        select = compiled_constraints.select_modes
         avoid = [() if hit else leaving.get(i, ()) for i in cand]
         try:
             sol = select(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
@@ -288,10 +306,9 @@ class Transitions:
                 raise
             # The impact without collision (`drake_dock.core.iwc`), then the modes again.
             v = impacts.without_collision(ev, t, modes, M, rows, v, paradox)
-            poses = evaluate_all(v)
-            ev.set_scratch(q, v)
-            rows = [ev.row(i, evs[i], poses, ctx) for i in cand]
-            M, Minv, a0, _, _ = ev.free_acceleration(ctx, v, inputs)
+            kin = evaluate_all(v)
+            rows = [eng.row(i, evs[i], kin) for i in cand]
+            M, Minv, a0 = eng.dynamics(q, v, inputs)[:3]
             sol = select(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
                          avoid=[()] * len(cand))
         cons = []

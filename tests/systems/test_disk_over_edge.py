@@ -98,10 +98,10 @@ def _handover_event(edge_first):
     names = [p.name for p in system.pairs]
     modes.pairs[names.index("rim_edge")].clearance = 0.0
     system.timing.reset()
-    x_new, after = system.transitions.resolve(ctx.get_time(), x, modes, system._inputs(ctx),
+    x_new, after = system.transitions.resolve(ctx.get_time(), x, modes, system.input_force(ctx),
                                               lambda: system._cache.Eval(ctx))
     u = x_new[system.nq + system.nv:]
-    pairs = {n: (st.mode, st.sigma, st.distance, u[system.evaluator.couple_slice(k)])
+    pairs = {n: (st.mode, st.sigma, st.distance, u[system.couple_slice(k)])
              for k, (n, st) in enumerate(zip(names, after.pairs))}
     return pairs, x_new[:system.nq + system.nv], dict(system.timing.seeks)
 

@@ -78,12 +78,12 @@ def test_far_bounds_from_the_index_equal_the_pair_by_pair_ones():
     sought among them."""
     from drake_dock.studies.small_scenes import stool
     system = stool().system
-    far = system.evaluator.far
+    far = system.far
     rng = np.random.default_rng(5)
     k = len(system.pairs)
     for _ in range(10):
         poses = [(np.linalg.qr(rng.normal(size=(3, 3)))[0], rng.normal(size=3))
-                 for _ in system.evaluator.frames]
+                 for _ in system.frames]
         states = [PairState(Mode(int(rng.integers(0, 2))),
                             ref_X21=None if rng.uniform() < 0.3 else
                             (np.linalg.qr(rng.normal(size=(3, 3)))[0], rng.normal(size=3)))

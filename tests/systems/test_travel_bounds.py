@@ -28,20 +28,20 @@ def test_far_pair_travel_bound_covers_every_point_of_the_patch():
     rng = np.random.default_rng(7)
     k = len(system.pairs)
     for trial in range(20):
-        poses0 = [(_random_rotation(rng), rng.normal(size=3)) for _ in system.evaluator.frames]
+        poses0 = [(_random_rotation(rng), rng.normal(size=3)) for _ in system.frames]
         scale = 10.0 ** rng.uniform(-4, 0)
         poses1 = [(_random_rotation(rng, scale * rng.uniform(0, 1)) @ R, p + scale
                    * rng.normal(size=3)) for R, p in poses0]
         states = []
         for i in range(k):
-            a, b = system.evaluator.fidx[i]
+            a, b = system.fidx[i]
             (R1, p1), (R2, p2) = poses0[a], poses0[b]
             states.append(PairState(Mode.FAR, ref_X21=(R2.T @ R1, R2.T @ (p1 - p2))))
-        far = system.evaluator.far
+        far = system.far
         bounds = far.bounds(list(range(k)), poses1, states)
         for i, pair in enumerate(system.pairs):
             r = pair.patch1.position(pair.patch1.grid(61))
-            a, b = system.evaluator.fidx[i]
+            a, b = system.fidx[i]
             moved = []
             for poses in (poses0, poses1):
                 (R1, p1), (R2, p2) = poses[a], poses[b]

@@ -311,3 +311,85 @@ def evaluate_point_curves(pc, kind2, prm1, prm2, fidx, uoff, spans, R, o, w, v, 
         row[DRIFT_REL] = abs(row[DRIFT]) / spans[i, 0]
         row[RATE] = row[UDOT] + drift_feedback * row[DRIFT]
         rate[uoff[i]] = row[RATE]
+
+
+@njit(cache=True)
+def evaluate_ps_one(kind2, prm2, p, radius, R1, o1, w1, v1, R2, o2, w2, v2, u_state, sigma,
+                    project, out):
+    """One point-surface couple (kind "PS", `drake_dock.core.couple._evaluate_point_surface`):
+    the point p (its frame's coordinates; a sphere of ``radius``) against the surface
+    (kind2, prm2), u = (u, v), into the row ``out`` (its u, drift and udot in the row's first
+    two places of each). F = [s_u . d, s_v . d] (Eq. 38 without its tangency row); the frame as
+    for C-S with no curve on Body 1; the contact point is the sphere's point towards the
+    surface, q = -radius n from its centre."""
+    r1 = _rot(R1, p)
+    x1 = _add(r1, o1)
+    a0, a1 = u_state[0], u_state[1]
+    r2, su, sv, suu, suv, svv = _geometry(kind2, prm2, R2, a0, a1)
+    d = _sub(x1, _add(r2, o2))
+    susv = _dot(su, sv)
+    F0, F1 = _dot(su, d), _dot(sv, d)
+    A0 = (_dot(suu, d) - _dot(su, su), _dot(suv, d) - susv, 0.0)
+    A1 = (_dot(suv, d) - susv, _dot(svv, d) - _dot(sv, sv), 0.0)
+    residual = math.hypot(F0, F1)
+    cond = _ps_conditioning(A0, A1, su, sv)
+    du0, du1 = 0.0, 0.0
+    if project and residual > 0.0 and cond > 1e-14:
+        x = _solve(2, A0, A1, _Z, (F0, F1, 0.0))
+        du0, du1 = -x[0], -x[1]
+        a0, a1 = a0 + du0, a1 + du1
+        r2, su, sv, suu, suv, svv = _geometry(kind2, prm2, R2, a0, a1)
+        d = _sub(x1, _add(r2, o2))
+        susv = _dot(su, sv)
+        A0 = (_dot(suu, d) - _dot(su, su), _dot(suv, d) - susv, 0.0)
+        A1 = (_dot(suv, d) - susv, _dot(svv, d) - _dot(sv, sv), 0.0)
+        cond = _ps_conditioning(A0, A1, su, sv)
+    x2 = _add(r2, o2)
+    w2su, w2sv = _cr(w2, su), _cr(w2, sv)
+    v_rel = _sub(_add(v1, _cr(w1, r1)), _add(v2, _cr(w2, r2)))
+    Ft0, Ft1 = _dot(w2su, d) + _dot(su, v_rel), _dot(w2sv, d) + _dot(sv, v_rel)
+    # Eq. (47); a singular Fu (p at a centre of curvature) gives zeros, reported by the
+    # conditioning.
+    ud0, ud1 = 0.0, 0.0
+    if cond > 1e-14:
+        y = _solve(2, A0, A1, _Z, (-Ft0, -Ft1, 0.0))
+        ud0, ud1 = y[0], y[1]
+    sudot = _axpy(ud1, suv, _axpy(ud0, suu, w2su))
+    svdot = _axpy(ud1, svv, _axpy(ud0, suv, w2sv))
+    nv, ndot, ta, tadot, conv = frame_rates_cs(_Z, su, sv, sudot, svdot, _cr(su, sv), w1, w2,
+                                               0.0, ud0, ud1, sigma)
+    q = _mul(nv, -radius)
+    qdot = _mul(ndot, -radius)
+    gap = _dot(nv, d) - radius
+    x1 = _add(x1, q)
+    v_rel = _add(v_rel, _cr(w1, q))
+    conv = _add(conv, _cr(w1, _sub(qdot, _cr(w1, q))))
+    tb = _cr(nv, ta)
+    tbdot = _add(_cr(ndot, ta), _cr(nv, tadot))
+    out[U], out[U + 1], out[DRIFT], out[DRIFT + 1] = a0, a1, du0, du1
+    out[UDOT], out[UDOT + 1] = ud0, ud1
+    out[RESIDUAL], out[COND] = residual, cond
+    _put(out, P1, x1)
+    _put(out, P2, x2)
+    _put(out, N, nv)
+    _put(out, TA, ta)
+    _put(out, TB, tb)
+    out[GAP] = gap
+    _put(out, VREL, v_rel)
+    out[VN] = _dot(nv, v_rel)
+    out[VT], out[VT + 1] = _dot(ta, v_rel), _dot(tb, v_rel)
+    out[BIAS_N] = _dot(nv, conv) + _dot(ndot, v_rel)
+    out[BIAS_T] = _dot(ta, conv) + _dot(tadot, v_rel)
+    out[BIAS_T + 1] = _dot(tb, conv) + _dot(tbdot, v_rel)
+
+
+@njit(cache=True)
+def _ps_conditioning(A0, A1, su, sv):
+    """`drake_dock.core.couple._conditioning` of a point-surface Fu: its columns scaled by
+    |s_u|, |s_v|, |det| over the product of the row norms."""
+    c0, c1 = math.sqrt(_dot(su, su)), math.sqrt(_dot(sv, sv))
+    if min(c0, c1) > 0.0:
+        A0 = (A0[0] / c0, A0[1] / c1, 0.0)
+        A1 = (A1[0] / c0, A1[1] / c1, 0.0)
+    den = math.hypot(A0[0], A0[1]) * math.hypot(A1[0], A1[1])
+    return abs(A0[0] * A1[1] - A0[1] * A1[0]) / den if den > 0 else 0.0

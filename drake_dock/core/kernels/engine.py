@@ -1,163 +1,227 @@
 """One evaluation of the contact dynamics of free rigid bodies in one compiled call: from the
-state (q, v, u*) and the generalized force of everything but contact to q', v', u*', the
-couples' rows and the contact forces.
+state x = [q, v, u*, energy integrals] to its time derivative, the couples, the contact forces,
+the values of every witness and the far pairs' travel bounds.
 
-The steps are the paper's, each an existing kernel:
+The steps are the paper's:
 - the bodies' and the frames' poses and twists (`free_bodies`);
+- the force elements: uniform gravity and Drake's LinearBushingRollPitchYaw (the Stewart
+  element, `bushing`), their generalized force, power and potential, each bushing's damper
+  power apart;
 - the tracked couples, Eq. (47) with one Newton projection, the contact frame, gap, normal
-  velocity and the Eq. (52) bias terms (`couples.evaluate_couples`,
-  `couples.evaluate_point_curves`);
+  velocity and the Eq. (52) bias terms, by pair kind (`couples`);
 - M^-1 and the velocity-product terms (`free_bodies.mass_inverse_and_bias`), the free
   acceleration a0 = M^-1 (tau - C v);
 - per couple in contact its row W (Eq. 11) and bias (Eq. 52) (`free_bodies.point_rows`), its
   sliding direction, and the constraint solve for the given modes (Eq. 48-52,
-  `solve.solve_modes`).
+  `solve.solve_modes`);
+- the witnesses of the contact system's table (`drake_dock.systems.witnesses`): per pair the
+  value of each kind (`W_GAP` ... `W_SIDE`), and the far pairs' smallest clearance left.
 
-The layouts are records of arrays (`Bodies`, `CoupleSet`), built once per system. The call
-returns a status (`solve.OK`, `SINGULAR`, `NONFINITE`) and leaves the typed errors to the
-caller, which names the couples.
+Records (`drake_dock.core.kernels.records`): `Model` (the bodies, frames, force elements,
+pairs, hand-over edges and options, built once per system) and `ModeArrays` (the pairs' modes
+and far-pair data, built once per sealed set of modes), each packed; the results go into one
+float buffer whose sections `layout` gives. The call returns nothing: a status in the buffer
+(`solve.OK`, `SINGULAR`, `NONFINITE`, or a pair to report: a point on its curve, a drift
+beyond ``drift_tol``) leaves the typed errors to the caller, which names the couples.
 """
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from drake_dock.core.kernels import couples as K
+from drake_dock.core.kernels.forces import block_apply, element_forces, kinetic_energy
 from drake_dock.core.kernels.free_bodies import (body_kinematics, frame_kinematics,
                                                  mass_inverse_and_bias, point_rows, qdot)
-from drake_dock.core.kernels.solve import OK, SLIDE, solve_modes
+from drake_dock.core.kernels.model import (BUSH_ROW, CC, FAR, NW, O_COND_MIN, O_DRIFT_FB, O_DRIFT_TOL,
+                                           O_ENERGY, O_GUARD, O_MU, O_MU_S, O_OMEGA, O_V_SLIP,
+                                           PC, PS, S_BAD_PC, S_BUSH, S_COND, S_DAMP, S_DRIFTING,
+                                           S_FAR, S_FRICTION, S_KE, S_P_EL, S_P_IN, S_PE,
+                                           S_STATUS, SLIDING, STICKING, W_APEX, W_COND, W_CONE,
+                                           W_END, W_GAP, W_HANDOVER, W_LAMBDA, W_SIDE, W_SLIP,
+                                           Z_IE, Z_NQ, Z_NV, Z_NX, layout, unpack_model,
+                                           unpack_modes)
+from drake_dock.core.kernels.solve import OK, SLIDE, STICK, solve_modes
+from drake_dock.core.kernels.witness_values import end_margin, handover_guard, point_curve_side
 
-
-class Bodies(NamedTuple):
-    """Free bodies and the frames fixed on them (`free_bodies` module docstring)."""
-    qs: np.ndarray       # (nb,) int64
-    vs: np.ndarray       # (nb,) int64
-    m: np.ndarray        # (nb,)
-    c_B: np.ndarray      # (nb, 3)
-    I_B: np.ndarray      # (nb, 3, 3) about the centre of mass
-    I_B_inv: np.ndarray  # (nb, 3, 3)
-    fb: np.ndarray       # (F,) int64, -1 for the world
-    R_BF: np.ndarray     # (F, 3, 3)
-    p_BF: np.ndarray     # (F, 3)
-
-
-class CoupleSet(NamedTuple):
-    """The pairs' couple kernels (`drake_dock.core.kernels.tracked.TrackedCouples`)."""
-    cc: np.ndarray       # (k,) bool: curve-curve
-    pc: np.ndarray       # (k,) bool: point-curve
-    kind1: np.ndarray
-    prm1: np.ndarray
-    kind2: np.ndarray
-    prm2: np.ndarray
-    fidx: np.ndarray     # (k, 2) frame indices
-    uoff: np.ndarray
-    spans: np.ndarray
+@njit(cache=True)
+def _couple(m, i, R, o, w, vf, u, sigma, out):
+    """Pair i's couple into its row out[i] (its kind's kernel), the drift relative to its
+    spans and its integrated rate."""
+    a, b = m.fidx[i, 0], m.fidx[i, 1]
+    row = out[i]
+    o1, w1, v1 = (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]), \
+        (vf[a, 0], vf[a, 1], vf[a, 2])
+    o2, w2, v2 = (o[b, 0], o[b, 1], o[b, 2]), (w[b, 0], w[b, 1], w[b, 2]), \
+        (vf[b, 0], vf[b, 1], vf[b, 2])
+    ui = u[m.uoff[i]:m.uoff[i + 1]]
+    kind = m.pair_kind[i]
+    if kind == PC:
+        p = (m.prm1[i, 0], m.prm1[i, 1], m.prm1[i, 2])
+        K.evaluate_pc_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], R[a], o1, w1, v1, R[b], o2,
+                          w2, v2, ui[0], sigma, True, row)
+    elif kind == PS:
+        p = (m.prm1[i, 0], m.prm1[i, 1], m.prm1[i, 2])
+        K.evaluate_ps_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], R[a], o1, w1, v1, R[b], o2,
+                          w2, v2, (ui[0], ui[1]), sigma, True, row)
+    else:
+        us = (ui[0], ui[1], ui[2] if len(ui) == 3 else 0.0)
+        K.evaluate_one(kind == CC, m.kind1[i], m.prm1[i], m.kind2[i], m.prm2[i], R[a], o1,
+                       w1, v1, R[b], o2, w2, v2, us, sigma, True, row)
 
 
 @njit(cache=True)
-def evaluate(B, C, q, v, u, sigma, active, rows, codes, held_dir, has_dir, tau_el, tau_in, mu,
-             mu_s, omega, v_slip, drift_feedback, drift_tol, energy_scale, R, o, w, vf, out,
-             xdot, lam_n, lam_t, gf):
-    """The evaluation (module docstring). ``active`` (k,) the tracked pairs; ``rows`` (r,) the
-    pairs in contact with their mode ``codes`` (STICK or SLIDE), ``held_dir`` (r, 2) the
-    sliding direction kept for a slow sliding couple when ``has_dir``; ``tau_el`` and
-    ``tau_in`` (nv,) the generalized forces of the force elements and of the inputs.
+def couple_rates(m, i, out, drift_feedback, udot):
+    """Pair i's largest drift relative to its spans (row DRIFT_REL) and its integrated rate
+    u*' = Eq. (47) + drift_feedback x projection, into its row and into udot."""
+    row = out[i]
+    rel = 0.0
+    for j in range(m.uoff[i + 1] - m.uoff[i]):
+        rel = max(rel, abs(row[K.DRIFT + j]) / m.spans[i, j])
+        row[K.RATE + j] = row[K.UDOT + j] + drift_feedback * row[K.DRIFT + j]
+        udot[m.uoff[i] + j] = row[K.RATE + j]
+    row[K.DRIFT_REL] = rel
 
-    Outputs: the frames' R, o, w, vf; ``out`` (k, couples.ROW) as `couples.evaluate_couples`;
-    ``xdot`` = [q', v', u*', friction power, power of tau_el, power of tau_in, ...] with the
-    powers divided by ``energy_scale`` (the rest of xdot is the caller's); lam_n (k,),
-    lam_t (k, 2) per pair (zero off contact); gf (nv,) the generalized contact force.
 
-    Returns (status, cond(A), the first tracked point-curve pair whose point lies on its curve
-    or -1, the first pair in contact whose projection exceeds ``drift_tol`` of its domain span
-    or -1, friction power, power of tau_el, power of tau_in). The solve is skipped (status OK)
-    when a pair is reported."""
-    nb, nq, nv, nu = B.qs.shape[0], q.shape[0], v.shape[0], u.shape[0]
-    qd, vdot, udot = xdot[:nq], xdot[nq:nq + nv], xdot[nq + nv:nq + nv + nu]
+@njit(cache=True)
+def evaluate(mp, sp, x, tau_in, buf):
+    """The evaluation (module docstring) at the state x with the inputs' generalized force
+    tau_in (nv,), the model and modes packed (`Model`, `ModeArrays`), into ``buf`` (`layout`)."""
+    m = unpack_model(mp)
+    s = unpack_modes(sp)
+    nq, nv, ie, nx = m.sizes[Z_NQ], m.sizes[Z_NV], m.sizes[Z_IE], m.sizes[Z_NX]
+    k, F, nb, nbush = s.code.shape[0], m.frame_body.shape[0], m.qs.shape[0], \
+        m.bush_frames.shape[0]
+    XD, OUT, LN, LT, GF, WV, BD, FR, FO, FW, FV, SC, BU, END = layout(nx, k, nv, F, nbush)
+    opt = m.options
+    q, v, u = x[:nq], x[nq:nq + nv], x[nq + nv:ie]
+    xdot = buf[XD:XD + nx]
+    out = buf[OUT:LN].reshape((k, K.ROW))
+    lam_n, lam_t = buf[LN:LT], buf[LT:GF].reshape((k, 2))
+    gf = buf[GF:WV]
+    wv = buf[WV:BD].reshape((k, NW))
+    R, o = buf[FR:FO].reshape((F, 3, 3)), buf[FO:FW].reshape((F, 3))
+    w, vf = buf[FW:FV].reshape((F, 3)), buf[FV:SC].reshape((F, 3))
+    sc = buf[SC:BU]
+    bush = buf[BU:END].reshape((nbush, BUSH_ROW))
+    sc[:] = 0.0
+    sc[S_BAD_PC], sc[S_DRIFTING] = -1.0, -1.0
+    # 1. Kinematics.
     Rb, pb = np.empty((nb, 3, 3)), np.empty((nb, 3))
     wb, vb = np.empty((nb, 3)), np.empty((nb, 3))
-    body_kinematics(B.qs, B.vs, q, v, Rb, pb, wb, vb)
-    frame_kinematics(B.fb, B.R_BF, B.p_BF, Rb, pb, wb, vb, R, o, w, vf)
-    qdot(B.qs, B.vs, q, v, qd)
+    body_kinematics(m.qs, m.vs, q, v, Rb, pb, wb, vb)
+    frame_kinematics(m.frame_body, m.R_BF, m.p_BF, Rb, pb, wb, vb, R, o, w, vf)
+    qdot(m.qs, m.vs, q, v, xdot[:nq])
+    # 2. The force elements.
+    tau_el = np.empty(nv)
+    sc[S_PE], bst = element_forces(m, q, v, Rb, pb, R, o, w, vf, tau_el, bush, sc[S_DAMP:])
+    sc[S_BUSH] = bst
     p_el, p_in = 0.0, 0.0
     for a in range(nv):
         p_el += tau_el[a] * v[a]
         p_in += tau_in[a] * v[a]
-    # The tracked couples (Eq. 47).
-    k = active.shape[0]
+    sc[S_P_EL], sc[S_P_IN] = p_el, p_in
+    sc[S_KE] = kinetic_energy(m, Rb, wb, vb)
+    # 3. The couples of the pairs that are not far (Eq. 47) and the witnesses they give.
+    udot = xdot[nq + nv:ie]
     udot[:] = 0.0
-    other = active.copy()
-    any_pc = False
-    for i in range(k):
-        if C.pc[i]:
-            other[i] = False
-            any_pc = any_pc or active[i]
-    bad_pc, bad_drift = -1, -1
-    if any_pc:
-        pc_idx = np.flatnonzero(C.pc)
-        K.evaluate_point_curves(pc_idx, C.kind2, C.prm1, C.prm2, C.fidx, C.uoff, C.spans, R, o,
-                                w, vf, u, sigma, active, True, drift_feedback, out, udot)
-        for i in pc_idx:
-            if active[i] and math.isnan(out[i, K.GAP]):
-                bad_pc = i
-                break
-    K.evaluate_couples(C.cc, C.kind1, C.prm1, C.kind2, C.prm2, C.fidx, C.uoff, C.spans, R, o, w,
-                       vf, u, sigma, other, True, drift_feedback, out, udot)
-    r = rows.shape[0]
-    for j in range(r):
-        if out[rows[j], K.DRIFT_REL] > drift_tol:
-            bad_drift = rows[j]
-            break
     lam_n[:] = 0.0
     lam_t[:] = 0.0
-    if bad_pc >= 0 or bad_drift >= 0:
-        return OK, 0.0, bad_pc, bad_drift, 0.0, p_el, p_in
-    # The free acceleration a0 = M^-1 (tau - C v).
+    gf[:] = 0.0
+    fb, tol = opt[O_DRIFT_FB], opt[O_DRIFT_TOL]
+    # Rows and witness values of far pairs are not written (nothing reads them).
+    for i in range(k):
+        code = s.code[i]
+        if code == FAR:
+            continue
+        out[i, :] = 0.0
+        wv[i, :] = 1.0
+        _couple(m, i, R, o, w, vf, u, s.sigma[i], out)
+        couple_rates(m, i, out, fb, udot)
+        row = out[i]
+        if m.pair_kind[i] == PC and math.isnan(row[K.GAP]):
+            if sc[S_BAD_PC] < 0:
+                sc[S_BAD_PC] = i
+            continue
+        if row[K.DRIFT_REL] > tol and sc[S_DRIFTING] < 0:
+            sc[S_DRIFTING] = i
+        R2 = R[m.fidx[i, 1]]
+        wv[i, W_GAP] = row[K.GAP]
+        wv[i, W_END] = end_margin(m, i, row)
+        wv[i, W_COND] = row[K.COND] - opt[O_COND_MIN]
+        wv[i, W_APEX] = 1.0 if row[K.GAP] > 0.0 else row[K.VN]
+        if m.edge_count[i] > 0:
+            wv[i, W_HANDOVER] = handover_guard(m, i, row, R2) + opt[O_GUARD]
+        if m.pair_kind[i] == PC:
+            wv[i, W_SIDE] = point_curve_side(m, i, row, R2)
+    sc[S_FAR] = math.nan        # `far_witness` fills it and BOUND when asked
+    e = ie
+    xdot[e + 1], xdot[e + 2] = p_el / opt[O_ENERGY], p_in / opt[O_ENERGY]
+    for n in range(nbush):
+        xdot[e + 3 + n] = sc[S_DAMP + n] / opt[O_ENERGY]
+    vdot = xdot[nq:nq + nv]
+    if sc[S_BAD_PC] >= 0:
+        sc[S_STATUS] = OK
+        vdot[:] = 0.0
+        xdot[e] = 0.0
+        return
+    # 5. The free acceleration a0 = M^-1 (tau - C v).
     Minv = np.zeros((nv, nv))
     cv = np.zeros(nv)
-    mass_inverse_and_bias(B.vs, B.m, B.c_B, B.I_B_inv, B.I_B, Rb, wb, Minv, cv)
-    a0 = Minv @ (tau_el + tau_in - cv)
-    # The rows of the couples in contact (Eq. 11, 52) and their sliding directions.
+    mass_inverse_and_bias(m.vs, m.mass, m.com, m.inertia_inv, m.inertia, Rb, wb, Minv, cv)
+    a0 = block_apply(m.vs, Minv, tau_el + tau_in - cv)
+    # 6. The rows of the couples in contact (Eq. 11, 52), their modes and sliding directions,
+    #    and the constraint solve (Eq. 48-52).
+    rows = s.rows
+    r = rows.shape[0]
     W = np.empty((r, nv, 3))
     bias = np.empty((r, 3))
     gap, vn = np.empty(r), np.empty(r)
-    mus, mus_s = np.full(r, mu), np.full(r, mu_s)
+    mus, mus_s = np.full(r, opt[O_MU]), np.full(r, opt[O_MU_S])
+    codes = np.empty(r, dtype=np.int64)
     dirs = np.zeros((r, 2))
     D = np.empty((3, 3))
     acc = np.empty(3)
+    v_slip = opt[O_V_SLIP]
     for j in range(r):
         i = rows[j]
         row = out[i]
         for c in range(3):
             D[0, c], D[1, c], D[2, c] = row[K.N + c], row[K.TA + c], row[K.TB + c]
-        a, b = C.fidx[i, 0], C.fidx[i, 1]
-        point_rows(B.vs, pb, wb, B.fb[a], B.fb[b], row[K.P1:K.P1 + 3], row[K.P2:K.P2 + 3], D,
-                   W[j], acc)
+        a, b = m.fidx[i, 0], m.fidx[i, 1]
+        point_rows(m.vs, pb, wb, m.frame_body[a], m.frame_body[b], row[K.P1:K.P1 + 3],
+                   row[K.P2:K.P2 + 3], D, W[j], acc)
         bias[j, 0] = row[K.BIAS_N] + acc[0]
         bias[j, 1] = row[K.BIAS_T] + acc[1]
         bias[j, 2] = row[K.BIAS_T + 1] + acc[2]
         gap[j], vn[j] = row[K.GAP], row[K.VN]
+        codes[j] = STICK if s.code[i] == STICKING else SLIDE
         if codes[j] == SLIDE:
-            s = math.hypot(row[K.VT], row[K.VT + 1])
-            if s > v_slip or not has_dir[j]:
-                if s > 0.0:
-                    dirs[j, 0], dirs[j, 1] = row[K.VT] / s, row[K.VT + 1] / s
+            sp_ = math.hypot(row[K.VT], row[K.VT + 1])
+            if sp_ > v_slip or not s.has_dir[i]:
+                if sp_ > 0.0:
+                    dirs[j, 0], dirs[j, 1] = row[K.VT] / sp_, row[K.VT + 1] / sp_
                 else:       # no direction: the solve reports NONFINITE
                     dirs[j, 0], dirs[j, 1] = math.nan, math.nan
             else:
-                dirs[j, 0], dirs[j, 1] = held_dir[j, 0], held_dir[j, 1]
+                dirs[j, 0], dirs[j, 1] = s.slide_dir[i, 0], s.slide_dir[i, 1]
     lr_n, lr_t = np.empty(r), np.empty((r, 2))
-    status, cond = solve_modes(Minv, a0, W, bias, gap, vn, mus, mus_s, codes, dirs, omega, vdot,
-                               lr_n, lr_t, gf)
+    status, cond = solve_modes(Minv, a0, W, bias, gap, vn, mus, mus_s, codes, dirs,
+                               opt[O_OMEGA], vdot, lr_n, lr_t, gf)
+    sc[S_STATUS], sc[S_COND] = status, cond
     power = 0.0
     for j in range(r):
         i = rows[j]
         lam_n[i], lam_t[i, 0], lam_t[i, 1] = lr_n[j], lr_t[j, 0], lr_t[j, 1]
         power -= lr_t[j, 0] * out[i, K.VT] + lr_t[j, 1] * out[i, K.VT + 1]
-    e = nq + nv + nu
-    xdot[e], xdot[e + 1], xdot[e + 2] = (power / energy_scale, p_el / energy_scale,
-                                         p_in / energy_scale)
-    return status, cond, bad_pc, bad_drift, power, p_el, p_in
+        wv[i, W_LAMBDA] = lr_n[j]
+        if s.code[i] == SLIDING:
+            if s.has_dir[i]:
+                wv[i, W_SLIP] = out[i, K.VT] * s.slide_dir[i, 0] \
+                    + out[i, K.VT + 1] * s.slide_dir[i, 1]
+        else:
+            wv[i, W_CONE] = opt[O_MU_S] * lr_n[j] - math.hypot(lr_t[j, 0], lr_t[j, 1])
+    sc[S_FRICTION] = power
+    xdot[e] = power / opt[O_ENERGY]

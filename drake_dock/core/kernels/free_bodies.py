@@ -40,6 +40,45 @@ def rotation(q0, q1, q2, q3):
 
 
 @njit(cache=True)
+def mm3(A, B):
+    """A B of 3x3 matrices (loops: small products called through BLAS cost more than they
+    compute)."""
+    C = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            C[r, c] = A[r, 0] * B[0, c] + A[r, 1] * B[1, c] + A[r, 2] * B[2, c]
+    return C
+
+
+@njit(cache=True)
+def mmt3(A, B):
+    """A B^T of 3x3 matrices."""
+    C = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            C[r, c] = A[r, 0] * B[c, 0] + A[r, 1] * B[c, 1] + A[r, 2] * B[c, 2]
+    return C
+
+
+@njit(cache=True)
+def mv3(A, x):
+    """A x of a 3x3 matrix and a 3-vector."""
+    y = np.empty(3)
+    for r in range(3):
+        y[r] = A[r, 0] * x[0] + A[r, 1] * x[1] + A[r, 2] * x[2]
+    return y
+
+
+@njit(cache=True)
+def mtv3(A, x):
+    """A^T x of a 3x3 matrix and a 3-vector."""
+    y = np.empty(3)
+    for r in range(3):
+        y[r] = A[0, r] * x[0] + A[1, r] * x[1] + A[2, r] * x[2]
+    return y
+
+
+@njit(cache=True)
 def _cross(a, b, out):
     out[0] = a[1] * b[2] - a[2] * b[1]
     out[1] = a[2] * b[0] - a[0] * b[2]
@@ -72,7 +111,7 @@ def frame_kinematics(fb, R_BF, p_BF, Rb, pb, wb, vb, R, o, w, vf):
             w[f] = 0.0
             vf[f] = 0.0
             continue
-        R[f] = Rb[b] @ R_BF[f]
+        R[f] = mm3(Rb[b], R_BF[f])
         for c in range(3):
             r[c] = Rb[b, c, 0] * p_BF[f, 0] + Rb[b, c, 1] * p_BF[f, 1] + Rb[b, c, 2] * p_BF[f, 2]
         _cross(wb[b], r, wr)
@@ -104,15 +143,15 @@ def mass_inverse_and_bias(vs, m, c_B, I_B_inv, I_B, Rb, wb, Minv, bias):
     for b in range(vs.shape[0]):
         j = vs[b]
         R = Rb[b]
-        c = R @ c_B[b]
-        Ii = R @ I_B_inv[b] @ R.T
-        Iw = R @ I_B[b] @ R.T
+        c = mv3(R, c_B[b])
+        Ii = mmt3(mm3(R, I_B_inv[b]), R)
+        Iw = mmt3(mm3(R, I_B[b]), R)
         X = np.zeros((3, 3))            # [c]
         X[0, 1], X[0, 2], X[1, 2] = -c[2], c[1], -c[0]
         X[1, 0], X[2, 0], X[2, 1] = c[2], -c[1], c[0]
-        IiX = Ii @ X
-        XIi = X @ Ii
-        XIiX = X @ IiX
+        IiX = mm3(Ii, X)
+        XIi = mm3(X, Ii)
+        XIiX = mm3(X, IiX)
         for r in range(3):
             for k in range(3):
                 Minv[j + r, j + k] = Ii[r, k]
@@ -120,7 +159,7 @@ def mass_inverse_and_bias(vs, m, c_B, I_B_inv, I_B, Rb, wb, Minv, bias):
                 Minv[j + 3 + r, j + k] = XIi[r, k]
                 Minv[j + 3 + r, j + 3 + k] = (1.0 / m[b] if r == k else 0.0) - XIiX[r, k]
         w = wb[b]
-        Icw = Iw @ w
+        Icw = mv3(Iw, w)
         t = np.empty(3)
         wc = np.empty(3)
         wwc = np.empty(3)
@@ -167,3 +206,43 @@ def point_rows(vs, pb, wb, body1, body2, p1, p2, D, W, acc):
                 W[j + 3 + k, col] += sign * D[col, k]
     for col in range(3):
         acc[col] = D[col, 0] * a[0] + D[col, 1] * a[1] + D[col, 2] * a[2]
+
+
+@njit(cache=True)
+def mass_matrix(vs, m, c_B, I_B, Rb, M):
+    """M (nv, nv; block diagonal, see the module docstring): [[I - m [c][c], m [c]],
+    [-m [c], m 1]] per body, I = R I_B R^T about the centre of mass, c = R c_B. Entries
+    outside the bodies' blocks are left as they are."""
+    for b in range(vs.shape[0]):
+        j = vs[b]
+        R = Rb[b]
+        c = mv3(R, c_B[b])
+        Iw = mmt3(mm3(R, I_B[b]), R)
+        X = np.zeros((3, 3))            # [c]
+        X[0, 1], X[0, 2], X[1, 2] = -c[2], c[1], -c[0]
+        X[1, 0], X[2, 0], X[2, 1] = c[2], -c[1], c[0]
+        XX = mm3(X, X)
+        for r in range(3):
+            for k in range(3):
+                M[j + r, j + k] = Iw[r, k] - m[b] * XX[r, k]
+                M[j + r, j + 3 + k] = m[b] * X[r, k]
+                M[j + 3 + r, j + k] = -m[b] * X[r, k]
+                M[j + 3 + r, j + 3 + k] = m[b] if r == k else 0.0
+
+
+@njit(cache=True)
+def frame_poses(qs, q, fb, R_BF, p_BF, R, o):
+    """The world rotations R (F, 3, 3) and origins o (F, 3) of the frames fixed on the bodies
+    (layout of the module docstring) at the positions q."""
+    for f in range(fb.shape[0]):
+        b = fb[f]
+        if b < 0:
+            R[f] = R_BF[f]
+            o[f] = p_BF[f]
+            continue
+        i = qs[b]
+        Rb = rotation(q[i], q[i + 1], q[i + 2], q[i + 3])
+        R[f] = mm3(Rb, R_BF[f])
+        for c in range(3):
+            o[f, c] = q[i + 4 + c] + Rb[c, 0] * p_BF[f, 0] + Rb[c, 1] * p_BF[f, 1] \
+                + Rb[c, 2] * p_BF[f, 2]

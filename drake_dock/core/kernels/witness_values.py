@@ -1,0 +1,134 @@
+"""The witness values the compiled engine computes per pair (`drake_dock.systems.witnesses`
+names them): the hand-over guard of an edge pair, a point-curve pair's side, the domain-end
+margin; and the far pairs' travel bounds and their witness (Sect. 5.1)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from drake_dock.core.kernels import couples as K
+from drake_dock.core.kernels.jets import jet
+from drake_dock.core.kernels.model import (AFFINE, FAR, O_EARLY, S_DUE, S_FAR, Z_NV, Z_NX,
+                                           layout, unpack_model, unpack_modes)
+from drake_dock.core.kernels.jets import position
+
+@njit(cache=True)
+def rot_col(R, a0, a1, a2):
+    return (R[0, 0] * a0 + R[0, 1] * a1 + R[0, 2] * a2,
+            R[1, 0] * a0 + R[1, 1] * a1 + R[1, 2] * a2,
+            R[2, 0] * a0 + R[2, 1] * a1 + R[2, 2] * a2)
+
+
+@njit(cache=True)
+def handover_guard(m, i, row, R2):
+    """Edge pair i's hand-over guard (`drake_dock.core.handover.edge_guard`): the least over
+    its edges of n . b, b the surface's outward conormal at the edge point, Body 2 turned by
+    R2; inf without edges."""
+    g = math.inf
+    e_par = row[K.U + 1]
+    for e in range(m.edge_first[i], m.edge_first[i] + m.edge_count[i]):
+        j = m.edge_surface[e]
+        fixed, upper, kmap = m.edge_info[e, 0], m.edge_info[e, 1], m.edge_info[e, 2]
+        if kmap == AFFINE:
+            free = m.edge_map[e, 0] * e_par + m.edge_map[e, 1]
+        else:
+            pt = position(m.kind2[i], m.prm2[i], e_par, 0.0)
+            free = pt[int(m.edge_map[e, 0])]
+        # The surface pair's u = (u1, a0, a1): a's bounds in columns 1, 2.
+        bound = m.upper[j, 1 + fixed] if upper else m.lower[j, 1 + fixed]
+        a0, a1 = (bound, free) if fixed == 0 else (free, bound)
+        _, T0, T1, _, _, _ = jet(m.kind2[j], m.prm2[j], a0, a1)
+        t = T0 if fixed == 0 else T1
+        s = rot_col(R2, t[0], t[1], t[2])
+        norm = math.sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2])
+        dot = row[K.N] * s[0] + row[K.N + 1] * s[1] + row[K.N + 2] * s[2]
+        g = min(g, (dot if upper else -dot) / norm)
+    return g
+
+
+@njit(cache=True)
+def point_curve_side(m, i, row, R2):
+    """A point-curve pair's side (`drake_dock.core.couple.point_curve_side`): the cosine
+    between its normal and the curve's curvature direction, 1 where the curve is straight."""
+    _, _, _, k, _, _ = jet(m.kind2[i], m.prm2[i], row[K.U], 0.0)
+    kw = rot_col(R2, k[0], k[1], k[2])
+    nk = math.sqrt(kw[0] * kw[0] + kw[1] * kw[1] + kw[2] * kw[2])
+    if not nk > 0.0:
+        return 1.0
+    return (row[K.N] * kw[0] + row[K.N + 1] * kw[1] + row[K.N + 2] * kw[2]) / nk
+
+
+@njit(cache=True)
+def end_margin(m, i, row):
+    """The smallest margin of pair i's bounded parameters to their domain's ends, relative to
+    the span (inf when none is bounded)."""
+    w = math.inf
+    for j in range(m.uoff[i + 1] - m.uoff[i]):
+        if m.bounded[i, j]:
+            lo, hi = m.lower[i, j], m.upper[i, j]
+            span = hi - lo
+            w = min(w, min((row[K.U + j] - lo) / span, (hi - row[K.U + j]) / span))
+    return w
+
+
+@njit(cache=True)
+def far_bounds(m, s, R, o, bound):
+    """The far pairs' travel bound (Sect. 5.1; `drake_dock.systems.far_pairs`):
+    |delta(X21 c1)| + |delta R21|_2 r1 since their last seek, inf for a pair never sought;
+    NaN for pairs that are not far."""
+    P = m.frame_pairs.shape[0]
+    R21 = np.empty((P, 3, 3))
+    p21 = np.empty((P, 3))
+    for f in range(P):
+        a, b = m.frame_pairs[f, 0], m.frame_pairs[f, 1]
+        for r in range(3):
+            for c in range(3):
+                R21[f, r, c] = R[b, 0, r] * R[a, 0, c] + R[b, 1, r] * R[a, 1, c] \
+                    + R[b, 2, r] * R[a, 2, c]
+            p21[f, r] = R[b, 0, r] * (o[a, 0] - o[b, 0]) + R[b, 1, r] * (o[a, 1] - o[b, 1]) \
+                + R[b, 2, r] * (o[a, 2] - o[b, 2])
+    for i in range(s.code.shape[0]):
+        if s.code[i] != FAR:
+            bound[i] = math.nan
+            continue
+        if not s.sought[i]:
+            bound[i] = math.inf
+            continue
+        f = m.frame_pair[i]
+        lin2 = 0.0
+        tr = 0.0
+        for r in range(3):
+            acc = p21[f, r] - s.p0[i, r]
+            for c in range(3):
+                acc += (R21[f, r, c] - s.R0[i, r, c]) * m.centre1[i, c]
+                tr += s.R0[i, r, c] * R21[f, r, c]
+            lin2 += acc * acc
+        bound[i] = math.sqrt(lin2) + math.sqrt(max(3.0 - tr, 0.0)) * m.radius1[i]
+
+
+@njit(cache=True)
+def far_witness(mp, sp, buf):
+    """Into an evaluation's result buffer (`layout`): the far pairs' travel bounds (BOUND;
+    NaN for the pairs not far), their witness, the smallest clearance left, min (clearance -
+    bound) (1 if no pair is far; scalar S_FAR), and whether a far pair sought before has used
+    ``reseek_early`` of its clearance (S_DUE). Asked by the witnesses and the step's start,
+    not by every evaluation."""
+    m = unpack_model(mp)
+    s = unpack_modes(sp)
+    k, F, nbush = s.code.shape[0], m.frame_body.shape[0], m.bush_frames.shape[0]
+    XD, OUT, LN, LT, GF, WV, BD, FR, FO, FW, FV, SC, BU, END = layout(
+        m.sizes[Z_NX], k, m.sizes[Z_NV], F, nbush)
+    bound = buf[BD:FR]
+    far_bounds(m, s, buf[FR:FO].reshape((F, 3, 3)), buf[FO:FW].reshape((F, 3)), bound)
+    wfar = math.inf
+    due = 0.0
+    early = m.options[O_EARLY]
+    for i in range(k):
+        if s.code[i] == FAR:
+            wfar = min(wfar, s.clearance[i] - bound[i])
+            if s.sought[i] and early > 0.0 and bound[i] >= early * s.clearance[i]:
+                due = 1.0
+    buf[SC + S_FAR] = 1.0 if wfar == math.inf else wfar
+    buf[SC + S_DUE] = due
