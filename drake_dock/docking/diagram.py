@@ -88,7 +88,10 @@ class CaptureMonitor(LeafSystem):
     def misalignment(self, context) -> tuple[float, float, float]:
         """Axial and lateral offset (m) and tilt (rad) of the chaser ring (`misalignment`); the
         axial offset is `axial_ring_distance`."""
-        q = self._state.Eval(context)[:self._nq]
+        return self.misalignment_of(self._state.Eval(context)[:self._nq])
+
+    def misalignment_of(self, q) -> tuple[float, float, float]:
+        """`misalignment` at the plant's positions q."""
         key = q.tobytes()
         if key != self._last[0]:
             # Drake asks again at equal positions (the witness at a step's end, the monitor,

@@ -10,7 +10,7 @@ u[N,C,3] (couple parameters, unused entries 0); p1_W[N,C,3], p2_W[N,C,3]; frame_
 (columns ta, tb, n: the contact frame, n from the couple's body 2 to its body 1; the identity
 for far couples); stewart_x[N,3] (m), stewart_rpy[N,3] (rad) (the Stewart element's deflection,
 `drake_dock.docking.plant.stewart_deflection`); stewart_force_W[N,3] (N, its force on the
-target APDS in the world frame, `drake_dock.docking.plant.stewart_force`); sample_kind[N]
+target APDS in the world frame); sample_kind[N]
 (0 step end, 1 just before an impact, 2 just after); ring_distance[N]; energy[N,k] with
 energy_names[k]; impact_t[M], impact_couples[M,C] (bool), impact_normal_impulse[M,C],
 impact_tangential_impulse[M,C,2], impact_restitution[M]; thrust_force_W[N,3] (N, the
@@ -26,8 +26,7 @@ import numpy as np
 from drake_dock.core.hybrid import Mode
 from drake_dock.systems.contact_system import COUPLE_SLICES
 from drake_dock.docking.outcome import misalignment
-from drake_dock.docking.plant import (APDS_NAMES, BODY_NAMES, stewart_deflection,
-                                      stewart_force, stewart_potential)
+from drake_dock.docking.plant import APDS_NAMES, BODY_NAMES
 from drake_dock.docking.loads import peak_loads
 from drake_dock.docking.pairs import CHASER_APDS, cost_by_pair_type, scenario_pairs
 from drake_dock.docking.scenario import scenario_dict
@@ -39,30 +38,28 @@ IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or
 
 def timeseries(result) -> dict:
     dd = result.dd
-    plant = dd.dp.plant
     rec = result.record
-    pc = plant.CreateDefaultContext()
-    X = np.asarray(rec.x)
+    contact = dd.contact
+    eng = contact.engine
+    X = rec.x
     N = len(rec.t)
+    nq = contact.nq
+    # The bodies' and the ring frames' poses and twists from the samples' states (compiled
+    # kinematics; bodies in the plant's order, frames by name).
+    body_at = [next(k for k in range(eng.nb) if int(eng.model.qs[k]) ==
+                    dd.dp.bodies[name].floating_positions_start()) for name in BODY_NAMES]
+    frame_at = [next(f for f, fr in enumerate(eng.frames)
+                     if fr.index() == dd.dp.apds_frames[name].index()) for name in APDS_NAMES]
     p_WB, R_WB = np.zeros((N, 3, 3)), np.zeros((N, 3, 3, 3))
     v_WB, w_WB = np.zeros((N, 3, 3)), np.zeros((N, 3, 3))
     p_WA, R_WA = np.zeros((N, 2, 3)), np.zeros((N, 2, 3, 3))
-    pe = np.zeros(N)
-    sx, srpy, sf = np.zeros((N, 3)), np.zeros((N, 3)), np.zeros((N, 3))
     for k in range(N):
-        plant.SetPositionsAndVelocities(pc, X[k])
-        for j, name in enumerate(BODY_NAMES):
-            body = dd.dp.bodies[name]
-            Xb = plant.EvalBodyPoseInWorld(pc, body)
-            Vb = plant.EvalBodySpatialVelocityInWorld(pc, body)
-            p_WB[k, j], R_WB[k, j] = Xb.translation(), Xb.rotation().matrix()
-            v_WB[k, j], w_WB[k, j] = Vb.translational(), Vb.rotational()
-        for j, name in enumerate(APDS_NAMES):
-            Xa = dd.dp.apds_frames[name].CalcPoseInWorld(pc)
-            p_WA[k, j], R_WA[k, j] = Xa.translation(), Xa.rotation().matrix()
-        pe[k] = stewart_potential(dd.dp, pc)
-        sx[k], srpy[k] = stewart_deflection(dd.dp, pc)
-        sf[k] = stewart_force(dd.dp, pc)
+        kin = eng.kinematics(X[k, :nq], X[k, nq:])
+        p_WB[k], R_WB[k] = kin.pb[body_at], kin.Rb[body_at]
+        v_WB[k], w_WB[k] = kin.vb[body_at], kin.wb[body_at]
+        p_WA[k], R_WA[k] = kin.o[frame_at], kin.R[frame_at]
+    bush = rec.bushings[:, 0]
+    sx, srpy, sf = bush[:, 0:3], bush[:, 3:6], bush[:, 9:12]
     C = np.asarray(rec.couples)
     S = COUPLE_SLICES
     status = C[:, :, S["status"]][..., 0].astype(np.int8)
@@ -77,7 +74,6 @@ def timeseries(result) -> dict:
             imp_c[m, j], imp_n[m, j], imp_t[m, j] = True, pn, pt
     energy = np.asarray(rec.energy)
     energy_names = list(dd.contact.energy_names)
-    energy[:, energy_names.index("potential")] = pe   # the Stewart potential (see plant.py)
     return dict(
         t=np.asarray(rec.t), body_names=np.array(BODY_NAMES), p_WB=p_WB, R_WB=R_WB, v_WB=v_WB,
         w_WB=w_WB, apds_names=np.array(APDS_NAMES), p_WA=p_WA, R_WA=R_WA,

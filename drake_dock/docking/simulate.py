@@ -35,16 +35,70 @@ from drake_dock.systems.simulator import make_simulator, make_witness_approach
 STEP, PRE_IMPACT, POST_IMPACT = 0, 1, 2
 
 
-@dataclasses.dataclass
 class Record:
-    """Raw samples of a run (row k = sample k)."""
+    """Samples of a run (row k = sample k): its time, the contact system's continuous state,
+    the sample's kind (STEP / PRE_IMPACT / POST_IMPACT), the contact modes and the inputs'
+    generalized force then. Everything else of a sample (the couple outputs, the energy, the
+    Stewart element's coordinates and force, the ring distance) is what one evaluation of the
+    contact system at it gives, made for every sample when first asked (`derive`): a run
+    records five references per step."""
 
-    t: list = dataclasses.field(default_factory=list)
-    x: list = dataclasses.field(default_factory=list)        # plant [q, v]
-    couples: list = dataclasses.field(default_factory=list)  # (n_pairs, COUPLE_OUTPUT_SIZE)
-    energy: list = dataclasses.field(default_factory=list)
-    ring_distance: list = dataclasses.field(default_factory=list)
-    kind: list = dataclasses.field(default_factory=list)     # STEP / PRE_IMPACT / POST_IMPACT
+    def __init__(self, dd=None):
+        self.dd = dd
+        self.t, self.states, self.kind, self.modes, self.tau = [], [], [], [], []
+        self._derived = None
+
+    def append(self, t, state, kind, modes, tau):
+        self.t.append(t)
+        self.states.append(state)
+        self.kind.append(kind)
+        self.modes.append(modes)
+        self.tau.append(tau)
+        self._derived = None
+
+    @property
+    def x(self) -> np.ndarray:
+        """The plant's [q, v] per sample (N, nq + nv)."""
+        n = self.dd.contact.nq + self.dd.contact.nv
+        return np.array([x[:n] for x in self.states]).reshape(len(self.t), n)
+
+    def derive(self) -> dict:
+        """Per sample, by one evaluation of the contact system: ``couples`` (N, pairs,
+        COUPLE_OUTPUT_SIZE) its couple outputs, ``energy`` (N, energy names), ``bushings``
+        (N, bushings, 12: deflection, roll-pitch-yaw, force on the APDS frame, world),
+        ``ring_distance`` (N,)."""
+        if self._derived is None:
+            contact, capture = self.dd.contact, self.dd.capture
+            n = len(self.t)
+            C = np.zeros((n, len(contact.pairs), COUPLE_OUTPUT_SIZE))
+            energy = np.zeros((n, len(contact.energy_names)))
+            bush = np.zeros((n, contact.engine.nbush, 12))
+            ring = np.zeros(n)
+            for k in range(n):
+                E = contact.engine.evaluate(self.t[k], self.states[k], self.modes[k],
+                                            self.tau[k])
+                C[k] = contact.couple_table_of(E)
+                energy[k] = contact.energy(E, self.modes[k])
+                bush[k] = E.bushings
+                ring[k] = capture.misalignment_of(self.states[k][:contact.nq])[0]
+            self._derived = dict(couples=C, energy=energy, bushings=bush, ring_distance=ring)
+        return self._derived
+
+    @property
+    def couples(self) -> np.ndarray:
+        return self.derive()["couples"]
+
+    @property
+    def energy(self) -> np.ndarray:
+        return self.derive()["energy"]
+
+    @property
+    def ring_distance(self) -> np.ndarray:
+        return self.derive()["ring_distance"]
+
+    @property
+    def bushings(self) -> np.ndarray:
+        return self.derive()["bushings"]
 
 
 @dataclasses.dataclass
@@ -98,23 +152,15 @@ def docking_simulator(dd: DockingDiagram, state: InitialState, config,
 class _Recorder:
     def __init__(self, dd: DockingDiagram):
         self.dd = dd
-        self.record = Record()
+        self.record = Record(dd)
         self.n_impacts = 0
         self._scratch = dd.diagram.CreateDefaultContext()
-        d = dd.diagram
-        self._state = d.GetOutputPort("state")
-        self._energy = d.GetOutputPort("energy")
-        self._ring = d.GetOutputPort("ring_distance")
 
-    def _append(self, context, kind):
-        r = self.record
-        r.t.append(context.get_time())
-        r.x.append(self._state.Eval(context).copy())
+    def _append(self, root, kind):
         contact = self.dd.contact
-        r.couples.append(contact.couple_table(contact.GetMyContextFromRoot(context)))
-        r.energy.append(self._energy.Eval(context).copy())
-        r.ring_distance.append(float(self._ring.Eval(context)[0]))
-        r.kind.append(kind)
+        cc = contact.GetMyContextFromRoot(root)
+        self.record.append(root.get_time(), cc.get_continuous_state_vector().CopyToVector(),
+                           kind, contact.get_modes(cc), contact.input_force(cc))
 
     def sample(self, root):
         """A step end. Impacts logged since the last sample happened at that sample's time:
@@ -122,13 +168,13 @@ class _Recorder:
         contact = self.dd.contact
         modes = contact.get_modes(contact.GetMyContextFromRoot(root))
         new = modes.impacts[self.n_impacts:]
+        r = self.record
         for imp in new:
-            if self.record.t and self.record.t[-1] == imp["t"] \
-                    and self.record.kind[-1] == STEP:
-                self.record.kind[-1] = PRE_IMPACT
+            if r.t and r.t[-1] == imp["t"] and r.kind[-1] == STEP:
+                r.kind[-1] = PRE_IMPACT
             self._post_impact(root, imp, modes)
         self.n_impacts = len(modes.impacts)
-        if not self.record.t or root.get_time() > self.record.t[-1] or new:
+        if not r.t or root.get_time() > r.t[-1] or new:
             self._append(root, STEP)
 
     def _post_impact(self, root, imp, modes):
@@ -140,7 +186,7 @@ class _Recorder:
         cc.SetContinuousState(imp["x_plus"])
         after = ContactModes(copied_states(imp["pairs_plus"]), [], imp["impact_loss_plus"],
                              modes.mode_changes)
-        cc.get_mutable_abstract_state(contact._mode_index).set_value(after.seal())
+        contact.set_modes(cc, after.seal())
         self._append(s, POST_IMPACT)
 
 

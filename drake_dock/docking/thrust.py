@@ -18,6 +18,7 @@ import numpy as np
 from pydrake.systems.framework import (BasicVector, EventStatus, LeafSystem, PublishEvent,
                                        WitnessFunctionDirection)
 
+
 WRENCH_SIZE = 6
 
 
@@ -64,8 +65,12 @@ class ThrustSystem(LeafSystem):
     def __init__(self, dp, schedule: ThrustSchedule):
         super().__init__()
         self.dp, self.schedule = dp, schedule
-        self._pc = dp.plant.CreateDefaultContext()
         self._nq = dp.plant.num_positions()
+        # The chaser APDS frame's docking axis e3 from the chaser's quaternion: R_WB R_BF e3.
+        frame = dp.apds_frames["chaser_apds"]
+        self._q0 = int(frame.body().floating_positions_start())
+        self._e3_B = tuple(float(c) for c in frame.GetFixedPoseInBodyFrame().rotation().col(2))
+        self._zero = np.zeros(WRENCH_SIZE)
         n = self._nq + dp.plant.num_velocities()
         self._state = self.DeclareVectorInputPort("state", n)
         self._contact = self.DeclareVectorInputPort("first_contact_time", 1)
@@ -87,13 +92,24 @@ class ThrustSystem(LeafSystem):
         tc = float(self._contact.Eval(context)[0])
         return math.isfinite(tc) and self.schedule.on(context.get_time() - tc)
 
+    def axis(self, q) -> tuple:
+        """The chaser APDS frame's docking axis (world) at the positions q: the chaser's
+        rotation (its quaternion, normalised as Drake does) applied to the frame's e3 in the
+        body (plain float arithmetic: it runs at every evaluation while the thrust acts)."""
+        w, x, y, z = (float(c) for c in q[self._q0:self._q0 + 4])
+        s = 2.0 / (w * w + x * x + y * y + z * z)
+        a, b, c = self._e3_B
+        return ((1.0 - s * (y * y + z * z)) * a + s * (x * y - w * z) * b + s * (x * z + w * y) * c,
+                s * (x * y + w * z) * a + (1.0 - s * (x * x + z * z)) * b + s * (y * z - w * x) * c,
+                s * (x * z - w * y) * a + s * (y * z + w * x) * b + (1.0 - s * (x * x + y * y)) * c)
+
     def _out(self, context, out):
         if not self.acting(context):
-            out.SetFromVector(np.zeros(WRENCH_SIZE))
+            out.SetFromVector(self._zero)
             return
-        self.dp.plant.SetPositions(self._pc, self._state.Eval(context)[:self._nq])
-        axis = self.dp.apds_frames["chaser_apds"].CalcPoseInWorld(self._pc).rotation().col(2)
-        out.SetFromVector(np.concatenate([np.zeros(3), self.schedule.force * np.asarray(axis)]))
+        f = self.schedule.force
+        e0, e1, e2 = self.axis(self._state.Eval(context))
+        out.SetFromVector([0.0, 0.0, 0.0, f * e0, f * e1, f * e2])
 
     def DoGetWitnessFunctions(self, context):
         return self._witnesses

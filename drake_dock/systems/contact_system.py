@@ -202,6 +202,11 @@ class RigidContactSystem(LeafSystem):
     def get_modes(self, context) -> ContactModes:
         return context.get_abstract_state(self._mode_index).get_value()
 
+    def set_modes(self, context, modes: ContactModes):
+        """Writes sealed ``modes`` into a context (a logger's scratch context: the state just
+        after an impact)."""
+        context.get_mutable_abstract_state(self._mode_index).set_value(modes)
+
     def get_couple_output_port(self, name):
         return self._couple_ports[[p.name for p in self.pairs].index(name)]
 
@@ -276,6 +281,10 @@ class RigidContactSystem(LeafSystem):
         (for loggers: one call instead of one port evaluation per couple)."""
         return self._rows.table(self._cache.Eval(context))
 
+    def couple_table_of(self, E) -> np.ndarray:
+        """`couple_table` of the evaluation E."""
+        return self._rows.table(E)
+
     # ------------------------------------------------------------------ witnesses
     def DoGetWitnessFunctions(self, context):
         return [self._w_far if i is None else self._w[i][kind] for i, kind in self._armed(context)]
@@ -307,19 +316,31 @@ class RigidContactSystem(LeafSystem):
 
     def witness_array(self, context) -> np.ndarray:
         """The values of the witnesses `DoGetWitnessFunctions` returns now, in the order of
-        `armed_witnesses` (the far pairs' first when armed)."""
+        `armed_witnesses` (the far pairs' first when armed; inf when far pairs are sought at
+        the step's start before their clearance is used up: `witness_target_leads` stands
+        for it)."""
         E = self._cache.Eval(context)
         a = self.armed_witnesses(context)
-        w = E.wv[a.pair, a.code]
-        return np.concatenate([[E.far_witness], w]) if a.far else w
+        w = E.wv.ravel().take(a.flat)
+        if not a.far:
+            return w
+        return np.concatenate([[E.far_witness if self.options.reseek_early <= 0 else math.inf],
+                               w])
+
+    def witness_target_leads(self, context) -> float:
+        """The step-end target of `WitnessApproach` (`drake_dock.systems.stepping`), s from
+        now: when a far pair is due a seek at a step's start (`_on_step`) at the present rate
+        of its travel bound; a step that ends there leaves the seek to the next step's start,
+        and no witness needs isolating."""
+        return self._cache.Eval(context).far_early
 
     def witness_rate_array(self, context) -> np.ndarray:
         """The time derivative of each witness of `witness_array` where known, NaN elsewhere:
         g' = v_n for the gap witnesses of the tracked couples."""
         E = self._cache.Eval(context)
         a = self.armed_witnesses(context)
-        d = np.full(len(a.pair), np.nan)
-        d[a.gap] = E.out[a.pair[a.gap], C.VN]
+        d = a.no_rates.copy()
+        d[a.gap] = E.out.ravel().take(a.gap_flat)
         return np.concatenate([[np.nan], d]) if a.far else d
 
     def witness_second_rate_array(self, context, mask) -> np.ndarray:
@@ -411,10 +432,13 @@ class ArmedWitnesses:
     when ``far``), and of the pairs' witnesses their pair, kind code and whether a gap
     witness of a tracked couple (``gap``, a mask)."""
 
-    __slots__ = ("names", "pair", "code", "far", "gap")
+    __slots__ = ("names", "pair", "code", "far", "gap", "flat", "gap_flat", "no_rates")
 
     def __init__(self, names, pair, code, far, gap):
         self.names, self.pair, self.code, self.far, self.gap = names, pair, code, far, gap
+        self.flat = pair * K.NW + code                  # into an evaluation's wv, raveled
+        self.gap_flat = pair[gap] * C.ROW + C.VN        # the gaps' v_n in its couple rows
+        self.no_rates = np.full(len(pair), np.nan)
 
     @classmethod
     def of(cls, armed, modes, pairs) -> "ArmedWitnesses":

@@ -181,6 +181,13 @@ class Evaluation:
         return float(self.sc[E.S_FAR])
 
     @property
+    def far_early(self) -> float:
+        """The time before a far pair is due a seek at a step's start (`due`) at the present
+        rate of its travel bound, inf without one."""
+        self._far_pass()
+        return float(self.sc[E.S_FAR_EARLY])
+
+    @property
     def due(self) -> bool:
         """A far pair's travel bound has used ``reseek_early`` of its clearance."""
         self._far_pass()

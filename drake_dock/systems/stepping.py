@@ -21,7 +21,10 @@ context)`` (a value, compared with ==, that changes whenever the set of witnesse
 ``witness_epoch(context)``, which changes whenever an event changes their state or modes
 (values from different epochs are not joined by a secant), ``witness_rate_array(context)``
 (each witness's time derivative where the source knows it, NaN elsewhere: a couple's gap) and
-``witness_second_rate_array(context, mask)`` (second derivatives of the witnesses in ``mask``):
+``witness_second_rate_array(context, mask)`` (second derivatives of the witnesses in ``mask``),
+and ``witness_target_leads(context)``: the time (s) from now at which a step should end, just
+past it, rather than isolate a witness (the source's transition is taken at the next step's
+start);
 those are also predicted by their Taylor parabola, the second derivative taken from the last
 two rates, or asked for at the first point of an epoch (just after an impact, where no history
 predicts the landing). The predictions are compiled (`drake_dock.core.kernels.leads`), over
@@ -31,32 +34,26 @@ import math
 
 import numpy as np
 
-from drake_dock.core.kernels.leads import earliest_zero, lead_jet as _lead_jet
+from drake_dock.core.kernels.leads import earliest_zero, lead_jet as _lead_jet, push
 
 
 class _History:
-    """A source's last three points (times, values, rates) of one epoch and witness layout."""
+    """A source's last three points (times, values, rates) of one epoch and witness layout,
+    in arrays the compiled predictions update in place (`leads.push`)."""
 
-    __slots__ = ("key", "T", "W", "D", "n")
+    __slots__ = ("key", "T", "W", "D", "n", "need")
 
-    def __init__(self, key, t, w, d):
+    def __init__(self, key, size):
         self.key = key
         self.T = np.full(3, np.nan)
-        self.W = np.zeros((3, len(w)))
-        self.D = np.full((3, len(w)), np.nan)
+        self.W = np.zeros((3, size))
+        self.D = np.full((3, size), np.nan)
         self.n = 0
-        self.add(t, w, d)
+        self.need = np.zeros(size, dtype=np.bool_)
 
     def add(self, t, w, d):
         """The point at t (replacing the last one at the same time or later)."""
-        if self.n and not self.T[2] < t:
-            self.n -= 1
-            self.T[1:], self.W[1:], self.D[1:] = self.T[:2].copy(), self.W[:2].copy(), \
-                self.D[:2].copy()
-        self.T[:2], self.W[:2], self.D[:2] = self.T[1:].copy(), self.W[1:].copy(), \
-            self.D[1:].copy()
-        self.T[2], self.W[2], self.D[2] = t, w, d
-        self.n = min(self.n + 1, 3)
+        self.n = push(self.T, self.W, self.D, self.n, t, w, d)
 
 
 class WitnessApproach:
@@ -84,34 +81,42 @@ class WitnessApproach:
 
     def predicted_zero(self, root) -> float:
         """Earliest predicted zero time (inf if none); updates the history."""
+        return self.predicted(root)[0]
+
+    def predicted(self, root) -> tuple[float, float]:
+        """(earliest predicted zero time of the witnesses, of the step-end targets), inf
+        where none is predicted; updates the histories."""
         t = root.get_time()
         best = math.inf
+        target = math.inf
         hist = {}
         for s in self.sources:
             c = s.GetMyContextFromRoot(root)
             epoch = s.witness_epoch(c) if hasattr(s, "witness_epoch") else 0
-            key = (epoch, s.witness_layout(c))
+            layout = s.witness_layout(c)
             w = s.witness_array(c)
             d = (s.witness_rate_array(c) if hasattr(s, "witness_rate_array")
                  else np.full(len(w), np.nan))
             h = self._hist.get(id(s))
-            if h is None or h.key[0] != key[0] or h.key[1] != key[1]:
-                h = _History(key, t, w, d)
-            else:
-                h.add(t, w, d)
+            if h is None or h.key[0] != epoch or (h.key[1] is not layout
+                                                  and h.key[1] != layout):
+                h = _History((epoch, layout), len(w))
+            h.add(t, w, d)
             hist[id(s)] = h
-            need = np.zeros(len(w), dtype=np.bool_)
+            need = h.need
             best = min(best, earliest_zero(h.T, h.W, h.D, h.n, need))
             if need.any():
                 wdd = s.witness_second_rate_array(c, need)
                 for j in np.flatnonzero(need).tolist():
                     best = min(best, t + _lead_jet(float(w[j]), float(d[j]), float(wdd[j])))
+            if hasattr(s, "witness_target_leads"):
+                target = min(target, t + s.witness_target_leads(c))
         self._hist = hist
-        return best
+        return best, target
 
     def __call__(self, root):
         t = root.get_time()
-        t_zero = self.predicted_zero(root)
+        t_zero, t_target = self.predicted(root)
         lead = t_zero - t
         step = self.max_step
         if lead < self.max_step + self.window and self._shortened < self.max_shortened:
@@ -123,4 +128,9 @@ class WitnessApproach:
             self.shortened_steps += 1
         else:
             self._shortened = 0
+        # A step-end target: the step ends just past it (its transition is taken at the next
+        # step's start), never shorter than the crossing step.
+        lead = t_target - t
+        if lead < step:
+            step = max(lead + self.window, self.cross * self.window)
         self.sim.get_mutable_integrator().set_maximum_step_size(min(step, self.max_step))

@@ -91,3 +91,24 @@ def earliest_zero(T, W, D, npts, need):
             else:
                 need[j] = True
     return best
+
+
+@njit(cache=True)
+def push(T, W, D, n, t, w, d):
+    """Appends the point (t, w (n_w,), d (n_w,)) to the history (T (3,), W, D (3, n_w)) of n
+    valid rows (the last ones), replacing the last row when t is not after it; returns the
+    new number of valid rows (at most 3)."""
+    if n > 0 and not T[2] < t:
+        n -= 1
+        for r in (1, 0):
+            T[r + 1] = T[r]
+            W[r + 1, :] = W[r, :]
+            D[r + 1, :] = D[r, :]
+    for r in range(2):
+        T[r] = T[r + 1]
+        W[r, :] = W[r + 1, :]
+        D[r, :] = D[r + 1, :]
+    T[2] = t
+    W[2, :] = w
+    D[2, :] = d
+    return min(n + 1, 3)

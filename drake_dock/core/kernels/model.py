@@ -32,7 +32,7 @@ N_OPTIONS = 10
 Z_NQ, Z_NV, Z_NU, Z_IE, Z_NX = range(5)
 N_SIZES = 5
 # Scalars of the results (section SC of `layout`), then each bushing's damper power.
-S_STATUS, S_COND, S_BAD_PC, S_UNUSED, S_FRICTION, S_P_EL, S_P_IN, S_FAR, S_KE, S_PE, \
+S_STATUS, S_COND, S_BAD_PC, S_FAR_EARLY, S_FRICTION, S_P_EL, S_P_IN, S_FAR, S_KE, S_PE, \
     S_DUE, S_DRIFTING, S_BUSH, S_DAMP = range(14)
 # Per bushing in section BUSH: deflection x (3), roll-pitch-yaw (3), spatial force on C (6).
 BUSH_ROW = 12

@@ -10,7 +10,8 @@ from numba import njit
 
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.jets import jet
-from drake_dock.core.kernels.model import (AFFINE, FAR, O_EARLY, S_DUE, S_FAR, Z_NV, Z_NX,
+from drake_dock.core.kernels.model import (AFFINE, FAR, O_EARLY, S_DUE, S_FAR, S_FAR_EARLY,
+                                           Z_NV, Z_NX,
                                            layout, unpack_model, unpack_modes)
 from drake_dock.core.kernels.jets import position
 
@@ -109,11 +110,33 @@ def far_bounds(m, s, R, o, bound):
 
 
 @njit(cache=True)
+def bound_rate(m, i, R, o, w, vf):
+    """An upper bound of the rate of far pair i's travel bound (`far_bounds`): the speed of
+    its bounding sphere's centre relative to frame 2 plus the relative angular speed times
+    its radius."""
+    a, b = m.frame_pairs[m.frame_pair[i], 0], m.frame_pairs[m.frame_pair[i], 1]
+    c = rot_col(R[a], m.centre1[i, 0], m.centre1[i, 1], m.centre1[i, 2])
+    v2 = 0.0
+    rot2 = 0.0
+    for r in range(3):
+        r1, r2 = (r + 1) % 3, (r + 2) % 3
+        pa = w[a, r1] * c[r2] - w[a, r2] * c[r1]                         # w_a x (R_a c)
+        d = (c[r1] + o[a, r1] - o[b, r1], c[r2] + o[a, r2] - o[b, r2])    # P1 - o_b
+        pb = w[b, r1] * d[1] - w[b, r2] * d[0]                           # w_b x (P1 - o_b)
+        v = vf[a, r] + pa - vf[b, r] - pb
+        v2 += v * v
+        dw = w[a, r] - w[b, r]
+        rot2 += dw * dw
+    return math.sqrt(v2) + math.sqrt(rot2) * m.radius1[i]
+
+
+@njit(cache=True)
 def far_witness(mp, sp, buf):
     """Into an evaluation's result buffer (`layout`): the far pairs' travel bounds (BOUND;
     NaN for the pairs not far), their witness, the smallest clearance left, min (clearance -
-    bound) (1 if no pair is far; scalar S_FAR), and whether a far pair sought before has used
-    ``reseek_early`` of its clearance (S_DUE). Asked by the witnesses and the step's start,
+    bound) (1 if no pair is far; scalar S_FAR), the time before a pair sought before is due a
+    seek at a step's start, min (reseek_early clearance - bound) / (the bound's rate,
+    `bound_rate`) (inf for none; S_FAR_EARLY), and whether one is due (S_DUE). Asked by the witnesses and the step's start,
     not by every evaluation."""
     m = unpack_model(mp)
     s = unpack_modes(sp)
@@ -121,14 +144,24 @@ def far_witness(mp, sp, buf):
     XD, OUT, LN, LT, GF, WV, BD, FR, FO, FW, FV, SC, BU, END = layout(
         m.sizes[Z_NX], k, m.sizes[Z_NV], F, nbush)
     bound = buf[BD:FR]
-    far_bounds(m, s, buf[FR:FO].reshape((F, 3, 3)), buf[FO:FW].reshape((F, 3)), bound)
+    R, o = buf[FR:FO].reshape((F, 3, 3)), buf[FO:FW].reshape((F, 3))
+    w, vf = buf[FW:FV].reshape((F, 3)), buf[FV:SC].reshape((F, 3))
+    far_bounds(m, s, R, o, bound)
     wfar = math.inf
+    lead = math.inf
     due = 0.0
     early = m.options[O_EARLY]
     for i in range(k):
         if s.code[i] == FAR:
             wfar = min(wfar, s.clearance[i] - bound[i])
-            if s.sought[i] and early > 0.0 and bound[i] >= early * s.clearance[i]:
-                due = 1.0
+            if s.sought[i] and early > 0.0:
+                left = early * s.clearance[i] - bound[i]
+                if left <= 0.0:
+                    due = 1.0
+                else:
+                    rate = bound_rate(m, i, R, o, w, vf)
+                    if rate > 0.0:
+                        lead = min(lead, left / rate)
     buf[SC + S_FAR] = 1.0 if wfar == math.inf else wfar
+    buf[SC + S_FAR_EARLY] = lead
     buf[SC + S_DUE] = due
