@@ -28,7 +28,7 @@ from numba import njit
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.free_bodies import (body_kinematics, frame_kinematics,
                                                  mass_inverse_and_bias, point_rows, qdot)
-from drake_dock.core.kernels.solve import OK, SLIDE, solve_modes
+from drake_dock.core.kernels.solve import OK, SLIDE, STICK, solve_modes
 
 
 class Bodies(NamedTuple):
@@ -161,3 +161,32 @@ def evaluate(B, C, q, v, u, sigma, active, rows, codes, held_dir, has_dir, tau_e
     xdot[e], xdot[e + 1], xdot[e + 2] = (power / energy_scale, p_el / energy_scale,
                                          p_in / energy_scale)
     return status, cond, bad_pc, bad_drift, power, p_el, p_in
+
+
+def warm():
+    """Compiles or loads the kernel: two free bodies with a frame each, and one CC, one CS and
+    one PC couple between the frames (those of `tracked.warm`), the first two in contact, one
+    sticking and one sliding; the argument types of `drake_dock.systems.engine`'s call."""
+    from drake_dock.core.kernels.tracked import TrackedCouples
+    from drake_dock.core.patches import Circle, PlaneRect, Point, Segment
+    tc = TrackedCouples([("CC", Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1)),
+                          Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0)), (0, 1)),
+                         ("CS", Circle(0.3, 0.1), PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)),
+                          (0, 1)),
+                         ("PC", Point((0.1, 0.2, 0.3), 0.01), Circle(0.3), (0, 1))])
+    pc = np.zeros(3, dtype=np.bool_)
+    pc[tc.pc] = True
+    C = CoupleSet(tc.cc, pc, tc.kind1, tc.prm1, tc.kind2, tc.prm2, tc.fidx, tc.uoff, tc.spans)
+    eye = np.array([np.eye(3), np.eye(3)])
+    B = Bodies(np.array([0, 7], dtype=np.int64), np.array([0, 6], dtype=np.int64), np.ones(2),
+               np.zeros((2, 3)), eye, eye.copy(), np.array([0, 1], dtype=np.int64), eye.copy(),
+               np.zeros((2, 3)))
+    q = np.array([1.0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1])
+    u = np.array([0.5, 0.5, 0.0, 0.5, 0.5, 1.0])
+    F, k, nv = 2, 3, 12
+    evaluate(B, C, q, np.zeros(nv), u, np.ones(k), np.ones(k, dtype=np.bool_),
+             np.array([0, 1], dtype=np.int64), np.array([STICK, SLIDE], dtype=np.int64),
+             np.zeros((2, 2)), np.zeros(2, dtype=np.bool_), np.zeros(nv), np.zeros(nv), 0.3, 0.3,
+             20.0, 1e-6, 0.0, 1e-3, 1.0, np.empty((F, 3, 3)), np.empty((F, 3)),
+             np.empty((F, 3)), np.empty((F, 3)), np.zeros((k, K.ROW)),
+             np.zeros(q.size + nv + u.size + 3), np.empty(k), np.empty((k, 2)), np.empty(nv))
