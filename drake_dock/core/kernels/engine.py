@@ -96,16 +96,19 @@ def evaluate(B, C, q, v, u, sigma, active, rows, codes, held_dir, has_dir, tau_e
             other[i] = False
             any_pc = any_pc or active[i]
     bad_pc, bad_drift = -1, -1
+    # Projected; a bool, not the literal True, so that the couples' kernels compiled for the
+    # tracked path (`tracked.TrackedCouples.evaluate`) serve here too.
+    project = np.bool_(True)
     if any_pc:
         pc_idx = np.flatnonzero(C.pc)
         K.evaluate_point_curves(pc_idx, C.kind2, C.prm1, C.prm2, C.fidx, C.uoff, C.spans, R, o,
-                                w, vf, u, sigma, active, True, drift_feedback, out, udot)
+                                w, vf, u, sigma, active, project, drift_feedback, out, udot)
         for i in pc_idx:
             if active[i] and math.isnan(out[i, K.GAP]):
                 bad_pc = i
                 break
     K.evaluate_couples(C.cc, C.kind1, C.prm1, C.kind2, C.prm2, C.fidx, C.uoff, C.spans, R, o, w,
-                       vf, u, sigma, other, True, drift_feedback, out, udot)
+                       vf, u, sigma, other, project, drift_feedback, out, udot)
     r = rows.shape[0]
     for j in range(r):
         if out[rows[j], K.DRIFT_REL] > drift_tol:
