@@ -50,7 +50,10 @@ _HERE = pathlib.Path(__file__).resolve().parent
 _CORE = _HERE.parent
 _PACKAGE = _CORE.parent                     # drake_dock/
 PACKAGE = "drake_dock.core.kernels"
-OPT = 3               # numba's optimisation level for the kernels, unless NUMBA_OPT is set
+# numba's optimisation level for the kernels, unless NUMBA_OPT is set: 1 compiles them in about
+# 3/4 of the time of numba's default 3, runs them as fast and gives the same bits
+# (docs/performance.md, "Compiled kernels"). 0 would leave some uncacheable.
+OPT = 1
 _base = None          # the base directory, set by `configure`
 
 
