@@ -122,21 +122,21 @@ STATS = """
 
 def test_the_parallel_compile_fills_the_cache_and_another_process_loads_it(tmp_path):
     names = ["cover", "tracked"]
-    out = _python(f"""
+    out = _python(textwrap.dedent(f"""
         import sys
         from drake_dock.core.kernels import prepare
         assert prepare.missing({names}) == {names}
         prepare.prepare(sys.stdout, jobs=2, names={names})
         assert prepare.missing({names}) == []
-    """ + STATS, tmp_path).stdout
+    """) + textwrap.dedent(STATS), tmp_path).stdout
     assert "compiling the numba kernels, 2 modules in 2 processes" in out
     assert "  cover: " in out and "  tracked: " in out
     hits, misses = map(int, out.split()[-2:])
     assert hits > 0 and misses == 0          # this process loaded what the workers compiled
-    out = _python(f"""
+    out = _python(textwrap.dedent(f"""
         from drake_dock.core.kernels import prepare
         prepare.warm({names})
-    """ + STATS, tmp_path).stdout
+    """) + textwrap.dedent(STATS), tmp_path).stdout
     hits, misses = map(int, out.split()[-2:])
     assert hits > 0 and misses == 0
 
@@ -145,7 +145,14 @@ def test_concurrent_writers_of_one_function_leave_an_index_that_loads_each(tmp_p
     kinds = ["1", "1.0", "True", "1j"]           # four signatures of frames.add
     code = """
         import sys, time
+        from numba.core import caching
         from drake_dock.core.kernels import frames
+        save_index = caching.IndexDataCacheFile._save_index
+
+        def slow(self, overloads):      # widens the window between reading and writing
+            time.sleep(0.5)
+            save_index(self, overloads)
+        caching.IndexDataCacheFile._save_index = slow
         x = {kind}
         time.sleep(max(0.0, float(sys.argv[1]) - time.time()))    # start together
         frames.add((x, x, x), (x, x, x))
