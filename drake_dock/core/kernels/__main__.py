@@ -1,7 +1,8 @@
 """``python -m drake_dock.core.kernels [--jobs N]``: compiles the kernels that the cache lacks,
 in N processes (default: one per core) with a line per module and its time, loads them all and
-prints the cache directory. ``--unit NAME`` is a worker's command: it compiles one module's
-kernels and prints its seconds (`drake_dock.core.kernels.prepare`)."""
+prints the cache directory. ``--worker`` is a worker's command: it compiles the modules named on
+its stdin, one a line, and answers each with a line "NAME SECONDS"
+(`drake_dock.core.kernels.prepare`)."""
 import argparse
 import sys
 
@@ -14,10 +15,10 @@ def main(argv=None) -> int:
                                  description=__doc__.split("\n\n")[0])
     ap.add_argument("--jobs", type=int, default=None,
                     help="worker processes (default: one per core; 1 compiles in this process)")
-    ap.add_argument("--unit", help=argparse.SUPPRESS)
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
-    if args.unit:
-        print(f"{prepare.compile_unit(args.unit):.3f}")
+    if args.worker:
+        prepare.serve(sys.stdin, sys.stdout)
         return 0
     seconds = prepare.prepare(sys.stdout, jobs=args.jobs)
     print(f"kernels ready in {seconds:.2f} s; numba cache: {cache_dir()}")

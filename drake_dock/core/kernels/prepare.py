@@ -6,8 +6,9 @@ the kernel modules it calls, by evaluating them once on a small case with the ar
 a run. `warm` runs every unit in this process. `prepare` (``drake-dock run`` and
 ``python -m drake_dock.core.kernels``) first compiles the units whose cache is missing (no
 ``warm.done`` in their module's cache directory, `compile_cache.module_cache_dir`, whose key
-covers everything the unit compiles) in up to ``jobs`` worker processes, a line per unit with
-its time, then loads every unit here.
+covers everything the unit compiles) in up to ``jobs`` worker processes
+(``python -m drake_dock.core.kernels --worker``, each taking one unit after another), a line per
+unit with its time, then loads every unit here.
 
 Order (`schedule`): a unit starts after the units it shares a kernel module with that have
 fewer kernel modules than it (`engine` after `tracked` and `constraints`): their common callees
@@ -18,8 +19,10 @@ kernel source lines it compiles itself (a rough measure of its compile time).
 from __future__ import annotations
 
 import ast
+import contextlib
 import importlib
 import os
+import select
 import subprocess
 import sys
 import time
@@ -107,39 +110,54 @@ def warm(names: list[str] | None = None, stream=None) -> None:
                      f"{time.perf_counter() - t0:.0f} s so far)")
 
 
-def _worker(name: str) -> subprocess.Popen:
-    """``python -m drake_dock.core.kernels --unit NAME``, on this process's cache base."""
+def _workers(jobs: int) -> list[subprocess.Popen]:
+    """``jobs`` processes ``python -m drake_dock.core.kernels --worker`` on this process's cache
+    base: each compiles the units named on its stdin, one a line, and answers each with a line
+    "NAME SECONDS" (the numba it warmed up and the kernels it compiled serve its next unit)."""
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cc.cache_dir().parent))
-    return subprocess.Popen([sys.executable, "-m", cc.PACKAGE, "--unit", name], env=env,
-                            stdout=subprocess.PIPE, text=True)
+    return [subprocess.Popen([sys.executable, "-m", cc.PACKAGE, "--worker"], env=env,
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+            for _ in range(jobs)]
+
+
+def serve(lines, out) -> None:
+    """A worker's loop: compiles each unit named in ``lines`` and writes "NAME SECONDS"."""
+    for line in lines:
+        out.write(f"{line.strip()} {compile_unit(line.strip()):.3f}\n")
+        out.flush()
 
 
 def compile_parallel(names: list[str], jobs: int, stream=None) -> None:
-    """Compiles the units ``names`` in up to ``jobs`` worker processes, in `schedule` order,
-    with a line per unit on ``stream`` as each one finishes. A failed unit raises
-    RuntimeError (the worker's traceback is on stderr) after the other workers are ended."""
+    """Compiles the units ``names`` in ``jobs`` worker processes, in `schedule` order, with a
+    line per unit on ``stream`` as each one finishes. A failed unit raises RuntimeError (the
+    worker's traceback is on stderr); the workers end with this call."""
     order, after = schedule(names)
-    running, done, t0 = {}, set(), time.perf_counter()
+    idle, busy, done, t0 = _workers(jobs), {}, set(), time.perf_counter()
     try:
-        while order or running:
-            for name in [n for n in order if not after[n] - done][:jobs - len(running)]:
+        while order or busy:
+            for name in [n for n in order if not after[n] - done][:len(idle)]:
                 order.remove(name)
-                running[name] = _worker(name)
-            time.sleep(0.05)
-            for name, proc in list(running.items()):
-                if proc.poll() is None:
-                    continue
-                out = proc.stdout.read()
-                del running[name]
-                if proc.returncode:
+                proc = idle.pop()
+                busy[proc] = name
+                proc.stdin.write(name + "\n")
+                proc.stdin.flush()
+            ready, _, _ = select.select([p.stdout for p in busy], [], [])
+            for proc in [p for p in busy if p.stdout in ready]:
+                answer = proc.stdout.readline().split()
+                name = busy.pop(proc)
+                if len(answer) != 2:
                     raise RuntimeError(f"compiling the kernels of {cc.PACKAGE}.{name} failed "
-                                       f"(exit code {proc.returncode}; see above)")
+                                       f"(see above)")
                 done.add(name)
-                _say(stream, f"  {name}: {float(out.split()[-1]):.1f} s ({len(done)} of "
+                idle.append(proc)
+                _say(stream, f"  {name}: {float(answer[1]):.1f} s ({len(done)} of "
                              f"{len(names)}, {time.perf_counter() - t0:.0f} s so far)")
     finally:
-        for proc in running.values():
-            proc.kill()
+        for proc in idle + list(busy):
+            with contextlib.suppress(OSError):
+                proc.stdin.close()          # the worker's loop ends
+            if proc in busy:
+                proc.kill()
             proc.wait()
 
 
