@@ -1,8 +1,8 @@
 """The compiled kernels' cache is keyed per module: a module's key follows its source and those
-of the modules it imports (numba checks only a kernel's own file), and no other; every kernel is
-compiled by some module's warm(); the parallel compile fills the cache so that another process
-loads every kernel without compiling; concurrent writers of one function's signatures leave an
-index that loads each of them."""
+of the modules it imports (numba checks only a kernel's own file), and no other. The parallel
+compile caches every kernel (each is compiled by some module's warm()) so that another process
+loads them without compiling; concurrent writers of one function's signatures leave an index
+that loads each of them."""
 import os
 import shutil
 import subprocess
@@ -86,20 +86,6 @@ def test_the_kernels_are_cached_in_their_module_directory_under_its_key():
         assert fn._cache._impl.locator.get_source_stamp() == key
 
 
-def test_every_kernel_is_compiled_by_a_module_warm():
-    """A kernel module that no unit's warm() reaches (a new module without warm(), or one no
-    warm() calls) fails here: `prepare` would leave it to compile in the middle of a run."""
-    import importlib
-    prepare.warm()
-    cold = []
-    for name in prepare.kernel_modules():
-        module = importlib.import_module(K + name)
-        cold += [f"{name}.{attr}" for attr, value in vars(module).items()
-                 if isinstance(value, CPUDispatcher) and value.py_func.__module__ == K + name
-                 and not value.signatures]
-    assert not cold, f"kernels no module's warm() compiles: {cold}"
-
-
 def _python(code, cache, **kw):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(ROOT))
     return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], env=env, cwd=ROOT,
@@ -120,23 +106,37 @@ STATS = """
 """
 
 
-def test_the_parallel_compile_fills_the_cache_and_another_process_loads_it(tmp_path):
-    names = ["cover", "tracked"]
+def _kernels():
+    """(module, dispatcher) of every kernel defined in the kernels package."""
+    import importlib
+    for name in prepare.kernel_modules():
+        for value in vars(importlib.import_module(K + name)).values():
+            if isinstance(value, CPUDispatcher) and value.py_func.__module__ == K + name:
+                yield name, value
+
+
+def test_the_parallel_compile_caches_every_kernel_and_another_process_loads_them(tmp_path):
+    """Every kernel is compiled by some module's warm(): one that none reaches (a new module
+    without warm(), or a kernel no warm() calls) fails here, since it would compile in the
+    middle of a run. Then a second process loads every module without compiling."""
+    units = prepare.units()
     out = _python(textwrap.dedent(f"""
         import sys
         from drake_dock.core.kernels import prepare
-        assert prepare.missing({names}) == {names}
-        prepare.prepare(sys.stdout, jobs=2, names={names})
-        assert prepare.missing({names}) == []
+        assert prepare.missing() == {units}
+        prepare.prepare(sys.stdout, jobs=2)
+        assert prepare.missing() == []
     """) + textwrap.dedent(STATS), tmp_path).stdout
-    assert "compiling the numba kernels, 2 modules in 2 processes" in out
-    assert "  cover: " in out and "  tracked: " in out
+    assert f"compiling the numba kernels, {len(units)} modules in 2 processes" in out
+    assert all(f"  {u}: " in out for u in units)
     hits, misses = map(int, out.split()[-2:])
     assert hits > 0 and misses == 0          # this process loaded what the workers compiled
-    out = _python(textwrap.dedent(f"""
-        from drake_dock.core.kernels import prepare
-        prepare.warm({names})
-    """) + textwrap.dedent(STATS), tmp_path).stdout
+    cold = [f"{name}.{fn.py_func.__qualname__}" for name, fn in _kernels()
+            if not list((tmp_path / "drake_dock" / f"{name}-{cc.module_key(K + name)}").glob(
+                f"{name}.{fn.py_func.__qualname__}-{fn.py_func.__code__.co_firstlineno}.py*.nbi"))]
+    assert not cold, f"kernels no module's warm() compiles: {cold}"
+    out = _python("from drake_dock.core.kernels import prepare\nprepare.warm()\n"
+                  + textwrap.dedent(STATS), tmp_path).stdout
     hits, misses = map(int, out.split()[-2:])
     assert hits > 0 and misses == 0
 
@@ -171,3 +171,10 @@ def test_concurrent_writers_of_one_function_leave_an_index_that_loads_each(tmp_p
               sum(frames.add.stats.cache_misses.values()))
     """, tmp_path).stdout
     assert out.split() == [str(len(kinds)), "0"]
+
+
+def test_a_unit_starts_after_the_smaller_units_it_shares_kernels_with():
+    order, after = prepare.schedule(prepare.units())
+    assert sorted(order) == prepare.units()
+    assert {"tracked", "constraints"} <= after["engine"]   # the couples, the constraint solve
+    assert not after["lzb"] and "engine" not in set().union(*after.values())

@@ -218,13 +218,13 @@ def configure() -> None:
         return
     _base = _choose_base()
     os.environ["NUMBA_OPT"] = opt_level()
+    classes = os.environ.get("NUMBA_CACHE_LOCATOR_CLASSES")
+    if classes and "KeyedLocator" not in classes:   # it replaces numba's list: ours first there
+        os.environ["NUMBA_CACHE_LOCATOR_CLASSES"] = f"{__name__}.KeyedLocator,{classes}"
     config.reload_config()
     impl = getattr(caching, "CacheImpl", None) or caching._CacheImpl
     if KeyedLocator not in impl._locator_classes:
         impl._locator_classes.insert(0, KeyedLocator)
-    if config.CACHE_LOCATOR_CLASSES and "KeyedLocator" not in config.CACHE_LOCATOR_CLASSES:
-        # NUMBA_CACHE_LOCATOR_CLASSES replaces numba's list: ours goes first there too
-        config.CACHE_LOCATOR_CLASSES = f"{__name__}.KeyedLocator,{config.CACHE_LOCATOR_CLASSES}"
     if not getattr(caching.IndexDataCacheFile.save, "drake_dock_locked", False):
         caching.IndexDataCacheFile.save = _locked(caching.IndexDataCacheFile.save)
 
