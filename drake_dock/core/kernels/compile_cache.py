@@ -33,11 +33,11 @@ import ast
 import contextlib
 import functools
 import hashlib
-import importlib.metadata
 import os
 import pathlib
 import tempfile
 
+import numba
 from numba.core import caching, config
 from numba.core.caching import _CacheLocator
 
@@ -89,8 +89,25 @@ def _imports(name: str, package: pathlib.Path) -> set[str]:
     """The drake_dock modules that module ``name``'s source imports (anywhere in the file)."""
     path = module_file(name, package)
     here = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+    st = path.stat()
+    return _parsed_imports(str(path), st.st_mtime_ns, st.st_size, here, package)
+
+
+def _statements(nodes):
+    """The statements ``nodes`` and those nested in them (imports are statements: expressions
+    are not walked, which makes it quick)."""
+    for node in nodes:
+        yield node
+        for field in ("body", "orelse", "finalbody", "handlers", "cases"):
+            yield from _statements(getattr(node, field, None) or [])
+
+
+@functools.lru_cache(maxsize=None)
+def _parsed_imports(path: str, mtime_ns: int, size: int, here: str,
+                    package: pathlib.Path) -> frozenset[str]:
+    """`_imports` of the file as it is at (mtime_ns, size): parsed once per version."""
     found = set()
-    for node in ast.walk(ast.parse(path.read_bytes(), filename=str(path))):
+    for node in _statements(ast.parse(pathlib.Path(path).read_bytes(), filename=path).body):
         if isinstance(node, ast.Import):
             found.update(a.name for a in node.names)
         elif isinstance(node, ast.ImportFrom):
@@ -100,7 +117,7 @@ def _imports(name: str, package: pathlib.Path) -> set[str]:
                 mod = ".".join(base + ([mod] if mod else []))
             for a in node.names:      # a submodule, or a name of the module
                 found.add(f"{mod}.{a.name}" if module_file(f"{mod}.{a.name}", package) else mod)
-    return {m for m in found if module_file(m, package) is not None}
+    return frozenset(m for m in found if module_file(m, package) is not None)
 
 
 def dependencies(name: str, package: pathlib.Path = _PACKAGE) -> list[str]:
@@ -121,7 +138,7 @@ def opt_level() -> str:
 def module_key(name: str, package: pathlib.Path = _PACKAGE) -> str:
     """A digest of numba's version, `opt_level` and the sources (names and bytes) of
     `dependencies`: it changes when the module or a module it imports changes."""
-    digest = hashlib.sha256(f"numba {importlib.metadata.version('numba')} "
+    digest = hashlib.sha256(f"numba {numba.__version__} "
                             f"opt {opt_level()}".encode())
     for dep in dependencies(name, package):
         digest.update(dep.encode() + b"\0" + module_file(dep, package).read_bytes() + b"\0")

@@ -51,9 +51,9 @@ def units(package=cc._PACKAGE) -> list[str]:
 
 def _kernel_deps(name: str, package=cc._PACKAGE) -> set[str]:
     """The kernel modules (short names) that unit ``name`` imports, itself included."""
-    prefix = cc.PACKAGE + "."
+    prefix, kernels = cc.PACKAGE + ".", set(kernel_modules(package))
     return {d[len(prefix):] for d in cc.dependencies(prefix + name, package)
-            if d.startswith(prefix) and d[len(prefix):] in kernel_modules(package)}
+            if d.startswith(prefix) and d[len(prefix):] in kernels}
 
 
 def schedule(names: list[str], package=cc._PACKAGE):
@@ -177,9 +177,10 @@ def prepare(stream=None, jobs: int | None = None, names: list[str] | None = None
     todo = missing(names)
     if todo:
         jobs = max(1, min(jobs or cores(), len(todo)))
-        _say(stream, f"drake-dock: compiling the numba kernels, {len(todo)} modules in {jobs} "
-                     f"process{'es' if jobs > 1 else ''} (after an install or an update only; "
-                     f"later runs load them from the cache)")
+        _say(stream, f"drake-dock: compiling the numba kernels, {len(todo)} module"
+                     f"{'s' if len(todo) > 1 else ''} in {jobs} process"
+                     f"{'es' if jobs > 1 else ''} (after an install or an update only; later "
+                     f"runs load them from the cache)")
         if jobs > 1:
             compile_parallel(todo, jobs, stream)
         else:
