@@ -111,10 +111,13 @@ def warm(names: list[str] | None = None, stream=None) -> None:
 
 
 def _workers(jobs: int) -> list[subprocess.Popen]:
-    """``jobs`` processes ``python -m drake_dock.core.kernels --worker`` on this process's cache
-    base: each compiles the units named on its stdin, one a line, and answers each with a line
-    "NAME SECONDS" (the numba it warmed up and the kernels it compiled serve its next unit)."""
-    env = dict(os.environ, NUMBA_CACHE_DIR=str(cc.cache_dir().parent))
+    """``jobs`` processes ``python -m drake_dock.core.kernels --worker`` on this process's
+    drake_dock sources and cache base: each compiles the units named on its stdin, one a line,
+    and answers each with a line "NAME SECONDS" (the numba it warmed up and the kernels it
+    compiled serve its next unit)."""
+    path = os.pathsep.join([str(cc._PACKAGE.parent)] + [p for p in [os.environ.get(
+        "PYTHONPATH")] if p])
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cc.cache_dir().parent), PYTHONPATH=path)
     return [subprocess.Popen([sys.executable, "-m", cc.PACKAGE, "--worker"], env=env,
                              stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
             for _ in range(jobs)]
