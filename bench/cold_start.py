@@ -10,7 +10,8 @@ first run and filled after it, and that nothing went to the clone's own ``__pyca
 Prints the commands' own lines (the compile's line per module) as they come, then
 `first run with an empty cache: <S> s` (wall time of the whole command), `warm run: <S> s`
 and the ratio of the two, the cache files the warm run added (0: it compiled nothing), and
-whether the target (S <= 45 s on 2 cores, issue 42) is met, with this machine's cores.
+whether the target (S <= 45 s on 2 cores, issue 42) is met, with this machine's cores (and,
+first, its load average: the compile takes up to twice as long beside other jobs).
 
     python bench/cold_start.py [--keep]
 """
@@ -59,7 +60,8 @@ def main():
         assert pathlib.Path(imported).is_relative_to(clone), imported
         assert _files(cache) == 0
         print(f"commit {commit[:12]}, cloned into {clone}; drake_dock imported from the clone; "
-              f"empty numba cache {cache}; {len(os.sched_getaffinity(0))} cores")
+              f"empty numba cache {cache}; {len(os.sched_getaffinity(0))} cores, load average "
+              f"{os.getloadavg()[0]:.2f} (other jobs slow the compile down)")
         run = [sys.executable, "-m", "drake_dock", "run", "models/paper_example.yaml",
                "--no-progress", "--out"]
         cold = _timed(run + [str(tmp / "out-cold")], env, clone)
