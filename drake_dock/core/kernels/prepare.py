@@ -148,11 +148,11 @@ def compile_parallel(names: list[str], jobs: int, stream=None) -> None:
             for proc in [p for p in busy if p.stdout in ready]:
                 answer = proc.stdout.readline().split()
                 name = busy.pop(proc)
+                idle.append(proc)
                 if len(answer) != 2:
                     raise RuntimeError(f"compiling the kernels of {cc.PACKAGE}.{name} failed "
                                        f"(see above)")
                 done.add(name)
-                idle.append(proc)
                 _say(stream, f"  {name}: {float(answer[1]):.1f} s ({len(done)} of "
                              f"{len(names)}, {time.perf_counter() - t0:.0f} s so far)")
     finally:
