@@ -13,7 +13,7 @@ $(BIN)/.installed: pyproject.toml constraints.txt
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade "pip==26.3"
 	$(BIN)/python -m pip install -c constraints.txt -e ".[test]"
-	@echo "== drake_dock: compiling the numba kernels (about 90 s, once; runs load them from the cache)"
+	@echo "== drake_dock: compiling the numba kernels (once, a process per core, a line per module; runs load them from the cache)"
 	$(BIN)/python -m drake_dock.core.kernels
 	touch $@
 

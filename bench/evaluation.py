@@ -17,7 +17,7 @@ import dataclasses
 import os
 import sys
 
-from drake_dock.core.kernels.compile_cache import warm
+from drake_dock.core.kernels.prepare import warm
 from drake_dock.docking.diagram import build_docking_diagram, contact_options
 from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE, load_scenario
 from drake_dock.docking.simulate import simulate

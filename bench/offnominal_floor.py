@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drake_dock.core.kernels.compile_cache import warm
+from drake_dock.core.kernels.prepare import warm
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.docking.scene import initial_state
 from drake_dock.docking.simulate import simulate

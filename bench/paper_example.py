@@ -27,7 +27,7 @@ import time
 import numpy as np
 
 from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.core.kernels.compile_cache import warm
+from drake_dock.core.kernels.prepare import warm
 from drake_dock.docking.scene import contact_approach, first_contact_seeks, initial_state
 from drake_dock.docking.simulate import simulate
 from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
@@ -40,7 +40,7 @@ def kernel_start(cache_dir):
     """Wall time of a fresh process importing and readying the compiled kernels with the numba
     cache in ``cache_dir`` (empty: a cold start, compiling; filled: a warm one, loading)."""
     code = ("import time; t = time.perf_counter(); "
-            "from drake_dock.core.kernels.compile_cache import warm; warm(); "
+            "from drake_dock.core.kernels.prepare import warm; warm(); "
             "print(time.perf_counter() - t)")
     env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
     out = subprocess.run([sys.executable, "-c", code], env=env, check=True,

@@ -202,34 +202,13 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-COMPILE_NOTE_AFTER = 2.0     # s of kernel preparation before the compile note is printed
-
-
 def prepare_kernels(stream=None) -> float:
-    """Compiles the numba kernels, or loads them from their cache
-    (`drake_dock.core.kernels.compile_cache`), before a run, so that the run's wall time and
-    its progress bar are the simulation's; a note on ``stream`` (stderr) says so when it takes
-    longer than COMPILE_NOTE_AFTER (a first run after an install or an update). Returns the
-    seconds it took."""
-    import threading
-    import time
-
-    from drake_dock.core.kernels.compile_cache import warm
-    stream = stream or sys.stderr
-
-    def note():
-        stream.write("drake-dock: compiling the numba kernels (after an install or an update "
-                     "only: about 90 s; later runs load them from the cache)\n")
-        stream.flush()
-    timer = threading.Timer(COMPILE_NOTE_AFTER, note)
-    timer.daemon = True
-    t0 = time.perf_counter()
-    timer.start()
-    try:
-        warm()
-    finally:
-        timer.cancel()
-    return time.perf_counter() - t0
+    """Compiles the numba kernels that their cache lacks (a first run after an install or an
+    update: in parallel, with a line per module on ``stream``, stderr by default) and loads
+    them all (`drake_dock.core.kernels.prepare`), before a run, so that the run's wall time and
+    its progress bar are the simulation's. Returns the seconds it took."""
+    from drake_dock.core.kernels.prepare import prepare
+    return prepare(stream or sys.stderr)
 
 
 def _need_out(out, what):

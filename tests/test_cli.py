@@ -160,20 +160,24 @@ def test_input_errors_lead_with_their_reason(tmp_path):
     assert "NoneType" not in msg and not (tmp_path / "out").exists()
 
 
-def test_kernels_prepared_with_a_note_when_it_takes_long(monkeypatch):
-    """The kernels are compiled (or loaded) before the run; when that takes long (a first run
-    after an install) a note says so while it happens, and not otherwise."""
+def test_kernels_prepared_with_a_line_per_module_when_they_compile(monkeypatch):
+    """The kernels are compiled (or loaded) before the run; when their cache lacks some (a
+    first run after an install) a note and a line per module say so, and nothing otherwise."""
     import io
-    import time
 
     from drake_dock import cli
-    monkeypatch.setattr(cli, "COMPILE_NOTE_AFTER", 0.05)
-    monkeypatch.setattr("drake_dock.core.kernels.compile_cache.warm", lambda: time.sleep(0.5))
-    slow = io.StringIO()
-    assert cli.prepare_kernels(slow) >= 0.5
-    assert "compiling the numba kernels" in slow.getvalue()
-    monkeypatch.setattr("drake_dock.core.kernels.compile_cache.warm", lambda: None)
-    fast = io.StringIO()
-    assert cli.prepare_kernels(fast) < 0.05
-    time.sleep(0.1)                   # past the note's delay: it was cancelled
-    assert fast.getvalue() == ""
+    from drake_dock.core.kernels import prepare
+    monkeypatch.setattr(prepare, "warm", lambda names=None, stream=None: None)
+    monkeypatch.setattr(prepare, "compile_parallel",
+                        lambda names, jobs, stream: [stream.write(f"  {n}: 1.0 s\n")
+                                                     for n in names])
+    monkeypatch.setattr(prepare, "cores", lambda: 2)
+    monkeypatch.setattr(prepare, "missing", lambda names=None: ["lzb", "seek"])
+    cold = io.StringIO()
+    cli.prepare_kernels(cold)
+    assert "compiling the numba kernels, 2 modules in 2 processes" in cold.getvalue()
+    assert "  lzb: 1.0 s\n  seek: 1.0 s\n" in cold.getvalue()
+    monkeypatch.setattr(prepare, "missing", lambda names=None: [])
+    warm = io.StringIO()
+    cli.prepare_kernels(warm)
+    assert warm.getvalue() == ""

@@ -1,28 +1,184 @@
-"""The compiled kernels' cache directory is keyed by the sources of drake_dock/core: a change
-in any module a kernel calls (not only in the kernel's own file, which is all numba checks)
-gives a new directory, so stale machine code is never loaded."""
+"""The compiled kernels' cache is keyed per module: a module's key follows its source and those
+of the modules it imports (numba checks only a kernel's own file), and no other. The parallel
+compile caches every kernel (each is compiled by some module's warm()) so that another process
+loads them without compiling; concurrent writers of one function's signatures leave an index
+that loads each of them."""
+import os
 import shutil
+import subprocess
+import sys
+import textwrap
 
-from drake_dock.core.kernels import compile_cache
+from numba.core.registry import CPUDispatcher
 
+from drake_dock.core.kernels import compile_cache as cc
+from drake_dock.core.kernels import prepare
 
-def test_the_key_follows_every_core_source(tmp_path):
-    root = tmp_path / "core"
-    shutil.copytree(compile_cache._CORE, root,
-                    ignore=shutil.ignore_patterns("__pycache__"))
-    key = compile_cache.source_key(root)
-    assert key == compile_cache.source_key(compile_cache._CORE)   # same bytes, same key
-    patches = root / "patches.py"                                  # a module kernels call
-    patches.write_bytes(patches.read_bytes() + b"\n")
-    assert compile_cache.source_key(root) != key
-    patches.write_bytes(patches.read_bytes()[:-1])
-    assert compile_cache.source_key(root) == key
-    (root / "kernels" / "extra.py").write_text("X = 1\n")          # a new module
-    assert compile_cache.source_key(root) != key
+ROOT = cc._PACKAGE.parent
+K = "drake_dock.core.kernels."
 
 
-def test_the_kernels_are_cached_under_the_key():
-    from numba.core import config
-    where = compile_cache.cache_dir()
-    assert where.name == compile_cache.PREFIX + compile_cache.source_key()
-    assert config.CACHE_DIR == str(where)
+def _tree(root, files):
+    for name, text in files.items():
+        path = root / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(textwrap.dedent(text))
+    return root / "drake_dock"
+
+
+def test_a_key_follows_the_module_and_what_it_imports_and_nothing_else(tmp_path):
+    pkg = _tree(tmp_path, {
+        "drake_dock/__init__.py": "", "drake_dock/core/__init__.py": "",
+        "drake_dock/core/base.py": "X = 1\n", "drake_dock/core/other.py": "Y = 2\n",
+        "drake_dock/core/kernels/__init__.py": "",
+        "drake_dock/core/kernels/leaf.py": "from drake_dock.core import base\n",
+        "drake_dock/core/kernels/mid.py": "from drake_dock.core.kernels.leaf import base\n",
+        "drake_dock/core/kernels/top.py": "def warm():\n    from . import mid\n",
+        "drake_dock/core/kernels/alone.py": "import drake_dock.core.other\n"})
+    names = ["leaf", "mid", "top", "alone"]
+
+    def keys():
+        return {n: cc.module_key(K + n, pkg) for n in names}
+    assert cc.dependencies(K + "top", pkg) == [
+        "drake_dock.core.base", K + "leaf", K + "mid", K + "top"]
+    assert prepare.units(pkg) == ["top"]
+    before = keys()
+    for edited, changed in [("core/base.py", {"leaf", "mid", "top"}),
+                            ("core/other.py", {"alone"}),
+                            ("core/kernels/mid.py", {"mid", "top"}),
+                            ("core/kernels/top.py", {"top"})]:
+        path = pkg / edited
+        path.write_text(path.read_text() + "# edited\n")
+        after = keys()
+        assert {n for n in names if after[n] != before[n]} == changed, edited
+        path.write_text(path.read_text().replace("# edited\n", ""))
+        assert keys() == before                                   # same bytes, same keys
+
+
+def test_an_edit_of_the_real_tree_changes_the_keys_of_the_modules_that_import_it(tmp_path):
+    pkg = tmp_path / "drake_dock"
+    shutil.copytree(cc._PACKAGE, pkg, ignore=shutil.ignore_patterns("__pycache__"))
+    names = prepare.kernel_modules(pkg)
+    assert set(prepare.units(pkg)) <= set(names)
+
+    def keys():
+        return {n: cc.module_key(K + n, pkg) for n in names}
+    before = keys()
+    assert before == {n: cc.module_key(K + n) for n in names}     # same bytes, same keys
+    for edited, first in [("core/kernels/lzb_phases.py", "lzb_phases"),
+                          ("core/patches.py", "jets")]:
+        path = pkg / edited
+        path.write_text(path.read_text() + "\n")
+        after = keys()
+        importers = {n for n in names if any(d.endswith(edited[:-3].replace("/", "."))
+                                             for d in cc.dependencies(K + n, pkg))}
+        assert first in importers
+        assert {n for n in names if after[n] != before[n]} == importers
+        assert importers != set(names)                 # some modules keep their cache
+        path.write_text(path.read_text()[:-1])
+
+
+def test_the_kernels_are_cached_in_their_module_directory_under_its_key():
+    from drake_dock.core.kernels import couples, lzb
+    for module, fn in [("couples", couples.evaluate_couples), ("lzb", lzb.lzb_impact)]:
+        key = cc.module_key(K + module)
+        assert fn._cache.cache_path == str(cc.cache_dir() / f"{module}-{key}")
+        assert fn._cache._impl.locator.get_source_stamp() == key
+
+
+def _python(code, cache, **kw):
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache), PYTHONPATH=str(ROOT))
+    return subprocess.run([sys.executable, "-c", textwrap.dedent(code)], env=env, cwd=ROOT,
+                          capture_output=True, text=True, check=True, **kw)
+
+
+STATS = """
+    import importlib
+    from numba.core.registry import CPUDispatcher
+    from drake_dock.core.kernels import prepare
+    hits = misses = 0
+    for name in prepare.kernel_modules():
+        for d in vars(importlib.import_module("drake_dock.core.kernels." + name)).values():
+            if isinstance(d, CPUDispatcher):
+                hits += sum(d.stats.cache_hits.values())
+                misses += sum(d.stats.cache_misses.values())
+    print(hits, misses)
+"""
+
+
+def _kernels():
+    """(module, dispatcher) of every kernel defined in the kernels package."""
+    import importlib
+    for name in prepare.kernel_modules():
+        for value in vars(importlib.import_module(K + name)).values():
+            if isinstance(value, CPUDispatcher) and value.py_func.__module__ == K + name:
+                yield name, value
+
+
+def test_the_parallel_compile_caches_every_kernel_and_another_process_loads_them(tmp_path):
+    """Every kernel is compiled by some module's warm(): one that none reaches (a new module
+    without warm(), or a kernel no warm() calls) fails here, since it would compile in the
+    middle of a run. Then a second process loads every module without compiling."""
+    units = prepare.units()
+    out = _python(textwrap.dedent(f"""
+        import sys
+        from drake_dock.core.kernels import prepare
+        assert prepare.missing() == {units}
+        prepare.prepare(sys.stdout, jobs=2)
+        assert prepare.missing() == []
+    """) + textwrap.dedent(STATS), tmp_path).stdout
+    assert f"compiling the numba kernels, {len(units)} modules in 2 processes" in out
+    assert all(f"  {u}: " in out for u in units)
+    hits, misses = map(int, out.split()[-2:])
+    assert hits > 0 and misses == 0          # this process loaded what the workers compiled
+    cold = [f"{name}.{fn.py_func.__qualname__}" for name, fn in _kernels()
+            if not list((tmp_path / "drake_dock" / f"{name}-{cc.module_key(K + name)}").glob(
+                f"{name}.{fn.py_func.__qualname__}-{fn.py_func.__code__.co_firstlineno}.py*.nbi"))]
+    assert not cold, f"kernels no module's warm() compiles: {cold}"
+    out = _python("from drake_dock.core.kernels import prepare\nprepare.warm()\n"
+                  + textwrap.dedent(STATS), tmp_path).stdout
+    hits, misses = map(int, out.split()[-2:])
+    assert hits > 0 and misses == 0
+
+
+def test_concurrent_writers_of_one_function_leave_an_index_that_loads_each(tmp_path):
+    kinds = ["1", "1.0", "True", "1j"]           # four signatures of frames.add
+    code = """
+        import sys, time
+        from numba.core import caching
+        from drake_dock.core.kernels import frames
+        save_index = caching.IndexDataCacheFile._save_index
+
+        def slow(self, overloads):      # widens the window between reading and writing
+            time.sleep(0.5)
+            save_index(self, overloads)
+        caching.IndexDataCacheFile._save_index = slow
+        x = {kind}
+        time.sleep(max(0.0, float(sys.argv[1]) - time.time()))    # start together
+        frames.add((x, x, x), (x, x, x))
+    """
+    import time
+    start = f"{time.time() + 3.0}"
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path), PYTHONPATH=str(ROOT))
+    procs = [subprocess.Popen([sys.executable, "-c", textwrap.dedent(code.format(kind=k)),
+                               start], env=env, cwd=ROOT) for k in kinds]
+    assert [p.wait() for p in procs] == [0] * len(kinds)
+    out = _python(f"""
+        from drake_dock.core.kernels import frames
+        for x in [{", ".join(kinds)}]:
+            assert frames.add((x, x, x), (x, x, x)) == (x + x,) * 3
+        print(sum(frames.add.stats.cache_hits.values()),
+              sum(frames.add.stats.cache_misses.values()))
+    """, tmp_path).stdout
+    assert out.split() == [str(len(kinds)), "0"]
+
+
+def test_a_unit_starts_after_the_smaller_units_it_shares_kernels_with():
+    order, after = prepare.schedule(prepare.units())
+    assert sorted(order) == prepare.units()
+    assert {"constraints", "bushing"} <= after["engine"]   # the constraint solve, the bushing
+    assert "engine" in after["calculators"] and not after["lzb"]
+    # A unit waits only for units with fewer kernel modules, which it shares modules with.
+    deps = {n: prepare._kernel_deps(n) for n in order}
+    for a, bs in after.items():
+        assert all(len(deps[b]) < len(deps[a]) and deps[a] & deps[b] for b in bs)

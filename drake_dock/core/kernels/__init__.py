@@ -3,8 +3,9 @@ plain arrays: the patches' jets by kind code and parameters (`jets`), and every 
 of a contact system in one call (`couples`: Eq. 47, the projection, the contact frame, gap,
 normal velocity and the Eq. 52 bias terms), the seek of Sect. 5.1 (`seek`), and the constraint
 solve and mode selection of Eq. 48-52 (`constraints`, with the solve in `solve` and the start
-of sliding in `slide_start`). `compile_cache` chooses the directory
-the compiled code is cached in; importing this package applies it before numba is imported.
+of sliding in `slide_start`). `compile_cache` keys the compiled code's cache per module and
+chooses its directory (importing this package applies it before any kernel is defined);
+`prepare` compiles the kernels before a run needs them, in parallel, with a line per module.
 
 The pure-Python modules (`drake_dock.core.patches`, `drake_dock.core.couple`,
 `drake_dock.core.seeking`, `drake_dock.core.constraints`) stay the reference the kernels are

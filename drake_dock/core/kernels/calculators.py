@@ -190,3 +190,31 @@ def couple_table(mp, sp, x, buf, cols, Y):
             for c in range(3):
                 y[P1c + c], y[P2c + c] = q1[c], q2[c]
                 y[FRc + 4 * c] = 1.0
+
+
+def warm():
+    """Compiles or loads the calculators on `engine.toy_model`."""
+    from drake_dock.core.kernels.engine import toy_model
+    from drake_dock.core.kernels.model import NW
+    from drake_dock.core.kernels.records import pack
+    m, s, x = toy_model()
+    mp, sp = pack(m), pack(s)
+    nq, nv = int(m.sizes[Z_NQ]), int(m.sizes[Z_NV])
+    nb, F, k = m.qs.shape[0], m.frame_body.shape[0], s.code.shape[0]
+    q, v = x[:nq], x[nq:nq + nv]
+    Rb, pb, wb, vb = np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3)), np.empty((nb, 3))
+    R, o, w, vf = np.empty((F, 3, 3)), np.empty((F, 3)), np.empty((F, 3)), np.empty((F, 3))
+    kinematics(mp, q, v, Rb, pb, wb, vb, R, o, w, vf)
+    out = np.zeros((k, K.ROW))
+    u = x[nq + nv:int(m.sizes[2]) + nq + nv]
+    couples_at(mp, R, o, w, vf, u.copy(), s.sigma.copy(), np.arange(k, dtype=np.int64),
+               np.bool_(True), 0.0, out)
+    contact_row(mp, 0, out[0], pb, wb, np.empty((nv, 3)), np.empty(3))
+    M, Minv, a0, scal = np.empty((nv, nv)), np.empty((nv, nv)), np.empty(nv), np.empty(4)
+    dynamics_at(mp, q, v, np.zeros(nv), M, Minv, a0, scal)
+    mass_at(mp, Rb, M)
+    far = np.array([3], dtype=np.int64)
+    far_points(mp, far, x, R, o, np.empty((1, 3)), np.empty((1, 3)))
+    buf = np.zeros(layout(int(m.sizes[Z_NX]), k, nv, F, m.bush_frames.shape[0])[-1])
+    del NW
+    couple_table(mp, sp, x, buf, np.arange(10, dtype=np.int64), np.empty((k, 26)))

@@ -58,18 +58,21 @@ def _couple(m, i, R, o, w, vf, u, sigma, out):
         (vf[b, 0], vf[b, 1], vf[b, 2])
     ui = u[m.uoff[i]:m.uoff[i + 1]]
     kind = m.pair_kind[i]
+    # Projected; a bool, not the literal True, so that the couples' kernels compiled for the
+    # calculators (`calculators.couples_at`) serve here too.
+    project = np.bool_(True)
     if kind == PC:
         p = (m.prm1[i, 0], m.prm1[i, 1], m.prm1[i, 2])
         K.evaluate_pc_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], R[a], o1, w1, v1, R[b], o2,
-                          w2, v2, ui[0], sigma, True, row)
+                          w2, v2, ui[0], sigma, project, row)
     elif kind == PS:
         p = (m.prm1[i, 0], m.prm1[i, 1], m.prm1[i, 2])
         K.evaluate_ps_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], R[a], o1, w1, v1, R[b], o2,
-                          w2, v2, (ui[0], ui[1]), sigma, True, row)
+                          w2, v2, (ui[0], ui[1]), sigma, project, row)
     else:
         us = (ui[0], ui[1], ui[2] if len(ui) == 3 else 0.0)
         K.evaluate_one(kind == CC, m.kind1[i], m.prm1[i], m.kind2[i], m.prm2[i], R[a], o1,
-                       w1, v1, R[b], o2, w2, v2, us, sigma, True, row)
+                       w1, v1, R[b], o2, w2, v2, us, sigma, project, row)
 
 
 @njit(cache=True)
@@ -225,3 +228,56 @@ def evaluate(mp, sp, x, tau_in, buf):
             wv[i, W_CONE] = opt[O_MU_S] * lr_n[j] - math.hypot(lr_t[j, 0], lr_t[j, 1])
     sc[S_FRICTION] = power
     xdot[e] = power / opt[O_ENERGY]
+
+
+def toy_model():
+    """A small model and modes for compiling the kernels (`warm`): two free bodies with a
+    frame each, a bushing between them, one pair of each kind (CC, CS, PC, PS) between the
+    frames, an edge hand-over from the CC pair to the CS pair; the CC pair tracked, the CS pair
+    sliding, the PC pair sticking, the PS pair far. Returns (Model, ModeArrays, x)."""
+    from drake_dock.core.kernels.jets import N_PARAMS, patch_spec
+    from drake_dock.core.kernels.model import (AFFINE, CS, N_OPTIONS, N_SIZES, TRACKED, Model,
+                                               ModeArrays)
+    from drake_dock.core.patches import Circle, PlaneRect, Segment
+    k, nq, nv = 4, 14, 12
+    specs = [(CC, patch_spec(Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1))),
+              patch_spec(Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0)))),
+             (CS, patch_spec(Circle(0.3, 0.1)),
+              patch_spec(PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)))),
+             (PC, (0, np.r_[0.1, 0.2, 0.3, 0.01, np.zeros(N_PARAMS - 4)]), patch_spec(Circle(0.3))),
+             (PS, (0, np.r_[0.1, 0.2, 0.3, 0.01, np.zeros(N_PARAMS - 4)]),
+              patch_spec(PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0))))]
+    dims = np.array([2, 3, 1, 2])
+    eye = np.tile(np.eye(3), (2, 1, 1))
+    m = Model(np.array([0, 7]), np.array([0, 6]), np.ones(2), np.zeros((2, 3)), eye.copy(),
+              eye.copy(), np.array([0.0, 0.0, -9.81]), np.array([0, 1]), eye.copy(),
+              np.zeros((2, 3)), np.array([[0, 1]]), np.ones((1, 4, 3)),
+              np.array([s[0] for s in specs]), np.array([s[1][0] for s in specs]),
+              np.array([s[2][0] for s in specs]), np.array([s[1][1] for s in specs]),
+              np.array([s[2][1] for s in specs]), np.tile([0, 1], (k, 1)),
+              np.r_[0, np.cumsum(dims)], np.ones((k, 3)), np.zeros((k, 3)), np.ones((k, 3)),
+              np.ones((k, 3), dtype=np.int64), np.zeros(k, dtype=np.int64),
+              np.array([[0, 1]]), np.zeros((k, 3)), np.ones(k), np.zeros(k, dtype=np.int64),
+              np.array([1, 0, 0, 0]), np.array([1]), np.array([[0, 1, AFFINE]]),
+              np.array([[1.0, 0.0]]), np.full(N_OPTIONS, 0.5),
+              np.array([nq, nv, int(dims.sum()), nq + nv + int(dims.sum()),
+                        nq + nv + int(dims.sum()) + 3 + 1])[:N_SIZES])
+    s = ModeArrays(np.array([TRACKED, SLIDING, STICKING, FAR]), np.ones(k), np.zeros((k, 2)),
+                   np.array([0, 1, 0, 0]), np.array([1, 2]), np.ones(k), np.ones(k),
+                   np.tile(np.eye(3), (k, 1, 1)), np.zeros((k, 3)), np.array([0, 0, 0, 1]))
+    x = np.zeros(int(m.sizes[Z_NX]))
+    x[0] = x[7] = 1.0
+    x[nq + nv:nq + nv + int(dims.sum())] = 0.5
+    return m, s, x
+
+
+def warm():
+    """Compiles or loads the engine's kernels: one evaluation of `toy_model`, and its far pass."""
+    from drake_dock.core.kernels.records import pack
+    from drake_dock.core.kernels.witness_values import far_witness
+    m, s, x = toy_model()
+    mp, sp = pack(m), pack(s)
+    nbush, k, F = m.bush_frames.shape[0], s.code.shape[0], m.frame_body.shape[0]
+    buf = np.empty(layout(int(m.sizes[Z_NX]), k, int(m.sizes[Z_NV]), F, nbush)[-1])
+    evaluate(mp, sp, x, np.zeros(int(m.sizes[Z_NV])), buf)
+    far_witness(mp, sp, buf)

@@ -246,3 +246,11 @@ def frame_poses(qs, q, fb, R_BF, p_BF, R, o):
         for c in range(3):
             o[f, c] = q[i + 4 + c] + Rb[c, 0] * p_BF[f, 0] + Rb[c, 1] * p_BF[f, 1] \
                 + Rb[c, 2] * p_BF[f, 2]
+
+
+def warm():
+    """Compiles or loads `frame_poses` (the ring frames of a docking run's capture test)."""
+    q = np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    frame_poses(np.zeros(1, dtype=np.int64), q, np.zeros(2, dtype=np.int64),
+                np.tile(np.eye(3), (2, 1, 1)), np.zeros((2, 3)), np.empty((2, 3, 3)),
+                np.empty((2, 3)))

@@ -112,3 +112,14 @@ def push(T, W, D, n, t, w, d):
     W[2, :] = w
     D[2, :] = d
     return min(n + 1, 3)
+
+
+def warm():
+    """Compiles or loads the predictions on a history of two witnesses."""
+    import numpy as np
+    T, W, D = np.full(3, np.nan), np.zeros((3, 2)), np.full((3, 2), np.nan)
+    n = 0
+    for t in (0.0, 0.1, 0.2):
+        n = push(T, W, D, n, t, np.array([1.0 - t, 2.0]), np.array([-1.0, np.nan]))
+    earliest_zero(T, W, D, n, np.zeros(2, dtype=np.bool_))
+    lead_jet(1.0, -1.0, 0.5)

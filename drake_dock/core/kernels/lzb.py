@@ -196,7 +196,9 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
     br_kind, br_j = np.empty(nbmax, np.int64), np.empty(nbmax, np.int64)
     br_a, br_b, roots = np.empty(nbmax), np.empty(nbmax), np.empty(nbmax)
     order = np.empty(nbmax, np.int64)
-    log = (np.empty(16), np.empty(16, np.int64), np.empty(16, np.int64), 0)
+    # The event log; its count an int64, not the literal 0, so that apply_event and _log
+    # are compiled for one type of it.
+    log = (np.empty(16), np.empty(16, np.int64), np.empty(16, np.int64), np.int64(0))
     hist = np.empty((64, s))
     nh = 0
     # The transaction of an event step: copies of what the events change.

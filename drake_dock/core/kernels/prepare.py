@@ -1,0 +1,194 @@
+"""Compiling the kernels before a run needs them: once, in parallel, with a line per module.
+
+A unit is a module of this package with a top-level ``warm()`` (found in the sources: there is
+no list to keep up to date). Its ``warm()`` compiles or loads the module's kernels, and those of
+the kernel modules it calls, by evaluating them once on a small case with the argument types of
+a run. `warm` runs every unit in this process. `prepare` (``drake-dock run`` and
+``python -m drake_dock.core.kernels``) first compiles the units whose cache is missing (no
+``warm.done`` in their module's cache directory, `compile_cache.module_cache_dir`, whose key
+covers everything the unit compiles) in up to ``jobs`` worker processes
+(``python -m drake_dock.core.kernels --worker``, each taking one unit after another), a line per
+unit with its time, then loads every unit here.
+
+Order (`schedule`): a unit starts after the units it shares a kernel module with that have
+fewer kernel modules than it (`engine` after `tracked` and `constraints`): their common callees
+are then compiled once, by the smaller unit, and loaded by the larger. Among the units free to
+start, the one heading the longest chain of waiting units goes first, a unit's length being the
+kernel source lines it compiles itself (a rough measure of its compile time).
+"""
+from __future__ import annotations
+
+import ast
+import contextlib
+import importlib
+import os
+import select
+import subprocess
+import sys
+import time
+
+from drake_dock.core.kernels import compile_cache as cc
+
+MARKER = "warm.done"
+
+
+def kernel_modules(package=cc._PACKAGE) -> list[str]:
+    """The modules of the kernels package (short names), infrastructure aside."""
+    here = package / "core" / "kernels"
+    return sorted(p.stem for p in here.glob("*.py")
+                  if p.stem not in ("__init__", "__main__", "compile_cache", "prepare"))
+
+
+def units(package=cc._PACKAGE) -> list[str]:
+    """The kernel modules that define a top-level ``warm()``."""
+    here = package / "core" / "kernels"
+
+    def has_warm(name):
+        tree = ast.parse((here / f"{name}.py").read_bytes())
+        return any(isinstance(n, ast.FunctionDef) and n.name == "warm" for n in tree.body)
+    return [m for m in kernel_modules(package) if has_warm(m)]
+
+
+def _kernel_deps(name: str, package=cc._PACKAGE) -> set[str]:
+    """The kernel modules (short names) that unit ``name`` imports, itself included."""
+    prefix, kernels = cc.PACKAGE + ".", set(kernel_modules(package))
+    return {d[len(prefix):] for d in cc.dependencies(prefix + name, package)
+            if d.startswith(prefix) and d[len(prefix):] in kernels}
+
+
+def schedule(names: list[str], package=cc._PACKAGE):
+    """(the units ``names`` in the order they are started when free to, {unit: the units
+    among ``names`` it starts after}): see the module docstring."""
+    deps = {n: _kernel_deps(n, package) for n in names}
+    after = {a: {b for b in names if deps[a] & deps[b] and len(deps[b]) < len(deps[a])}
+             for a in names}
+    here = package / "core" / "kernels"
+
+    def own(n):     # the kernel source lines that unit n compiles itself
+        mine = deps[n] - set().union(*(deps[b] for b in after[n]))
+        return sum((here / f"{m}.py").read_bytes().count(b"\n") for m in mine)
+
+    def path(n):    # its own lines and those of the longest chain of units waiting for it
+        return own(n) + max((path(a) for a in names if n in after[a]), default=0)
+    return sorted(names, key=lambda n: (-path(n), n)), after
+
+
+def _marker(name: str):
+    return cc.module_cache_dir(name) / MARKER
+
+
+def missing(names: list[str] | None = None) -> list[str]:
+    """The units (of ``names``, default all) whose kernels are not all in the cache."""
+    return [n for n in (units() if names is None else names) if not _marker(n).is_file()]
+
+
+def compile_unit(name: str) -> float:
+    """Runs unit ``name``'s ``warm()`` in this process (compiling what the cache lacks) and
+    marks it done; returns the seconds it took."""
+    t0 = time.perf_counter()
+    importlib.import_module(f"{cc.PACKAGE}.{name}").warm()
+    seconds = time.perf_counter() - t0
+    _marker(name).parent.mkdir(parents=True, exist_ok=True)
+    _marker(name).write_text(f"{seconds:.2f}\n")
+    return seconds
+
+
+def _say(stream, text: str) -> None:
+    if stream is not None:
+        stream.write(text + "\n")
+        stream.flush()
+
+
+def warm(names: list[str] | None = None, stream=None) -> None:
+    """Compiles or loads the units ``names`` (default all) in this process, in `schedule`
+    order, with a line per unit on ``stream`` if given."""
+    order, _ = schedule(units() if names is None else names)
+    t0 = time.perf_counter()
+    for i, name in enumerate(order):
+        seconds = compile_unit(name)
+        _say(stream, f"  {name}: {seconds:.1f} s ({i + 1} of {len(order)}, "
+                     f"{time.perf_counter() - t0:.0f} s so far)")
+
+
+def _workers(jobs: int) -> list[subprocess.Popen]:
+    """``jobs`` processes ``python -m drake_dock.core.kernels --worker`` on this process's
+    drake_dock sources and cache base: each compiles the units named on its stdin, one a line,
+    and answers each with a line "NAME SECONDS" (the numba it warmed up and the kernels it
+    compiled serve its next unit)."""
+    path = os.pathsep.join([str(cc._PACKAGE.parent)] + [p for p in [os.environ.get(
+        "PYTHONPATH")] if p])
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cc.cache_dir().parent), PYTHONPATH=path)
+    return [subprocess.Popen([sys.executable, "-m", cc.PACKAGE, "--worker"], env=env,
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+            for _ in range(jobs)]
+
+
+def serve(lines, out) -> None:
+    """A worker's loop: compiles each unit named in ``lines`` and writes "NAME SECONDS"."""
+    for line in lines:
+        out.write(f"{line.strip()} {compile_unit(line.strip()):.3f}\n")
+        out.flush()
+
+
+def compile_parallel(names: list[str], jobs: int, stream=None) -> None:
+    """Compiles the units ``names`` in ``jobs`` worker processes, in `schedule` order, with a
+    line per unit on ``stream`` as each one finishes. A failed unit raises RuntimeError (the
+    worker's traceback is on stderr); the workers end with this call."""
+    order, after = schedule(names)
+    idle, busy, done, t0 = _workers(jobs), {}, set(), time.perf_counter()
+    try:
+        while order or busy:
+            for name in [n for n in order if not after[n] - done][:len(idle)]:
+                order.remove(name)
+                proc = idle.pop()
+                busy[proc] = name
+                proc.stdin.write(name + "\n")
+                proc.stdin.flush()
+            ready, _, _ = select.select([p.stdout for p in busy], [], [])
+            for proc in [p for p in busy if p.stdout in ready]:
+                answer = proc.stdout.readline().split()
+                name = busy.pop(proc)
+                idle.append(proc)
+                if len(answer) != 2:
+                    raise RuntimeError(f"compiling the kernels of {cc.PACKAGE}.{name} failed "
+                                       f"(see above)")
+                done.add(name)
+                _say(stream, f"  {name}: {float(answer[1]):.1f} s ({len(done)} of "
+                             f"{len(names)}, {time.perf_counter() - t0:.0f} s so far)")
+    finally:
+        for proc in idle + list(busy):
+            with contextlib.suppress(OSError):
+                proc.stdin.close()          # the worker's loop ends
+            if proc in busy:
+                proc.kill()
+            proc.wait()
+
+
+def cores() -> int:
+    """The cores this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:
+        return os.cpu_count() or 1
+
+
+def prepare(stream=None, jobs: int | None = None, names: list[str] | None = None) -> float:
+    """Compiles the missing units of ``names`` (default all) in up to ``jobs`` processes
+    (default `cores`; in this process when one, or one unit, is missing), saying so on
+    ``stream`` with a line per unit, then loads every unit here. Returns the seconds taken."""
+    t0 = time.perf_counter()
+    todo = missing(names)
+    if todo:
+        jobs = max(1, min(jobs or cores(), len(todo)))
+        _say(stream, f"drake-dock: compiling the numba kernels, {len(todo)} module"
+                     f"{'s' if len(todo) > 1 else ''} in {jobs} process"
+                     f"{'es' if jobs > 1 else ''} (after an install or an update only; later "
+                     f"runs load them from the cache)")
+        if jobs > 1:
+            compile_parallel(todo, jobs, stream)
+        else:
+            warm(todo, stream)
+    warm(names)
+    if todo:
+        _say(stream, f"drake-dock: kernels compiled in {time.perf_counter() - t0:.0f} s")
+    return time.perf_counter() - t0
