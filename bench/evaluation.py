@@ -18,9 +18,10 @@ import os
 import sys
 
 from drake_dock.core.kernels.prepare import warm
-from drake_dock.docking.diagram import build_docking_diagram, contact_options
-from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE, load_scenario
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE, load_scenario
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from floors import empty_leaf_cost  # noqa: E402  (a sibling bench module)
@@ -30,10 +31,10 @@ TARGET = 10.0
 
 def _run(scenario, engine, duration):
     """The `RunResult` with the engine on or off."""
-    options = dataclasses.replace(contact_options(scenario), engine=engine)
-    dd = build_docking_diagram(scenario, options=options)
+    options = dataclasses.replace(DiagramSpec.of(scenario).contact_options(), engine=engine)
+    dd = build_docking_diagram(DiagramSpec.of(scenario, options=options))
     assert (dd.contact.evaluator.engine is not None) == engine
-    return simulate(scenario, dd=dd, duration=duration)
+    return simulate(scenario, place(scenario), dd=dd, duration=duration)
 
 
 def _per_evaluation(r):
@@ -53,7 +54,7 @@ def main():
     empty = empty_leaf_cost(scenes[0][1].simulator_config.integration_scheme)
     print(f"empty Python LeafSystem: {empty * 1e6:.1f} us per evaluation")
     for name, scenario, duration in scenes:
-        simulate(scenario, duration=0.01)        # loads every kernel and Drake's code once
+        simulate(scenario, place(scenario), duration=0.01)   # every kernel and Drake's code loaded
         results = {}
         for engine in (True, False):
             r = results[engine] = _run(scenario, engine, duration)

@@ -25,9 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from drake_dock.core.kernels.prepare import warm
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.docking.scene import initial_state
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.errors import DrakeDockError
 from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
 
@@ -56,7 +56,7 @@ def main():
     for name, cond in todo:
         s = with_condition(base, cond)
         try:
-            state = initial_state(s)
+            state = place(s)
             r = simulate(s, state=state)
         except DrakeDockError as e:
             print(f"{name:<11} error: {type(e).__name__} (left out)")

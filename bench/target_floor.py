@@ -23,11 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.compliant import (CompliantConfig, hunt_crossley_dissipation,
                                           run_compliant)
-from drake_dock.docking.scene import initial_state
-from drake_dock.docking.simulate import simulate
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.docking_metrics import (METRICS, compliant_metrics, contact_effect,
                                                 errors, rigid_metrics, scene_start)
 
@@ -42,7 +42,7 @@ def main():
     args = ap.parse_args()
     tol = args.tolerance
     scenario = load_scenario(PAPER_EXAMPLE)
-    state = initial_state(scenario)
+    state = place(scenario)
     start = scene_start(scenario, state)
     sc = copy.deepcopy(scenario)
     sc.simulator_config.accuracy = 1e-8

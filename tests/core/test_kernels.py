@@ -12,8 +12,11 @@ from drake_dock.core.kernels.jets import jet, patch_spec, position
 from drake_dock.core.kernels.tracked import TrackedCouples
 from drake_dock.core.patches import Circle, Cone, PlaneRect, PolarCurve, Segment, posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.apds import ApdsGeometry, apds_patches
-from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec
+from drake_dock.docking.geometry.apds import apds_patches
+from drake_dock.docking.geometry.pairs import R_MATCHED
+from drake_dock.docking.geometry.rotations import rot_vec
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.scenario.dimensions import ApdsGeometry
 
 GEOMETRIES = [ApdsGeometry(), ApdsGeometry(R=0.9, Rs=0.55, H=0.3, alpha1_deg=50.0,
                                            alpha2_deg=25.0)]
@@ -118,7 +121,7 @@ def test_apds_couples_equal_the_python_path(g, d):
     poses, twists = [X_T, X_C], [_twist(rng), _twist(rng)]
     frame = {"target_apds": 0, "chaser_apds": 1}
     pairs, us, sigmas = [], [], []
-    for k, pr in enumerate(apds_pairs(g)):
+    for k, pr in enumerate(DockingScene(g, "paper").pairs):
         span = np.concatenate([pr.patch1.span, pr.patch2.span])
         c = seek_couple(posed(pr.patch1, *poses[frame[pr.body1]]),
                         posed(pr.patch2, *poses[frame[pr.body2]]))
