@@ -18,14 +18,15 @@ from drake_dock.systems.witnesses import FAR_WITNESS
 class ArmedWitnesses:
     """The armed witnesses of a set of modes as arrays: their names (the far pairs' first,
     when ``far``), and of the pairs' witnesses their pair, kind code and whether a gap
-    witness of a tracked couple (``gap``, a mask)."""
+    witness of a tracked couple (``gap``, a mask); their places in an evaluation's witness
+    values and couple rows (those of the pairs not far, by their place among them)."""
 
     __slots__ = ("names", "pair", "code", "far", "gap", "flat", "gap_flat", "no_rates")
 
-    def __init__(self, names, pair, code, far, gap):
+    def __init__(self, names, pair, code, far, gap, slot):
         self.names, self.pair, self.code, self.far, self.gap = names, pair, code, far, gap
-        self.flat = pair * K.NW + code                  # into an evaluation's wv, raveled
-        self.gap_flat = pair[gap] * C.ROW + C.VN        # the gaps' v_n in its couple rows
+        self.flat = slot * K.NW + code                  # into an evaluation's wv, raveled
+        self.gap_flat = slot[gap] * C.ROW + C.VN        # the gaps' v_n in its couple rows
         self.no_rates = np.full(len(pair), np.nan)
 
     @classmethod
@@ -37,7 +38,9 @@ class ArmedWitnesses:
         code = np.array([witnesses.CODE[kind] for _, kind in per], dtype=np.intp)
         gap = np.array([kind == "gap" and modes.pairs[i].mode == Mode.TRACKED
                         for i, kind in per], dtype=bool)
-        return cls(names, pair, code, any(i is None for i, _ in armed), gap)
+        place = {i: j for j, i in enumerate(modes.index().near)}
+        slot = np.array([place[i] for i, _ in per], dtype=np.intp)
+        return cls(names, pair, code, any(i is None for i, _ in armed), gap, slot)
 
 
 class WitnessPredictions:
