@@ -279,7 +279,12 @@ def simulate(scenario, *, state: InitialState | None = None, dd: DockingDiagram 
         watch = OutcomeWatch(dd.capture.distance(dd.capture.GetMyContextFromRoot(root)),
                              sp.jam_time, beside=2.0 * g.R, beyond=g.H)
         sim.set_monitor(monitor)
-        status = sim.AdvanceTo(t_end)
+        try:
+            status = sim.AdvanceTo(t_end)
+        finally:
+            # The monitor refers to the simulator (the step control): a cycle through Drake's
+            # C++ that Python's collector cannot see would keep the run's record alive.
+            sim.clear_monitor()
     wall = _time.perf_counter() - wall0
     rec.sample(root)
     terminated = status.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition
