@@ -15,7 +15,7 @@ The steps are the paper's:
   sliding direction, and the constraint solve for the given modes (Eq. 48-52,
   `solve.solve_modes`);
 - the witnesses of the contact system's table (`drake_dock.systems.witnesses`): per pair the
-  value of each kind (`W_GAP` ... `W_SIDE`), and the far pairs' smallest clearance left.
+  value of each kind (`W_IMPACT` ... `W_SIDE`), and the far pairs' smallest clearance left.
 
 Records (`drake_dock.core.kernels.records`): `Model` (the bodies, frames, force elements,
 pairs, hand-over edges and options, built once per system) and `ModeArrays` (the pairs' modes
@@ -39,8 +39,8 @@ from drake_dock.core.kernels.model import (BUSH_ROW, CC, FAR, NW, O_COND_MIN, O_
                                            O_ENERGY, O_GUARD, O_MU, O_MU_S, O_OMEGA, O_V_SLIP,
                                            PC, PS, S_BAD_PC, S_BUSH, S_COND, S_DAMP, S_DRIFTING,
                                            S_FAR, S_FRICTION, S_KE, S_P_EL, S_P_IN, S_PE,
-                                           S_REPORT, S_STATUS, SLIDING, STICKING, W_APEX, W_COND, W_CONE,
-                                           W_END, W_GAP, W_HANDOVER, W_LAMBDA, W_SIDE, W_SLIP,
+                                           S_REPORT, S_STATUS, SLIDING, STICKING, W_CONE,
+                                           W_HANDOVER, W_IMPACT, W_LAMBDA, W_REGULAR, W_SIDE, W_SLIP,
                                            Z_IE, Z_NQ, Z_NV, Z_NX, layout, unpack_model,
                                            unpack_modes)
 from drake_dock.core.kernels.solve import OK, SLIDE, STICK, solve_modes
@@ -147,10 +147,8 @@ def evaluate(mp, sp, x, tau_in, buf):
         if row[K.DRIFT_REL] > tol and sc[S_DRIFTING] < 0:
             sc[S_DRIFTING] = i
         R2 = R[m.fidx[i, 1]]
-        wv[j, W_GAP] = row[K.GAP]
-        wv[j, W_END] = end_margin(m, i, row)
-        wv[j, W_COND] = row[K.COND] - opt[O_COND_MIN]
-        wv[j, W_APEX] = 1.0 if row[K.GAP] > 0.0 else row[K.VN]
+        wv[j, W_IMPACT] = row[K.GAP] if row[K.GAP] > 0.0 else row[K.VN]
+        wv[j, W_REGULAR] = min(end_margin(m, i, row), row[K.COND] - opt[O_COND_MIN])
         if m.edge_count[i] > 0:
             wv[j, W_HANDOVER] = handover_guard(m, i, row, R2) + opt[O_GUARD]
         if m.pair_kind[i] == PC:

@@ -17,9 +17,12 @@ CC, CS, PC, PS = 0, 1, 2, 3
 KIND_CODE = {"CC": CC, "CS": CS, "PC": PC, "PS": PS}
 # Modes (`drake_dock.core.hybrid.Mode`).
 FAR, TRACKED, SLIDING, STICKING = 0, 1, 2, 3
-# Witness kinds, in the order of `drake_dock.systems.witnesses.WITNESSES`.
-W_GAP, W_END, W_COND, W_LAMBDA, W_SLIP, W_CONE, W_APEX, W_HANDOVER, W_SIDE = range(9)
-NW = 9
+# Witness kinds, in the order of `drake_dock.systems.witnesses.WITNESSES`: the impact (the gap
+# of a tracked couple while positive, its rate while not), the couple's regularity (its least
+# domain-end margin or conditioning margin), lambda_n, slip, the friction cone, the hand-over
+# guard and a point-curve couple's side.
+W_IMPACT, W_REGULAR, W_LAMBDA, W_SLIP, W_CONE, W_HANDOVER, W_SIDE = range(7)
+NW = 7
 # Hand-over edge maps (`drake_dock.core.handover.SurfaceEdge.kernel_map`): the surface's free
 # parameter at the edge's parameter e is alpha e + beta, or component c of the edge curve's
 # point (its frame's coordinates).
