@@ -118,7 +118,7 @@ def solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, 
     else:
         U, sv, V = L.svd(A)
         cond = sv[0] / sv[-1] if sv[-1] > 0.0 else math.inf
-        lam = L.lstsq(A, b, 1e-10)
+        lam = L.svd_solve(U, sv, V, b, 1e-10)
         if L.norm(L.matvec(A, lam) - b) > (1e-8 * (1.0 + L.norm(b)) + math.sqrt(soft)):
             return SINGULAR, cond
         ns = 0
