@@ -44,7 +44,7 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/paper_example.py
 	$(BIN)/python bench/time_shares.py
 	$(BIN)/python bench/target_floor.py
-	$(BIN)/python bench/offnominal_floor.py
+	$(BIN)/python bench/offnominal.py
 
 clean:
 	rm -rf $(VENV) .venv-core out

@@ -69,6 +69,11 @@ def main():
     for n in (1000, 10000):
         print(f"projected {n} samples with {last['workers']} workers: "
               f"{duration_text(n / last['rate'] * 60.0)}")
+    hours = 10000 / last["rate"] / 60.0
+    print(f"target: the 10,000-sample IDSS campaign on 2 cores in at most 2 h: "
+          + ("met" if hours <= 2.0 and last["workers"] == 2
+             else f"NOT met ({hours / 2.0:.1f}x over)" if last["workers"] == 2
+             else "not measured (2 workers needed)"))
 
 
 if __name__ == "__main__":

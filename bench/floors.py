@@ -1,5 +1,5 @@
 """The floors the bench scripts print (`target_floor.py`, `paper_example.py`,
-`offnominal_floor.py`): the same plant integrated by Drake without contact, and the least a
+`offnominal.py`): the same plant integrated by Drake without contact, and the least a
 Python LeafSystem costs per derivative evaluation in Drake's simulator."""
 import time
 

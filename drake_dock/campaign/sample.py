@@ -22,7 +22,9 @@ from drake_dock.campaign.plan import set_field
 from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import PlacementCache, place
-from drake_dock.docking.report.results import summary, timeseries
+from drake_dock.docking.report.results import (energy_ledger, final_misalignment, momenta,
+                                               momentum_reference_point, relative,
+                                               thrust_impulses, timeseries)
 from drake_dock.docking.scenario.validation import validate
 from drake_dock.errors import DrakeDockError, NumericalError
 
@@ -77,19 +79,28 @@ def stewart_peaks(ts: dict) -> tuple[float, float]:
 
 
 def measure(result) -> dict:
-    """The row's result columns of a finished run (RESULT_COLUMNS but wall_time)."""
-    ts = timeseries(result)
-    s = summary(result, ts)
+    """The row's result columns of a finished run (RESULT_COLUMNS but wall_time), from its
+    timeseries without the per-couple arrays (`timeseries(..., couples=False)`): the numbers
+    of `summary` that a row holds, computed as `summary` computes them."""
+    ts = timeseries(result, couples=False)
+    s = result.scenario
+    params = [getattr(s.bodies, n) for n in ts["body_names"]]
+    masses = [p.mass for p in params]
+    about = momentum_reference_point(s, ts)
+    P, _, sP, _ = momenta(ts, masses, [p.inertia for p in params], about)
+    J, _ = thrust_impulses(result, ts, about)
     stroke, force = stewart_peaks(ts)
-    fm = s["final_misalignment"]
-    row = {"outcome": s["outcome"], "reason": s["outcome_reason"],
-           "capture_time": s["capture_time_s"], "end_time": s["end_time_s"],
-           "peak_contact_force": s["loads"]["couple_normal_force_N"]["peak"], "peak_stewart_stroke": stroke,
-           "peak_stewart_force": force, "final_axial": fm["axial_m"],
-           "final_lateral": fm["lateral_m"], "final_tilt_deg": fm["tilt_deg"],
-           "impacts": s["number_of_impacts"],
-           "momentum_drift": s["momentum_drift_relative"]["linear"],
-           "energy_closure": s["energy_ledger"]["closure_error_relative"], "error": None}
+    fm = final_misalignment(ts)
+    lam = ts["lambda_n_max"]
+    row = {"outcome": result.outcome, "reason": result.reason,
+           "capture_time": result.capture_time, "end_time": result.end_time,
+           "peak_contact_force": float(lam.max()) if lam.size and lam.max() > 0 else 0.0,
+           "peak_stewart_stroke": stroke, "peak_stewart_force": force,
+           "final_axial": fm["axial_m"], "final_lateral": fm["lateral_m"],
+           "final_tilt_deg": fm["tilt_deg"], "impacts": len(result.impacts),
+           "momentum_drift": relative(np.linalg.norm(P - P[0] - J, axis=1).max(), sP),
+           "energy_closure": energy_ledger(ts, masses)["closure_error_relative"],
+           "error": None}
     for name, v in row.items():
         if isinstance(v, float) and not math.isfinite(v):
             raise NumericalError(f"the sample's {name} is not finite (an overflow of extreme "

@@ -59,8 +59,11 @@ def surface_params(edge: SurfaceEdge, lower, upper, e: float) -> list:
 
 def reaches_edge(edge: SurfaceEdge, lower, upper, a) -> bool:
     """Rule: the surface couple a is on or past the edge (its ``fixed`` parameter at or past
-    that bound)."""
-    k = edge.fixed
+    that bound) and along it (its other parameter within its bounds: a couple past a corner is
+    on neither edge's curve)."""
+    k, f = edge.fixed, edge.free
+    if not lower[f] <= a[f] <= upper[f]:
+        return False
     return a[k] >= upper[k] if edge.upper else a[k] <= lower[k]
 
 

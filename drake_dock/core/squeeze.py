@@ -87,17 +87,33 @@ def squeeze_interval(lam, z, offsets, mus, shrink):
 def squeezed(lam, A, C, offsets, mus):
     """lam, or lam plus the squeeze nearest to it that puts the sticking couples inside their
     cones (module docstring)."""
+    if cones_hold(lam, offsets, mus):
+        return lam
+    U, S, Vt = np.linalg.svd(A)
+    z = Vt[-1].copy()
+    return squeeze_along(lam, S, z, np.linalg.norm(np.dot(C, z)), np.linalg.norm(C), offsets,
+                         mus)
+
+
+@register_jitable
+def cones_hold(lam, offsets, mus):
+    """Whether lam puts every sticking couple in its cone, or there are fewer than two (no
+    squeeze)."""
     ok = True
     for j in range(len(offsets)):
         o = offsets[j]
         ok = ok and inside(lam[o], lam[o + 1], lam[o + 2], mus[j])
-    if ok or len(offsets) < 2:
-        return lam
-    U, S, Vt = np.linalg.svd(A)
+    return ok or len(offsets) < 2
+
+
+@register_jitable
+def squeeze_along(lam, S, z, Cz_norm, C_norm, offsets, mus):
+    """`squeezed` from A's singular values S (descending) and the right singular vector z of
+    the smallest, with |C z| and |C| (Frobenius): the squeeze along z when it is A's only null
+    direction and does no work."""
     if S[-1] > NULL_RTOL * S[0] or (len(S) > 1 and S[-2] <= NULL_RTOL * S[0]):
         return lam
-    z = Vt[-1].copy()
-    if np.linalg.norm(np.dot(C, z)) > WORK_RTOL * np.linalg.norm(C):
+    if Cz_norm > WORK_RTOL * C_norm:
         return lam
     for shrink in (SHRINK, 1.0):
         lo, hi = squeeze_interval(lam, z, offsets, mus, shrink)

@@ -216,7 +216,7 @@ def _read_only(a):
 
 # What `ModesIndex.derived` keeps that depends only on which pairs are near and far and on
 # their modes (not on far-pair data).
-LAYOUT_DERIVED = ("armed", "armed_arrays", "far_u")
+LAYOUT_DERIVED = ("armed", "armed_arrays", "far_u", "slot", "layout")
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

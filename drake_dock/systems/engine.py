@@ -217,7 +217,7 @@ class Engine:
             far.radii, first, count, surface, info, maps, options_arr, sizes)
         self.packed = pack(self.model)
         self.nbush = len(order)
-        self.layout = E.layout(self.nx, self.k, self.nv, len(frames), self.nbush)
+        self.nframes = len(frames)
         self.nb = len(bodies)
         self.evaluations = 0
 
@@ -257,18 +257,51 @@ class Engine:
                 R0[i], p0[i] = st.ref_X21
                 sought[i] = 1
         rows = np.array([i for i in index.near if states[i].mode.in_contact], np.int64)
+        near = np.array(index.near, np.int64)
+        slot = np.full(k, -1, np.int64)
+        slot[near] = np.arange(len(near))
         return E.ModeArrays(code, index.sigma.copy(), slide, has, rows,
                             np.array([st.clearance for st in states], float),
-                            np.array([st.distance for st in states], float), R0, p0, sought)
+                            np.array([st.distance for st in states], float), R0, p0, sought,
+                            near, slot)
 
     # ------------------------------------------------------------------ evaluation
     def evaluate(self, t, x, modes, tau_in) -> "Evaluation":
         """The evaluation at time t, state x (the system's continuous state), `ContactModes`
         modes and the inputs' generalized force tau_in (nv,)."""
         self.evaluations += 1
-        buf = np.empty(self.layout[-1])
-        evaluate_kernel(self.packed, self.mode_arrays(modes), x, tau_in, buf)
-        return Evaluation(self, t, x, modes, buf)
+        packed, layout = self.prepared(modes)
+        buf = np.empty(layout[-1])
+        evaluate_kernel(self.packed, packed, x, tau_in, buf)
+        return Evaluation(self, t, x, modes, buf, layout)
+
+    def prepared(self, modes) -> tuple:
+        """(`mode_arrays`, `layout_of`) of ``modes`` (kept on their index)."""
+        derived = modes.index().derived
+        hit = derived.get("prepared")
+        if hit is None:
+            hit = derived["prepared"] = (self.mode_arrays(modes), self.layout_of(modes))
+        return hit
+
+    def slot_of(self, modes) -> np.ndarray:
+        """Each pair's place among the pairs not far under ``modes`` (-1 for a far one; kept on
+        their index)."""
+        derived = modes.index().derived
+        hit = derived.get("slot")
+        if hit is None:
+            hit = np.full(self.k, -1, dtype=np.intp)
+            hit[list(modes.index().near)] = np.arange(len(modes.index().near))
+            derived["slot"] = hit
+        return hit
+
+    def layout_of(self, modes) -> tuple:
+        """The result buffer's layout under ``modes`` (`model.layout`; kept on their index)."""
+        derived = modes.index().derived
+        hit = derived.get("layout")
+        if hit is None:
+            hit = derived["layout"] = E.layout(self.nx, self.k, self.nv, self.nframes,
+                                               self.nbush, len(modes.index().near))
+        return hit
 
     # ------------------------------------------------------------------ calculators
     def kinematics(self, q, v) -> "Kinematics":

@@ -54,18 +54,29 @@ class Evaluation:
     """One evaluation (`Engine.evaluate`): views of its result buffer (`engine.layout`), made
     when asked (a derivative evaluation reads only xdot)."""
 
-    def __init__(self, engine, t, x, modes, buf):
+    def __init__(self, engine, t, x, modes, buf, layout):
         self.engine, self.t, self.x, self.modes, self.buf = engine, t, x, modes, buf
+        self.layout = layout
         self.xdot = buf[:engine.nx]
         self._far = False
 
     def _section(self, a, b):
-        L = self.engine.layout
+        L = self.layout
         return self.buf[L[a]:L[b]]
 
     @functools.cached_property
     def out(self):
-        return self._section(1, 2).reshape(self.engine.k, K.ROW)
+        """The couple rows of the pairs not far (n_near, couples.ROW), by `slot`."""
+        return self._section(1, 2).reshape(-1, K.ROW)
+
+    @functools.cached_property
+    def slot(self) -> np.ndarray:
+        """Each pair's place among the pairs not far (-1 for a far one)."""
+        return self.engine.slot_of(self.modes)
+
+    def row(self, i) -> np.ndarray:
+        """Pair i's couple row (a pair not far)."""
+        return self.out[self.slot[i]]
 
     @functools.cached_property
     def lam_n(self):
@@ -81,8 +92,8 @@ class Evaluation:
 
     @functools.cached_property
     def wv(self):
-        """Witness values (k, engine.NW) of the pairs that are not far."""
-        return self._section(5, 6).reshape(self.engine.k, E.NW)
+        """Witness values (n_near, engine.NW) of the pairs that are not far, by `slot`."""
+        return self._section(5, 6).reshape(-1, E.NW)
 
     @property
     def bound(self):
@@ -129,8 +140,8 @@ class Evaluation:
         """`CoupleRow` per pair not far, None per far pair."""
         eng, out = self.engine, self.out
         ev = [None] * eng.k
-        for i in self.modes.index().near:
-            ev[i] = CoupleRow(out[i], int(eng.uoff[i + 1] - eng.uoff[i]))
+        for j, i in enumerate(self.modes.index().near):
+            ev[i] = CoupleRow(out[j], int(eng.uoff[i + 1] - eng.uoff[i]))
         return ev
 
     def _far_pass(self):

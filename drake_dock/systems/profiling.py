@@ -28,15 +28,20 @@ class Timing:
     tracked: dict = dataclasses.field(default_factory=dict)    # evaluations with the pair tracked
 
     _tracked: object = None
+    _epochs: list = dataclasses.field(default_factory=list)
 
     def reset(self):
         self.seeking = self.contact_dynamics = self.impacts = 0.0
         self.seeks, self.screens, self.seek_time, self.tracked = {}, {}, {}, {}
         self._tracked = None
+        self._epochs = []
 
     def tracked_counts(self) -> dict:
         """Per pair, the evaluations in which it was tracked."""
         counts = {n: self.tracked.get(n, 0) for n in self.pairs}
+        for index, n in self._epochs:
+            for i in index.near:
+                counts[self.pairs[i]] += n
         if self._tracked is not None:
             for n, c in zip(self.pairs, self._tracked.tolist()):
                 counts[n] += c
@@ -59,6 +64,15 @@ class Timing:
         """One evaluation with the pairs ``names`` tracked (their couples evaluated, Eq. 47)."""
         for n in names:
             self.tracked[n] = self.tracked.get(n, 0) + 1
+
+    def count_tracked_epoch(self, index):
+        """One evaluation with the pairs not far of the `ModesIndex` ``index`` tracked
+        (counted per index; summed over the pairs when asked, `tracked_counts`)."""
+        last = self._epochs[-1] if self._epochs else None
+        if last is not None and last[0] is index:
+            last[1] += 1
+        else:
+            self._epochs.append([index, 1])
 
     def count_tracked_indices(self, index):
         """One evaluation with the pairs at the positions ``index`` (an array into ``pairs``)

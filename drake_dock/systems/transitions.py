@@ -205,6 +205,14 @@ class Transitions:
             raise SeekingError(str(e), time=time, couples=[p.name]) from None
         st.ref_X21 = ev.far.reference(i, poses)
         st.distance = c.distance
+        if not initial and c.distance >= opt.track_distance:
+            # Beyond the tracking distance the pair stays far whatever its couple is; the
+            # seek's distance, a global minimum, sets its clearance (`hybrid.after_seek`).
+            u[ev.couple_slice(i)] = c.u
+            st.mode, st.clearance = hybrid.after_seek(c.distance, False, False, was_contact,
+                                                      opt.track_distance, opt.reseek_floor)
+            st.slide_dir = None
+            return c.distance, False, was_contact, []
         # Interior, isolated and finished on the contact form inside the domain, else not a
         # potential contact (docs/model.md, "Degenerate couples").
         f = contact_couple(p.kind, p.patch1, poses[a], p.patch2, poses[b], c,

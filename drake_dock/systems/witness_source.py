@@ -18,14 +18,17 @@ from drake_dock.systems.witnesses import FAR_WITNESS
 class ArmedWitnesses:
     """The armed witnesses of a set of modes as arrays: their names (the far pairs' first,
     when ``far``), and of the pairs' witnesses their pair, kind code and whether a gap
-    witness of a tracked couple (``gap``, a mask)."""
+    witness of a tracked couple (``gap``, a mask); their places in an evaluation's witness
+    values and couple rows (those of the pairs not far, by their place among them)."""
 
-    __slots__ = ("names", "pair", "code", "far", "gap", "flat", "gap_flat", "no_rates")
+    __slots__ = ("names", "pair", "code", "far", "gap", "flat", "gap_flat", "g_flat",
+                 "no_rates")
 
-    def __init__(self, names, pair, code, far, gap):
+    def __init__(self, names, pair, code, far, gap, slot):
         self.names, self.pair, self.code, self.far, self.gap = names, pair, code, far, gap
-        self.flat = pair * K.NW + code                  # into an evaluation's wv, raveled
-        self.gap_flat = pair[gap] * C.ROW + C.VN        # the gaps' v_n in its couple rows
+        self.flat = slot * K.NW + code                  # into an evaluation's wv, raveled
+        self.gap_flat = slot[gap] * C.ROW + C.VN        # the gaps' v_n in its couple rows
+        self.g_flat = slot[gap] * C.ROW + C.GAP         # and the gaps
         self.no_rates = np.full(len(pair), np.nan)
 
     @classmethod
@@ -35,9 +38,11 @@ class ArmedWitnesses:
                       f"{pairs[i].name} {witnesses.WITNESSES[kind][0]}" for i, kind in armed)
         pair = np.array([i for i, _ in per], dtype=np.intp)
         code = np.array([witnesses.CODE[kind] for _, kind in per], dtype=np.intp)
-        gap = np.array([kind == "gap" and modes.pairs[i].mode == Mode.TRACKED
+        gap = np.array([kind == "impact" and modes.pairs[i].mode == Mode.TRACKED
                         for i, kind in per], dtype=bool)
-        return cls(names, pair, code, any(i is None for i, _ in armed), gap)
+        place = {i: j for j, i in enumerate(modes.index().near)}
+        slot = np.array([place[i] for i, _ in per], dtype=np.intp)
+        return cls(names, pair, code, any(i is None for i, _ in armed), gap, slot)
 
 
 class WitnessPredictions:
@@ -85,7 +90,9 @@ class WitnessPredictions:
         E = self._cache.Eval(context)
         a = self.armed_witnesses(context)
         d = a.no_rates.copy()
-        d[a.gap] = E.out.ravel().take(a.gap_flat)
+        # The impact witness is the gap while positive: its rate v_n; otherwise unknown.
+        out = E.out.ravel()
+        d[a.gap] = np.where(out.take(a.g_flat) > 0.0, out.take(a.gap_flat), np.nan)
         return np.concatenate([[np.nan], d]) if a.far else d
 
     def witness_second_rate_array(self, context, mask) -> np.ndarray:

@@ -2,31 +2,29 @@
 direction. One guard per transition (module docstring of `contact_system`); every witness is
 positive while its transition is not due and triggers when it reaches zero from above. The
 values are computed by the compiled evaluation (`drake_dock.core.kernels.engine`, per pair and
-kind `W_GAP` ... `W_SIDE`, and the far pairs' smallest clearance left); each witness function
+kind `W_IMPACT` ... `W_SIDE`, and the far pairs' smallest clearance left); each witness function
 reads its own.
 
-The kinds:
-- gap: the gap g of a tracked couple; its zero is an impact.
-- gap rate ("apex"): v_n while the gap is not positive, else 1. Just after an impact the gap is
-  at or below zero (the impact is isolated to within Drake's window), so the gap witness cannot
-  trigger; a couple that closes again before its gap has become positive would be missed. This
-  witness triggers if it turns back (v_n reaches zero) while the gap is still not positive.
-  Once the gap is positive the gap witness takes over: the value jumps from v_n > 0 to 1 (no
-  trigger) on the way out, and from 1 to v_n < 0 on the way back, at the gap's zero, together
-  with the gap witness (a rate witness active at every bounce's apex would cost an isolated
-  event each).
-- domain end: the smallest margin of a bounded parameter to its domain's ends, relative to the
-  span (periodic parameters have none): the couple reaches the end of its domain.
-- Eq. 39: the conditioning of J above ``conditioning_min``: Eq. (39) fails at its zero.
+The kinds, one per transition:
+- impact: the gap g of a tracked couple while it is positive, its rate v_n while it is not; its
+  zero is an impact. Just after an impact the gap is at or below zero (the impact is isolated
+  to within Drake's window): the witness is then v_n > 0, and triggers if the couple turns back
+  (v_n reaches zero) before its gap has become positive; once the gap is positive it is the gap
+  (no trigger on the way out), and on the way back it crosses zero at the gap's zero.
+- regular: the least of the couple's margin to its domain's ends (of each bounded parameter,
+  relative to the span; periodic parameters have none) and of the conditioning of J above
+  ``conditioning_min``: at its zero the couple leaves its domain or Eq. (39) fails, and the pair
+  is sought again.
 - lambda_n of a couple in contact: it detaches at its zero (Eq. 50-51).
 - slip: the sliding velocity along its direction: it stops or reverses at its zero.
 - friction cone: mu_s lambda_n - |lambda_t| of a sticking couple: it reaches the static cone
   (Eq. 51).
 - hand-over: the guard of an edge pair with a declared hand-over (`drake_dock.core.handover`),
-  n . b + `drake_dock.systems.engine.GUARD_BAND`, positive while its curve lies beyond the edge; at its zero the couple
-  passes onto the surface and is handed to the surface pair. The band: a couple that rides on
-  the switching surface (n . b = 0 to round-off, as where a symmetric motion keeps a ring's
-  circle over a petal's edge) does not trigger an event at every step.
+  n . b + `drake_dock.systems.engine.GUARD_BAND`, positive while its curve lies beyond the
+  edge; at its zero the couple passes onto the surface and is handed to the surface pair. The
+  band: a couple that rides on the switching surface (n . b = 0 to round-off, as where a
+  symmetric motion keeps a ring's circle over a petal's edge) does not trigger an event at
+  every step.
 - concave side: a point-curve pair's side (`drake_dock.core.couple.point_curve_side`),
   positive while the point lies on the curve's concave side; at its zero the pair is sought
   again (a potential contact only there).
@@ -44,18 +42,18 @@ FAR_WITNESS = "far pairs clearance"   # the one witness of all far pairs ("clear
 DIRECTION = WitnessFunctionDirection.kPositiveThenNonPositive
 
 # kind: (name after the pair's name, its code in the evaluation's values)
-WITNESSES = {"gap": ("gap", K.W_GAP), "end": ("domain end", K.W_END), "cond": ("Eq. 39", K.W_COND),
+WITNESSES = {"impact": ("gap", K.W_IMPACT), "regular": ("domain end or Eq. 39", K.W_REGULAR),
              "lambda": ("lambda_n", K.W_LAMBDA), "slip": ("slip", K.W_SLIP),
-             "cone": ("friction cone", K.W_CONE), "apex": ("gap rate", K.W_APEX),
-             "handover": ("hand-over", K.W_HANDOVER), "side": ("concave side", K.W_SIDE)}
+             "cone": ("friction cone", K.W_CONE), "handover": ("hand-over", K.W_HANDOVER),
+             "side": ("concave side", K.W_SIDE)}
 CODE = {kind: code for kind, (_, code) in WITNESSES.items()}
 
 
 # The witnesses of a pair in each mode, in the order they are armed.
 BY_MODE = {Mode.FAR: (),
-           Mode.TRACKED: ("end", "cond", "gap", "apex"),
-           Mode.SLIDING: ("end", "cond", "lambda", "slip"),
-           Mode.STICKING: ("end", "cond", "lambda", "cone")}
+           Mode.TRACKED: ("regular", "impact"),
+           Mode.SLIDING: ("regular", "lambda", "slip"),
+           Mode.STICKING: ("regular", "lambda", "cone")}
 
 
 def declare(system, pairs, value_at, far_value, event):

@@ -173,12 +173,15 @@ def test_concurrent_writers_of_one_function_leave_an_index_that_loads_each(tmp_p
     assert out.split() == [str(len(kinds)), "0"]
 
 
-def test_a_unit_starts_after_the_smaller_units_it_shares_kernels_with():
+def test_a_unit_starts_after_the_owners_of_its_modules():
     order, after = prepare.schedule(prepare.units())
     assert sorted(order) == prepare.units()
-    assert {"constraints", "bushing"} <= after["engine"]   # the constraint solve, the bushing
-    assert "engine" in after["calculators"] and not after["lzb"]
-    # A unit waits only for units with fewer kernel modules, which it shares modules with.
+    assert {"solve", "bushing"} <= after["engine"] and "constraints" not in after["engine"]
+    assert "solve" in after["constraints"] and "engine" in after["calculators"]
+    # A unit waits for the owner of each module it holds: of the units holding the module, the
+    # one with the fewest modules (ties by name).
     deps = {n: prepare._kernel_deps(n) for n in order}
     for a, bs in after.items():
-        assert all(len(deps[b]) < len(deps[a]) and deps[a] & deps[b] for b in bs)
+        owners = {min((u for u in order if d in deps[u]), key=lambda u: (len(deps[u]), u))
+                  for d in deps[a]} - {a}
+        assert bs == owners

@@ -1,5 +1,7 @@
 """The compiled constraint solve and mode selection (drake_dock.core.kernels.constraints) against
-the pure-Python reference (drake_dock.core.constraints) to 1e-12: random seeded scenes of one
+the pure-Python reference (drake_dock.core.constraints) to 1e-10 (the compiled solve factors its
+systems by its own LU, `small_linalg`, the reference by LAPACK's: they agree to the round-off
+the systems' conditioning allows): random seeded scenes of one
 or two free bodies with sticking, sliding and detached couples, redundant and inconsistent
 sticking rows, and Painleve's rod on both sides of its critical friction (closed form).
 tests/core/test_constraints.py runs its scenes through both implementations too."""
@@ -17,7 +19,7 @@ from test_constraints import G, OMEGA, random_scene, rod
 FIELDS = ("vdot", "lam_n", "lam_t", "generalized_force")
 
 
-def assert_same(a, b, tol=1e-12):
+def assert_same(a, b, tol=1e-10):
     """Two `ContactSolution`s: the same modes and sliding directions, and every force and
     acceleration within tol of its scale."""
     assert a.modes == b.modes

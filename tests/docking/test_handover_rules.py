@@ -49,9 +49,11 @@ def test_refused_handovers_leave_the_run_unchanged(scenario, monkeypatch):
 
 def test_without_the_rules_the_couples_go_to_and_fro(scenario, monkeypatch):
     """Every hand-over that falls due taken: more are taken than twice the declared hand-overs
-    (each could go once each way), so couples go to and fro; the tracked couples that drift on
-    the way are sought again, and the run still captures at the run without hand-overs'
-    time."""
+    (each could go once each way), so couples go to and fro. The run still ends captured (the
+    tracked couples that drift on the way are sought again), but not the physical run: a
+    couple handed where the rules refuse it (singular, or not the same pair of points) can
+    meet a patch the run without hand-overs never touches, so it captures later, after more
+    impacts."""
     taken = []
 
     def take(*args):
@@ -65,7 +67,7 @@ def test_without_the_rules_the_couples_go_to_and_fro(scenario, monkeypatch):
     ref = _run(scenario, False)
     assert len(taken) > 2 * len(declared) > 0
     assert r.outcome == ref.outcome == "captured"
-    assert abs(r.capture_time - ref.capture_time) <= 1e-6
+    assert r.capture_time >= ref.capture_time and len(r.impacts) >= len(ref.impacts)
 
 
 def test_the_complete_set_shifts_the_paper_example_by_its_first_contact(scenario):

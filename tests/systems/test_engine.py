@@ -199,7 +199,7 @@ def test_an_evaluation_in_contact_solves_its_equations(scene):
     omega = system.options.baumgarte
     vdot = E.vdot
     for i in contact:
-        p, row = system.pairs[i], E.out[i]
+        p, row = system.pairs[i], E.row(i)
         P1, P2 = row[K.P1:K.P1 + 3], row[K.P2:K.P2 + 3]
         D = np.array([row[K.N:K.N + 3], row[K.TA:K.TA + 3], row[K.TB:K.TB + 3]])
         X1, X2 = p.frame1.CalcPoseInWorld(pc), p.frame2.CalcPoseInWorld(pc)

@@ -53,7 +53,7 @@ def couples_at(mp, R, o, w, vf, u, sigma, which, project, drift_feedback, out):
             us = (ui[0], ui[1], ui[2] if len(ui) == 3 else 0.0)
             K.evaluate_one(kind == CC, m.kind1[i], m.prm1[i], m.kind2[i], m.prm2[i], R[a], o1,
                            w1, v1, R[b], o2, w2, v2, us, sigma[i], project, row)
-        couple_rates(m, i, out, drift_feedback, rate)
+        couple_rates(m, i, row, drift_feedback, rate)
 
 
 @njit(cache=True)
@@ -156,9 +156,10 @@ def couple_table(mp, sp, x, buf, cols, Y):
     m = unpack_model(mp)
     s = unpack_modes(sp)
     k, F, nbush = s.code.shape[0], m.frame_body.shape[0], m.bush_frames.shape[0]
+    nn = s.near.shape[0]
     XD, OUT, LN, LT, GF, WV, BD, FR, FO, FW, FV, SC, BU, END = layout(
-        m.sizes[Z_NX], k, m.sizes[Z_NV], F, nbush)
-    out = buf[OUT:LN].reshape((k, K.ROW))
+        m.sizes[Z_NX], k, m.sizes[Z_NV], F, nbush, nn)
+    out = buf[OUT:LN].reshape((nn, K.ROW))
     lam_n, lam_t = buf[LN:LT], buf[LT:GF].reshape((k, 2))
     bound = buf[BD:FR]
     R, o = buf[FR:FO].reshape((F, 3, 3)), buf[FO:FW].reshape((F, 3))
@@ -170,7 +171,7 @@ def couple_table(mp, sp, x, buf, cols, Y):
         y = Y[i]
         dims = m.uoff[i + 1] - m.uoff[i]
         if s.code[i] != FAR:
-            row = out[i]
+            row = out[s.slot[i]]
             y[ST] = s.code[i]
             y[GP], y[VN] = row[K.GAP], row[K.VN]
             y[LNc], y[LTc], y[LTc + 1] = lam_n[i], lam_t[i, 0], lam_t[i, 1]
@@ -215,6 +216,7 @@ def warm():
     mass_at(mp, Rb, M)
     far = np.array([3], dtype=np.int64)
     far_points(mp, far, x, R, o, np.empty((1, 3)), np.empty((1, 3)))
-    buf = np.zeros(layout(int(m.sizes[Z_NX]), k, nv, F, m.bush_frames.shape[0])[-1])
+    buf = np.zeros(layout(int(m.sizes[Z_NX]), k, nv, F, m.bush_frames.shape[0],
+                          s.near.shape[0])[-1])
     del NW
     couple_table(mp, sp, x, buf, np.arange(10, dtype=np.int64), np.empty((k, 26)))

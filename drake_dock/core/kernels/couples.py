@@ -393,3 +393,28 @@ def _ps_conditioning(A0, A1, su, sv):
         A1 = (A1[0] / c0, A1[1] / c1, 0.0)
     den = math.hypot(A0[0], A0[1]) * math.hypot(A1[0], A1[1])
     return abs(A0[0] * A1[1] - A0[1] * A1[0]) / den if den > 0 else 0.0
+
+
+def warm():
+    """Compiles or loads the couples of each kind with the argument types of the compiled
+    engine's calls (`drake_dock.core.kernels.engine`): frames' rotations as views of a stacked
+    array, points and twists as tuples, a row of a stacked array."""
+    from drake_dock.core.patches import Circle, PlaneRect, Segment
+    from drake_dock.core.kernels.jets import patch_spec
+    import numpy as np
+    R = np.tile(np.eye(3), (2, 1, 1))
+    out = np.zeros((3, ROW))
+    z = (0.0, 0.0, 0.0)
+    project = np.bool_(True)
+    k1, p1 = patch_spec(Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1)))
+    k2, p2 = patch_spec(Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0)))
+    evaluate_one(True, k1, p1, k2, p2, R[0], z, z, z, R[1], z, z, z, (0.5, 0.5, 0.0), 1.0,
+                 project, out[0])
+    kc, pcirc = patch_spec(Circle(0.3, 0.1))
+    kp, pplane = patch_spec(PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)))
+    evaluate_one(False, kc, pcirc, kp, pplane, R[0], z, z, z, R[1], z, z, z, (0.5, 0.5, 0.5),
+                 1.0, project, out[1])
+    evaluate_pc_one(kc, pcirc, (0.1, 0.2, 0.3), 0.01, R[0], z, z, z, R[1], z, z, z, 0.5, 1.0,
+                    project, out[2])
+    evaluate_ps_one(kp, pplane, (0.1, 0.2, 0.3), 0.01, R[0], z, z, z, R[1], z, z, z,
+                    (0.5, 0.5), 1.0, project, out[2])

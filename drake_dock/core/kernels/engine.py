@@ -15,7 +15,7 @@ The steps are the paper's:
   sliding direction, and the constraint solve for the given modes (Eq. 48-52,
   `solve.solve_modes`);
 - the witnesses of the contact system's table (`drake_dock.systems.witnesses`): per pair the
-  value of each kind (`W_GAP` ... `W_SIDE`), and the far pairs' smallest clearance left.
+  value of each kind (`W_IMPACT` ... `W_SIDE`), and the far pairs' smallest clearance left.
 
 Records (`drake_dock.core.kernels.records`): `Model` (the bodies, frames, force elements,
 pairs, hand-over edges and options, built once per system) and `ModeArrays` (the pairs' modes
@@ -39,19 +39,17 @@ from drake_dock.core.kernels.model import (BUSH_ROW, CC, FAR, NW, O_COND_MIN, O_
                                            O_ENERGY, O_GUARD, O_MU, O_MU_S, O_OMEGA, O_V_SLIP,
                                            PC, PS, S_BAD_PC, S_BUSH, S_COND, S_DAMP, S_DRIFTING,
                                            S_FAR, S_FRICTION, S_KE, S_P_EL, S_P_IN, S_PE,
-                                           S_STATUS, SLIDING, STICKING, W_APEX, W_COND, W_CONE,
-                                           W_END, W_GAP, W_HANDOVER, W_LAMBDA, W_SIDE, W_SLIP,
+                                           S_REPORT, S_STATUS, SLIDING, STICKING, W_CONE,
+                                           W_HANDOVER, W_IMPACT, W_LAMBDA, W_REGULAR, W_SIDE, W_SLIP,
                                            Z_IE, Z_NQ, Z_NV, Z_NX, layout, unpack_model,
                                            unpack_modes)
 from drake_dock.core.kernels.solve import OK, SLIDE, STICK, solve_modes
 from drake_dock.core.kernels.witness_values import end_margin, handover_guard, point_curve_side
 
 @njit(cache=True)
-def _couple(m, i, R, o, w, vf, u, sigma, out):
-    """Pair i's couple into its row out[i] (its kind's kernel), the drift relative to its
-    spans and its integrated rate."""
+def _couple(m, i, R, o, w, vf, u, sigma, row):
+    """Pair i's couple into its couple row (its kind's kernel)."""
     a, b = m.fidx[i, 0], m.fidx[i, 1]
-    row = out[i]
     o1, w1, v1 = (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]), \
         (vf[a, 0], vf[a, 1], vf[a, 2])
     o2, w2, v2 = (o[b, 0], o[b, 1], o[b, 2]), (w[b, 0], w[b, 1], w[b, 2]), \
@@ -76,10 +74,9 @@ def _couple(m, i, R, o, w, vf, u, sigma, out):
 
 
 @njit(cache=True)
-def couple_rates(m, i, out, drift_feedback, udot):
+def couple_rates(m, i, row, drift_feedback, udot):
     """Pair i's largest drift relative to its spans (row DRIFT_REL) and its integrated rate
     u*' = Eq. (47) + drift_feedback x projection, into its row and into udot."""
-    row = out[i]
     rel = 0.0
     for j in range(m.uoff[i + 1] - m.uoff[i]):
         rel = max(rel, abs(row[K.DRIFT + j]) / m.spans[i, j])
@@ -97,14 +94,15 @@ def evaluate(mp, sp, x, tau_in, buf):
     nq, nv, ie, nx = m.sizes[Z_NQ], m.sizes[Z_NV], m.sizes[Z_IE], m.sizes[Z_NX]
     k, F, nb, nbush = s.code.shape[0], m.frame_body.shape[0], m.qs.shape[0], \
         m.bush_frames.shape[0]
-    XD, OUT, LN, LT, GF, WV, BD, FR, FO, FW, FV, SC, BU, END = layout(nx, k, nv, F, nbush)
+    nn = s.near.shape[0]
+    XD, OUT, LN, LT, GF, WV, BD, FR, FO, FW, FV, SC, BU, END = layout(nx, k, nv, F, nbush, nn)
     opt = m.options
     q, v, u = x[:nq], x[nq:nq + nv], x[nq + nv:ie]
     xdot = buf[XD:XD + nx]
-    out = buf[OUT:LN].reshape((k, K.ROW))
+    out = buf[OUT:LN].reshape((nn, K.ROW))
     lam_n, lam_t = buf[LN:LT], buf[LT:GF].reshape((k, 2))
     gf = buf[GF:WV]
-    wv = buf[WV:BD].reshape((k, NW))
+    wv = buf[WV:BD].reshape((nn, NW))
     R, o = buf[FR:FO].reshape((F, 3, 3)), buf[FO:FW].reshape((F, 3))
     w, vf = buf[FW:FV].reshape((F, 3)), buf[FV:SC].reshape((F, 3))
     sc = buf[SC:BU]
@@ -134,16 +132,14 @@ def evaluate(mp, sp, x, tau_in, buf):
     lam_t[:] = 0.0
     gf[:] = 0.0
     fb, tol = opt[O_DRIFT_FB], opt[O_DRIFT_TOL]
-    # Rows and witness values of far pairs are not written (nothing reads them).
-    for i in range(k):
+    for j in range(nn):
+        i = s.near[j]
         code = s.code[i]
-        if code == FAR:
-            continue
-        out[i, :] = 0.0
-        wv[i, :] = 1.0
-        _couple(m, i, R, o, w, vf, u, s.sigma[i], out)
-        couple_rates(m, i, out, fb, udot)
-        row = out[i]
+        row = out[j]
+        row[:] = 0.0
+        wv[j, :] = 1.0
+        _couple(m, i, R, o, w, vf, u, s.sigma[i], row)
+        couple_rates(m, i, row, fb, udot)
         if m.pair_kind[i] == PC and math.isnan(row[K.GAP]):
             if sc[S_BAD_PC] < 0:
                 sc[S_BAD_PC] = i
@@ -151,14 +147,12 @@ def evaluate(mp, sp, x, tau_in, buf):
         if row[K.DRIFT_REL] > tol and sc[S_DRIFTING] < 0:
             sc[S_DRIFTING] = i
         R2 = R[m.fidx[i, 1]]
-        wv[i, W_GAP] = row[K.GAP]
-        wv[i, W_END] = end_margin(m, i, row)
-        wv[i, W_COND] = row[K.COND] - opt[O_COND_MIN]
-        wv[i, W_APEX] = 1.0 if row[K.GAP] > 0.0 else row[K.VN]
+        wv[j, W_IMPACT] = row[K.GAP] if row[K.GAP] > 0.0 else row[K.VN]
+        wv[j, W_REGULAR] = min(end_margin(m, i, row), row[K.COND] - opt[O_COND_MIN])
         if m.edge_count[i] > 0:
-            wv[i, W_HANDOVER] = handover_guard(m, i, row, R2) + opt[O_GUARD]
+            wv[j, W_HANDOVER] = handover_guard(m, i, row, R2) + opt[O_GUARD]
         if m.pair_kind[i] == PC:
-            wv[i, W_SIDE] = point_curve_side(m, i, row, R2)
+            wv[j, W_SIDE] = point_curve_side(m, i, row, R2)
     sc[S_FAR] = math.nan        # `far_witness` fills it and BOUND when asked
     e = ie
     xdot[e + 1], xdot[e + 2] = p_el / opt[O_ENERGY], p_in / opt[O_ENERGY]
@@ -167,6 +161,7 @@ def evaluate(mp, sp, x, tau_in, buf):
     vdot = xdot[nq:nq + nv]
     if sc[S_BAD_PC] >= 0:
         sc[S_STATUS] = OK
+        sc[S_REPORT] = 1.0
         vdot[:] = 0.0
         xdot[e] = 0.0
         return
@@ -190,7 +185,7 @@ def evaluate(mp, sp, x, tau_in, buf):
     v_slip = opt[O_V_SLIP]
     for j in range(r):
         i = rows[j]
-        row = out[i]
+        row = out[s.slot[i]]
         for c in range(3):
             D[0, c], D[1, c], D[2, c] = row[K.N + c], row[K.TA + c], row[K.TB + c]
         a, b = m.fidx[i, 0], m.fidx[i, 1]
@@ -214,18 +209,20 @@ def evaluate(mp, sp, x, tau_in, buf):
     status, cond = solve_modes(Minv, a0, W, bias, gap, vn, mus, mus_s, codes, dirs,
                                opt[O_OMEGA], vdot, lr_n, lr_t, gf)
     sc[S_STATUS], sc[S_COND] = status, cond
+    sc[S_REPORT] = 1.0 if status != OK or sc[S_BUSH] != 0.0 else 0.0
     power = 0.0
     for j in range(r):
         i = rows[j]
+        n = s.slot[i]
         lam_n[i], lam_t[i, 0], lam_t[i, 1] = lr_n[j], lr_t[j, 0], lr_t[j, 1]
-        power -= lr_t[j, 0] * out[i, K.VT] + lr_t[j, 1] * out[i, K.VT + 1]
-        wv[i, W_LAMBDA] = lr_n[j]
+        power -= lr_t[j, 0] * out[n, K.VT] + lr_t[j, 1] * out[n, K.VT + 1]
+        wv[n, W_LAMBDA] = lr_n[j]
         if s.code[i] == SLIDING:
             if s.has_dir[i]:
-                wv[i, W_SLIP] = out[i, K.VT] * s.slide_dir[i, 0] \
-                    + out[i, K.VT + 1] * s.slide_dir[i, 1]
+                wv[n, W_SLIP] = out[n, K.VT] * s.slide_dir[i, 0] \
+                    + out[n, K.VT + 1] * s.slide_dir[i, 1]
         else:
-            wv[i, W_CONE] = opt[O_MU_S] * lr_n[j] - math.hypot(lr_t[j, 0], lr_t[j, 1])
+            wv[n, W_CONE] = opt[O_MU_S] * lr_n[j] - math.hypot(lr_t[j, 0], lr_t[j, 1])
     sc[S_FRICTION] = power
     xdot[e] = power / opt[O_ENERGY]
 
@@ -264,7 +261,8 @@ def toy_model():
                         nq + nv + int(dims.sum()) + 3 + 1])[:N_SIZES])
     s = ModeArrays(np.array([TRACKED, SLIDING, STICKING, FAR]), np.ones(k), np.zeros((k, 2)),
                    np.array([0, 1, 0, 0]), np.array([1, 2]), np.ones(k), np.ones(k),
-                   np.tile(np.eye(3), (k, 1, 1)), np.zeros((k, 3)), np.array([0, 0, 0, 1]))
+                   np.tile(np.eye(3), (k, 1, 1)), np.zeros((k, 3)), np.array([0, 0, 0, 1]),
+                   np.array([0, 1, 2]), np.array([0, 1, 2, -1]))
     x = np.zeros(int(m.sizes[Z_NX]))
     x[0] = x[7] = 1.0
     x[nq + nv:nq + nv + int(dims.sum())] = 0.5
@@ -278,6 +276,7 @@ def warm():
     m, s, x = toy_model()
     mp, sp = pack(m), pack(s)
     nbush, k, F = m.bush_frames.shape[0], s.code.shape[0], m.frame_body.shape[0]
-    buf = np.empty(layout(int(m.sizes[Z_NX]), k, int(m.sizes[Z_NV]), F, nbush)[-1])
+    buf = np.empty(layout(int(m.sizes[Z_NX]), k, int(m.sizes[Z_NV]), F, nbush,
+                          s.near.shape[0])[-1])
     evaluate(mp, sp, x, np.zeros(int(m.sizes[Z_NV])), buf)
     far_witness(mp, sp, buf)

@@ -17,9 +17,12 @@ CC, CS, PC, PS = 0, 1, 2, 3
 KIND_CODE = {"CC": CC, "CS": CS, "PC": PC, "PS": PS}
 # Modes (`drake_dock.core.hybrid.Mode`).
 FAR, TRACKED, SLIDING, STICKING = 0, 1, 2, 3
-# Witness kinds, in the order of `drake_dock.systems.witnesses.WITNESSES`.
-W_GAP, W_END, W_COND, W_LAMBDA, W_SLIP, W_CONE, W_APEX, W_HANDOVER, W_SIDE = range(9)
-NW = 9
+# Witness kinds, in the order of `drake_dock.systems.witnesses.WITNESSES`: the impact (the gap
+# of a tracked couple while positive, its rate while not), the couple's regularity (its least
+# domain-end margin or conditioning margin), lambda_n, slip, the friction cone, the hand-over
+# guard and a point-curve couple's side.
+W_IMPACT, W_REGULAR, W_LAMBDA, W_SLIP, W_CONE, W_HANDOVER, W_SIDE = range(7)
+NW = 7
 # Hand-over edge maps (`drake_dock.core.handover.SurfaceEdge.kernel_map`): the surface's free
 # parameter at the edge's parameter e is alpha e + beta, or component c of the edge curve's
 # point (its frame's coordinates).
@@ -31,9 +34,10 @@ N_OPTIONS = 10
 # Sizes (`Model.sizes`).
 Z_NQ, Z_NV, Z_NU, Z_IE, Z_NX = range(5)
 N_SIZES = 5
-# Scalars of the results (section SC of `layout`), then each bushing's damper power.
+# Scalars of the results (section SC of `layout`), then each bushing's damper power; S_REPORT is
+# 1 when the evaluation has something to report (S_BAD_PC, S_BUSH or S_STATUS), else 0.
 S_STATUS, S_COND, S_BAD_PC, S_FAR_EARLY, S_FRICTION, S_P_EL, S_P_IN, S_FAR, S_KE, S_PE, \
-    S_DUE, S_DRIFTING, S_BUSH, S_DAMP = range(14)
+    S_DUE, S_DRIFTING, S_BUSH, S_REPORT, S_DAMP = range(15)
 # Per bushing in section BUSH: deflection x (3), roll-pitch-yaw (3), spatial force on C (6).
 BUSH_ROW = 12
 
@@ -99,10 +103,11 @@ def unpack_model(p):
 
 class ModeArrays(NamedTuple):
     """The pairs' modes (`FAR` ... `STICKING`), orientation sigma, held sliding direction
-    (has_dir 1 where one is held), the pairs in contact (rows, ascending), and per pair its
-    far-pair data: clearance, distance at the last seek, the relative pose (R0, p0) of its
-    frame 1 in its frame 2 then, and whether it was ever sought; built once per sealed set of
-    modes."""
+    (has_dir 1 where one is held), the pairs in contact (rows, ascending), the pairs not far
+    (near, ascending) and each pair's place among them (slot, -1 for a far pair: the couple rows
+    and witness values of an evaluation are the near pairs' only), and per pair its far-pair
+    data: clearance, distance at the last seek, the relative pose (R0, p0) of its frame 1 in
+    its frame 2 then, and whether it was ever sought; built once per sealed set of modes."""
 
     code: np.ndarray
     sigma: np.ndarray
@@ -114,27 +119,30 @@ class ModeArrays(NamedTuple):
     R0: np.ndarray
     p0: np.ndarray
     sought: np.ndarray
+    near: np.ndarray
+    slot: np.ndarray
 
 
 @njit(cache=True)
 def unpack_modes(p):
     return ModeArrays(i1(p, 0), f1(p, 1), f2(p, 2), i1(p, 3), i1(p, 4), f1(p, 5), f1(p, 6),
-                      f3(p, 7), f2(p, 8), i1(p, 9))
+                      f3(p, 7), f2(p, 8), i1(p, 9), i1(p, 10), i1(p, 11))
 
 
 @njit(cache=True)
-def layout(nx, k, nv, nframes, nbush):
-    """The offsets of the result buffer's sections: xdot, couple rows (k, couples.ROW),
-    lambda_n (k), lambda_t (k, 2), generalized contact force (nv), witness values (k, NW),
-    far travel bounds (k), the frames' R (F, 3, 3), o, w, v (F, 3), the scalars (`S_*` and the
-    damper powers), the bushings (nbush, BUSH_ROW); and the total size."""
+def layout(nx, k, nv, nframes, nbush, nn):
+    """The offsets of the result buffer's sections: xdot, the near pairs' couple rows
+    (nn, couples.ROW, by `ModeArrays.slot`), lambda_n (k), lambda_t (k, 2), generalized contact
+    force (nv), the near pairs' witness values (nn, NW), far travel bounds (k), the frames' R
+    (F, 3, 3), o, w, v (F, 3), the scalars (`S_*` and the damper powers), the bushings
+    (nbush, BUSH_ROW); and the total size."""
     XD = 0
     OUT = XD + nx
-    LN = OUT + k * K.ROW
+    LN = OUT + nn * K.ROW
     LT = LN + k
     GF = LT + 2 * k
     WV = GF + nv
-    BD = WV + k * NW
+    BD = WV + nn * NW
     FR = BD + k
     FO = FR + 9 * nframes
     FW = FO + 3 * nframes

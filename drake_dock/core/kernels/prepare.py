@@ -10,9 +10,11 @@ covers everything the unit compiles) in up to ``jobs`` worker processes
 (``python -m drake_dock.core.kernels --worker``, each taking one unit after another), a line per
 unit with its time, then loads every unit here.
 
-Order (`schedule`): a unit starts after the units it shares a kernel module with that have
-fewer kernel modules than it (`engine` after `tracked` and `constraints`): their common callees
-are then compiled once, by the smaller unit, and loaded by the larger. Among the units free to
+Order (`schedule`): each kernel module is owned by the unit with the fewest kernel modules that
+holds it, and a unit starts after the owners of the modules it holds (`engine` after `solve`,
+which owns the constraint solve that `constraints` calls too): common callees are then compiled
+once, by their owner, and loaded by the others, and two units that share only an owner's
+modules compile side by side. Among the units free to
 start, the one heading the longest chain of waiting units goes first, a unit's length being the
 kernel source lines it compiles itself (a rough measure of its compile time).
 """
@@ -60,8 +62,12 @@ def schedule(names: list[str], package=cc._PACKAGE):
     """(the units ``names`` in the order they are started when free to, {unit: the units
     among ``names`` it starts after}): see the module docstring."""
     deps = {n: _kernel_deps(n, package) for n in names}
-    after = {a: {b for b in names if deps[a] & deps[b] and len(deps[b]) < len(deps[a])}
-             for a in names}
+    # Each kernel module's owner: the unit with the fewest kernel modules that holds it.
+    owner = {}
+    for n in sorted(names, key=lambda n: (len(deps[n]), n)):
+        for d in deps[n]:
+            owner.setdefault(d, n)
+    after = {a: {owner[d] for d in deps[a]} - {a} for a in names}
     here = package / "core" / "kernels"
 
     def own(n):     # the kernel source lines that unit n compiles itself

@@ -1,7 +1,7 @@
 """The constraint solve of `drake_dock.core.constraints.solve_given_modes` compiled (Eq. 48-52):
 the forces and accelerations of a contact set for given modes, over the packed rows of
-`drake_dock.core.kernels.constraints`, with the reference's operations in its order (BLAS
-products, LAPACK's LU solve) and the squeeze of two sticking couples
+`drake_dock.core.kernels.constraints`: the products in loops, LU with partial pivoting and the
+SVD for the singular case (`small_linalg`), and the squeeze of two sticking couples
 (`drake_dock.core.squeeze`)."""
 from __future__ import annotations
 
@@ -12,7 +12,8 @@ from numba import njit, types
 from numba.extending import intrinsic
 
 from drake_dock.core import constraints as ref
-from drake_dock.core.squeeze import squeezed
+from drake_dock.core.kernels import small_linalg as L
+from drake_dock.core.squeeze import cones_hold, squeeze_along
 
 STICK, SLIDE, DETACH = 0, 1, 2
 CODE = {ref.STICK: STICK, ref.SLIDE: SLIDE, ref.DETACH: DETACH}
@@ -78,13 +79,29 @@ def solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, 
                 Dt[j, a] = W[i, a, 0]
             rhs[j] = stabilised(bias[i, 0], vn[i], gap[i], omega)
             j += 1
-    C = Ct.T
-    MinvC = np.dot(Minv, C)
-    A = np.dot(Dt, MinvC)
-    b = -(rhs + np.dot(Dt, a0))
+    # MinvC = M^-1 C (nv, m), A = D^T M^-1 C, b = -(rhs + D^T a0).
+    MinvC = np.empty((nv, m))
+    for r in range(nv):
+        for c in range(m):
+            acc = 0.0
+            for a in range(nv):
+                acc += Minv[r, a] * Ct[c, a]
+            MinvC[r, c] = acc
+    A = np.empty((m, m))
+    b = np.empty(m)
+    for r in range(m):
+        acc = 0.0
+        for a in range(nv):
+            acc += Dt[r, a] * a0[a]
+        b[r] = -(rhs[r] + acc)
+        for c in range(m):
+            acc = 0.0
+            for a in range(nv):
+                acc += Dt[r, a] * MinvC[a, c]
+            A[r, c] = acc
     if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
-        return NONFINITE, np.nan        # LAPACK is not called on them
-    # The reference's singularity test: the Hadamard ratio |det A| / prod of its row norms.
+        return NONFINITE, np.nan
+    # The singularity test: the Hadamard ratio |det A| / prod of its row norms.
     prod, positive = 1.0, True
     for r in range(m):
         s = 0.0
@@ -93,15 +110,16 @@ def solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, 
         rn = math.sqrt(s)
         positive = positive and rn > 0
         prod *= rn
-    ratio = abs(np.linalg.det(A)) / prod if positive and prod > 0 else 0.0
+    LU, piv, sign = L.lu(A)
+    ratio = abs(L.lu_det(LU, sign)) / prod if positive and prod > 0 else 0.0
     cond = 0.0
     if np.isfinite(ratio) and ratio > 1e-12:
-        lam = np.linalg.solve(A, b)
+        lam = L.lu_solve(LU, piv, b)
     else:
-        cond = np.linalg.cond(A)
-        lam = np.linalg.lstsq(A, b, rcond=1e-10)[0]
-        if np.linalg.norm(np.dot(A, lam) - b) > (1e-8 * (1.0 + np.linalg.norm(b))
-                                                   + math.sqrt(soft)):
+        U, sv, V = L.svd(A)
+        cond = sv[0] / sv[-1] if sv[-1] > 0.0 else math.inf
+        lam = L.svd_solve(U, sv, V, b, 1e-10)
+        if L.norm(L.matvec(A, lam) - b) > (1e-8 * (1.0 + L.norm(b)) + math.sqrt(soft)):
             return SINGULAR, cond
         ns = 0
         for i in range(k):
@@ -113,9 +131,22 @@ def solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, 
                 offsets[n], mus[n] = j, mu_s[i]
                 n += 1
             j += 3 if modes[i] == STICK else (1 if modes[i] == SLIDE else 0)
-        lam = squeezed(lam, A, C, offsets, mus)     # `drake_dock.core.squeeze` (Eq. 51)
-    vdot[:] = a0 + np.dot(MinvC, lam)
-    gf[:] = np.dot(C, lam)
+        if not cones_hold(lam, offsets, mus):     # `drake_dock.core.squeeze` (Eq. 51)
+            z = V[:, m - 1].copy()
+            C = Ct.T.copy()
+            C_norm = 0.0
+            for r in range(nv):
+                for c in range(m):
+                    C_norm += C[r, c] * C[r, c]
+            lam = squeeze_along(lam, sv, z, L.norm(L.matvec(C, z)), math.sqrt(C_norm),
+                                offsets, mus)
+    for r in range(nv):
+        acc, acc2 = 0.0, 0.0
+        for c in range(m):
+            acc += MinvC[r, c] * lam[c]
+            acc2 += Ct[c, r] * lam[c]
+        vdot[r] = a0[r] + acc
+        gf[r] = acc2
     j = 0
     for i in range(k):
         if modes[i] == STICK:
@@ -142,3 +173,17 @@ def accelerations(W, bias, vdot, gdd, at):
             else:
                 at[i, c - 1] = s + bias[i, c]
 
+
+
+def warm():
+    """Compiles or loads the solve: a free body (nv = 6) with one sticking and one sliding
+    couple."""
+    nv, k = 6, 2
+    W = np.zeros((k, nv, 3))
+    for i in range(k):
+        W[i, :3] = np.eye(3)
+        W[i, 3:, 0] = (1.0, 0.0, 0.0)
+    solve_modes(np.eye(nv), np.zeros(nv), W, np.zeros((k, 3)), np.zeros(k), np.zeros(k),
+                np.full(k, 0.3), np.full(k, 0.3), np.array([STICK, SLIDE], dtype=np.int64),
+                np.array([[0.0, 0.0], [1.0, 0.0]]), 20.0, np.empty(nv), np.empty(k),
+                np.empty((k, 2)), np.empty(nv))

@@ -142,7 +142,7 @@ def far_witness(mp, sp, buf):
     s = unpack_modes(sp)
     k, F, nbush = s.code.shape[0], m.frame_body.shape[0], m.bush_frames.shape[0]
     XD, OUT, LN, LT, GF, WV, BD, FR, FO, FW, FV, SC, BU, END = layout(
-        m.sizes[Z_NX], k, m.sizes[Z_NV], F, nbush)
+        m.sizes[Z_NX], k, m.sizes[Z_NV], F, nbush, s.near.shape[0])
     bound = buf[BD:FR]
     R, o = buf[FR:FO].reshape((F, 3, 3)), buf[FO:FW].reshape((F, 3))
     w, vf = buf[FW:FV].reshape((F, 3)), buf[FV:SC].reshape((F, 3))

@@ -61,26 +61,33 @@ class Record:
         n = self.dd.contact.nq + self.dd.contact.nv
         return np.array([x[:n] for x in self.states]).reshape(len(self.t), n)
 
-    def derive(self) -> dict:
+    def derive(self, couples: bool = True) -> dict:
         """Per sample, by one evaluation of the contact system: ``couples`` (N, pairs,
-        COUPLE_OUTPUT_SIZE) its couple outputs, ``energy`` (N, energy names), ``bushings``
-        (N, bushings, 12: deflection, roll-pitch-yaw, force on the APDS frame, world),
-        ``ring_distance`` (N,)."""
-        if self._derived is None:
+        COUPLE_OUTPUT_SIZE) its couple outputs (left out with ``couples`` False: the largest
+        part), ``lambda_n_max`` (N,) the largest normal force, ``energy`` (N, energy names),
+        ``bushings`` (N, bushings, 12: deflection, roll-pitch-yaw, force on the APDS frame,
+        world), ``ring_distance`` (N,)."""
+        if self._derived is None or (couples and "couples" not in self._derived):
             contact, capture = self.dd.contact, self.dd.capture
             n = len(self.t)
-            C = np.zeros((n, len(contact.pairs), COUPLE_OUTPUT_SIZE))
+            C = np.zeros((n, len(contact.pairs), COUPLE_OUTPUT_SIZE)) if couples else None
+            lam = np.zeros(n)
             energy = np.zeros((n, len(contact.energy_names)))
             bush = np.zeros((n, contact.engine.nbush, 12))
             ring = np.zeros(n)
             for k in range(n):
                 E = contact.engine.evaluate(self.t[k], self.states[k], self.modes[k],
                                             self.tau[k])
-                C[k] = contact.couple_table_of(E)
+                if couples:
+                    C[k] = contact.couple_table_of(E)
+                lam[k] = E.lam_n.max(initial=0.0)
                 energy[k] = contact.energy(E, self.modes[k])
                 bush[k] = E.bushings
                 ring[k] = capture.misalignment_of(self.states[k][:contact.nq])[0]
-            self._derived = dict(couples=C, energy=energy, bushings=bush, ring_distance=ring)
+            self._derived = dict(lambda_n_max=lam, energy=energy, bushings=bush,
+                                 ring_distance=ring)
+            if couples:
+                self._derived["couples"] = C
         return self._derived
 
     @property
@@ -89,15 +96,15 @@ class Record:
 
     @property
     def energy(self) -> np.ndarray:
-        return self.derive()["energy"]
+        return self.derive(False)["energy"]
 
     @property
     def ring_distance(self) -> np.ndarray:
-        return self.derive()["ring_distance"]
+        return self.derive(False)["ring_distance"]
 
     @property
     def bushings(self) -> np.ndarray:
-        return self.derive()["bushings"]
+        return self.derive(False)["bushings"]
 
 
 @dataclasses.dataclass
@@ -266,7 +273,12 @@ def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
         watch = OutcomeWatch(dd.capture.distance(dd.capture.GetMyContextFromRoot(root)),
                              sp.jam_time, beside=2.0 * g.R, beyond=g.H)
         sim.set_monitor(monitor)
-        status = sim.AdvanceTo(t_end)
+        try:
+            status = sim.AdvanceTo(t_end)
+        finally:
+            # The monitor refers to the simulator (the step control): a cycle through Drake's
+            # C++ that Python's collector cannot see would keep the run's record alive.
+            sim.clear_monitor()
     wall = _time.perf_counter() - wall0
     rec.sample(root)
     terminated = status.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition

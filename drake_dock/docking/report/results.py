@@ -36,7 +36,10 @@ from drake_dock.systems.contact_system import COUPLE_SLICES
 IN_CONTACT = Mode.SLIDING   # status codes >= IN_CONTACT: in contact (sliding or sticking)
 
 
-def timeseries(result) -> dict:
+def timeseries(result, couples: bool = True) -> dict:
+    """The run's arrays (module docstring); without ``couples`` the per-couple ones are left
+    out (a campaign's row needs none of them) and ``lambda_n_max`` (N,) holds each sample's
+    largest normal force."""
     dd = result.dd
     rec = result.record
     contact = dd.contact
@@ -60,6 +63,21 @@ def timeseries(result) -> dict:
         p_WA[k], R_WA[k] = kin.o[frame_at], kin.R[frame_at]
     bush = rec.bushings[:, 0]
     sx, srpy, sf = bush[:, 0:3], bush[:, 3:6], bush[:, 9:12]
+    energy = np.asarray(rec.energy)
+    energy_names = list(dd.contact.energy_names)
+    common = dict(
+        t=np.asarray(rec.t), body_names=np.array(BODY_NAMES), p_WB=p_WB, R_WB=R_WB, v_WB=v_WB,
+        w_WB=w_WB, apds_names=np.array(APDS_NAMES), p_WA=p_WA, R_WA=R_WA,
+        stewart_x=sx, stewart_rpy=srpy, stewart_force_W=sf,
+        sample_kind=np.asarray(rec.kind, dtype=np.int8),
+        ring_distance=np.asarray(rec.ring_distance), energy=energy,
+        energy_names=np.array(energy_names),
+        impact_t=np.array([imp["t"] for imp in result.impacts], dtype=float),
+        impact_restitution=np.array([imp["restitution"] for imp in result.impacts], dtype=float),
+        thrust_force_W=thrust_forces(result, np.asarray(rec.t), R_WB[:, BODY_NAMES.index(
+            "chaser")]))
+    if not couples:
+        return dict(common, lambda_n_max=rec.derive(False)["lambda_n_max"])
     C = np.asarray(rec.couples)
     S = COUPLE_SLICES
     status = C[:, :, S["status"]][..., 0].astype(np.int8)
@@ -72,23 +90,12 @@ def timeseries(result) -> dict:
         for c, pn, pt in zip(imp["couples"], imp["normal_impulse"], imp["tangential_impulse"]):
             j = names.index(c)
             imp_c[m, j], imp_n[m, j], imp_t[m, j] = True, pn, pt
-    energy = np.asarray(rec.energy)
-    energy_names = list(dd.contact.energy_names)
     return dict(
-        t=np.asarray(rec.t), body_names=np.array(BODY_NAMES), p_WB=p_WB, R_WB=R_WB, v_WB=v_WB,
-        w_WB=w_WB, apds_names=np.array(APDS_NAMES), p_WA=p_WA, R_WA=R_WA,
-        couple_names=np.array(names), status=status, active=status >= Mode.TRACKED,
+        common, couple_names=np.array(names), status=status, active=status >= Mode.TRACKED,
         gap=C[:, :, S["gap"]][..., 0], lambda_n=C[:, :, S["lambda_n"]][..., 0],
         lambda_t=C[:, :, S["lambda_t"]], u=C[:, :, S["u"]], p1_W=C[:, :, S["p1"]],
         p2_W=C[:, :, S["p2"]], frame_W=C[:, :, S["frame"]].reshape(N, -1, 3, 3),
-        stewart_x=sx, stewart_rpy=srpy, stewart_force_W=sf, sample_kind=np.asarray(rec.kind, dtype=np.int8),
-        ring_distance=np.asarray(rec.ring_distance), energy=energy,
-        energy_names=np.array(energy_names),
-        impact_t=np.array([imp["t"] for imp in result.impacts], dtype=float),
-        impact_couples=imp_c, impact_normal_impulse=imp_n, impact_tangential_impulse=imp_t,
-        impact_restitution=np.array([imp["restitution"] for imp in result.impacts], dtype=float),
-        thrust_force_W=thrust_forces(result, np.asarray(rec.t), R_WB[:, BODY_NAMES.index(
-            "chaser")]))
+        impact_couples=imp_c, impact_normal_impulse=imp_n, impact_tangential_impulse=imp_t)
 
 
 def first_contact_time(result) -> float:
@@ -181,7 +188,7 @@ def momentum_reference_point(scenario, ts) -> np.ndarray:
     return ts["p_WA"][0, 0] + scenario.geometry.R * ts["R_WA"][0, 0][:, 0]
 
 
-def _relative(value, scale):
+def relative(value, scale):
     """value / scale; None (null in summary.json) when the scale is zero (a chaser so slow
     that its kinetic energy underflows): the ratio is undefined, not NaN."""
     return float(value / scale) if scale > 0 else None
@@ -240,7 +247,7 @@ def energy_ledger(ts: dict, masses=None) -> dict:
                 "stewart_potential_J": float(pe[-1]), "dissipated_damper_J": float(damper[-1]),
                 "dissipated_friction_J": float(friction[-1]),
                 "dissipated_impacts_J": float(impacts[-1]), "input_work_J": float(inputs[-1]),
-                "closure_error_relative": _relative(np.abs(residual).max(), abs(total0))})
+                "closure_error_relative": relative(np.abs(residual).max(), abs(total0))})
     return out
 
 
@@ -340,8 +347,8 @@ def summary(result, ts: dict) -> dict:
         "impact_times_s": ts["impact_t"].tolist(),
         "largest_impulse_Ns": float(imp.max()) if imp.size else 0.0,
         "momentum_drift_relative": {
-            "linear": _relative(np.linalg.norm(P - P[0] - J, axis=1).max(), sP),
-            "angular": _relative(np.linalg.norm(L - L[0] - H, axis=1).max(), sL)},
+            "linear": relative(np.linalg.norm(P - P[0] - J, axis=1).max(), sP),
+            "angular": relative(np.linalg.norm(L - L[0] - H, axis=1).max(), sL)},
         "end_state": {
             "holding_couples": [dataclasses.asdict(h) for h in result.holding],
             "relative_kinetic_energy_J": (None if math.isnan(result.relative_kinetic_energy)
