@@ -1,4 +1,4 @@
-"""The floors the bench scripts print (`target_floor.py`, `paper_example.py`,
+"""The floors the bench scripts print (`target_floor.py`, `paper_example.py`, `evaluation.py`,
 `offnominal.py`): the same plant integrated by Drake without contact, and the least a
 Python LeafSystem costs per derivative evaluation in Drake's simulator."""
 import time

@@ -1,5 +1,4 @@
-"""The off-nominal conditions of the conditions sweep, drake_dock side by side with Drake's own
-plant, measured in one run.
+"""The conditions sweep's first conditions, drake_dock against the plant alone, in one run.
 
 For the first ``--runs`` random conditions of `drake-dock study conditions` (its seed, order and
 contact set; the paper example's scenario unless one is given), prints per run drake_dock's

@@ -2,7 +2,7 @@
 approach, the consistent aim with a lateral velocity, and the independent check of the path
 down to it) costs: the paper example, and the first ``--conditions`` conditions of
 `drake-dock study conditions` (seed 2026, inside the IDSS box; 75 for all but the first), with
-the contact set ``--pairs`` (`complete`, or `paper` as the IDSS campaign plan). Per placement
+the contact set ``--pairs`` (`complete`, as the IDSS envelope plan, or `paper`). Per placement
 (on a fresh `PlacementCache` of the scenario's scene) it prints the wall time, the
 first-contact searches it ran (those its cache served not counted; those of a bracket among
 some pairs, and those stopped at a height, `_among_height`, also apart) and their time, and

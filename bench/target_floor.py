@@ -2,7 +2,8 @@
 
 For each metric: the fastest coarse compliant configuration (point contact, SAP at the coarse
 steps a Drake user tries first) within the tolerance of the rigid reference, the drake_dock
-wall time 10x would need, and that time against two floors measured here:
+wall time 10x would need, and that time against drake_dock's run and a floor, both measured
+here:
 
 - drake_dock's fastest run within the tolerance (accuracy 1e-3, step cap 0.01 s; median of
   ``--repeats`` identical runs) and its derivative evaluations;
@@ -14,7 +15,7 @@ wall time 10x would need, and that time against two floors measured here:
 Errors are relative to each metric's contact effect, as in the study
 (`drake_dock.studies.docking_metrics`).
 
-    python bench/target_floor.py [--repeats 5]
+    python bench/target_floor.py [--repeats 5] [--tolerance 1e-3]
 """
 import argparse
 import copy
