@@ -13,10 +13,10 @@ from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import (DriftError, InputError, PainleveInconsistency, SeekingError,
                                SingularCoupleError)
-from drake_dock.systems import handovers, impacts
+from drake_dock.systems import handover_links, impacts
 from drake_dock.systems.contact_types import copied_states
 from drake_dock.systems.evaluation import Kinematics
-from drake_dock.systems.handovers import applied
+from drake_dock.systems.handover_links import applied
 
 
 def _reseek(p, c, margin, R2, conditioning_min) -> bool:
@@ -124,7 +124,7 @@ class Transitions:
             c = couples[i]
             u[ev.couple_slice(i)] = c.u
             to = ev.links.target(i, c.u, c.n, poses[ev.fidx[i][1]][0], states)
-            if to is not None and handovers.accepts(ev, i, to, c.n, kin):
+            if to is not None and handover_links.accepts(ev, i, to, c.n, kin):
                 due[i] = to
         handed = applied(due)
         for j, i in handed.items():
@@ -304,7 +304,7 @@ class Transitions:
                 st.track()
         rows = [eng.row(i, evs[i], kin) for i in cand]
         M, Minv, a0 = eng.dynamics(q, v, inputs)[:3]
-        select = compiled_constraints.select_modes
+        select = compiled_constraints.select_contact_modes
         avoid = [() if hit else leaving.get(i, ()) for i in cand]
         try:
             sol = select(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,

@@ -29,7 +29,7 @@ from drake_dock.docking.model.outcome import misalignment
 from drake_dock.docking.model.plant import APDS_NAMES, BODY_NAMES
 from drake_dock.docking.model.simulate import PRE_IMPACT
 from drake_dock.docking.model.thrust import ThrustSchedule
-from drake_dock.docking.report.loads import peak_loads
+from drake_dock.docking.report.interface_loads import peak_loads
 from drake_dock.docking.scenario.loading import scenario_dict
 from drake_dock.systems.contact_system import COUPLE_SLICES
 
@@ -317,10 +317,11 @@ def non_finite_key(node, path=""):
 
 def summary(result, ts: dict) -> dict:
     """The numbers of a run for a docking engineer (summary.json): the outcome and its reason,
-    capture, the final misalignment, the peak loads (`drake_dock.docking.report.loads.peak_loads`),
-    the relative kinetic energy at contact, the energy ledger, the impacts, the momentum drift,
-    the first contact and the couples that came near (`couples_table`). The solver's cost is
-    apart (`drake_dock.docking.report.cost.run_cost`)."""
+    capture, the final misalignment, the peak loads
+    (`drake_dock.docking.report.interface_loads.peak_loads`), the relative kinetic energy at
+    contact, the energy ledger, the impacts, the momentum drift, the first contact and the
+    couples that came near (`couples_table`). The solver's cost is apart
+    (`drake_dock.docking.report.cost.run_cost`)."""
     s = result.scenario
     b = s.bodies
     params = [getattr(b, n) for n in ts["body_names"]]
