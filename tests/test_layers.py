@@ -171,6 +171,24 @@ def test_no_two_modules_are_inflections_of_one_name():
     assert not clashes, clashes
 
 
+def test_an_impact_is_made_in_one_place_and_no_caller_writes_a_system_s_private_fields():
+    """`Impact` records are constructed only in systems/impacts.py; no module reaches into
+    another object's private attributes of the contact system's state (``x._mode_index`` for
+    an ``x`` other than ``self``)."""
+    made, reached = [], []
+    for name, path in _modules().items():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call):
+                f = node.func
+                called = f.id if isinstance(f, ast.Name) else getattr(f, "attr", None)
+                if called == "Impact" and name != "drake_dock.systems.impacts":
+                    made.append(name)
+            if isinstance(node, ast.Attribute) and node.attr == "_mode_index" and not (
+                    isinstance(node.value, ast.Name) and node.value.id == "self"):
+                reached.append(name)
+    assert not made and not reached, (made, reached)
+
+
 def _reachable(start_files):
     """Every module (internal or external top-level name) reachable from the files' imports."""
     mods = _modules()

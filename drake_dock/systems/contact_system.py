@@ -274,7 +274,7 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     def _out_first_contact(self, context, out):
         """The time of the first impact (s; every contact starts with one), +inf before it."""
         impacts = self.get_modes(context).impacts
-        out.SetFromVector([impacts[0]["t"] if impacts else math.inf])
+        out.SetFromVector([impacts[0].t if impacts else math.inf])
 
     def _out_couple(self, context, out, i):
         out.SetFromVector(self.couple_table(context)[i])

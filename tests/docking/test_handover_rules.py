@@ -96,4 +96,4 @@ def test_the_complete_set_shifts_the_paper_example_by_its_first_contact(scenario
     assert r.outcome == ref.outcome == "captured" and len(r.impacts) == len(ref.impacts) > 0
     assert abs(r.capture_time - ref.capture_time - shift) <= 1e-6
     for a, b in zip(r.impacts, ref.impacts):
-        assert a["couples"] == b["couples"] and abs(a["t"] - b["t"] - shift) <= 1e-6
+        assert a.couples == b.couples and abs(a.t - b.t - shift) <= 1e-6

@@ -72,8 +72,8 @@ def timeseries(result, couples: bool = True) -> dict:
         sample_kind=np.asarray(rec.kind, dtype=np.int8),
         ring_distance=np.asarray(rec.ring_distance), energy=energy,
         energy_names=np.array(energy_names),
-        impact_t=np.array([imp["t"] for imp in result.impacts], dtype=float),
-        impact_restitution=np.array([imp["restitution"] for imp in result.impacts], dtype=float),
+        impact_t=np.array([imp.t for imp in result.impacts], dtype=float),
+        impact_restitution=np.array([imp.restitution for imp in result.impacts], dtype=float),
         thrust_force_W=thrust_forces(result, np.asarray(rec.t), R_WB[:, BODY_NAMES.index(
             "chaser")]))
     if not couples:
@@ -87,7 +87,7 @@ def timeseries(result, couples: bool = True) -> dict:
     imp_n = np.zeros((M, len(names)))
     imp_t = np.zeros((M, len(names), 2))
     for m, imp in enumerate(result.impacts):
-        for c, pn, pt in zip(imp["couples"], imp["normal_impulse"], imp["tangential_impulse"]):
+        for c, pn, pt in zip(imp.couples, imp.normal_impulse, imp.tangential_impulse):
             j = names.index(c)
             imp_c[m, j], imp_n[m, j], imp_t[m, j] = True, pn, pt
     return dict(
@@ -100,7 +100,7 @@ def timeseries(result, couples: bool = True) -> dict:
 
 def first_contact_time(result) -> float:
     """The time of the run's first impact (s; every contact starts with one), inf without."""
-    return float(result.impacts[0]["t"]) if result.impacts else math.inf
+    return float(result.impacts[0].t) if result.impacts else math.inf
 
 
 def thrust_forces(result, t, R_WC) -> np.ndarray:
