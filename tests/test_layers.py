@@ -1,7 +1,8 @@
 """The package's shape, read from its source with `ast` (nothing is imported): layers, and the
 wings of `drake_dock.docking`, import only downwards; no import circles; no private name imported
-across modules; no module over 500 lines, no class over 300 lines; module names unique; a wing's
-package only a docstring; tests/core reaches no Drake module through any chain of imports."""
+across modules; no module over 500 lines, no class over 300 lines; module names unique, and none
+an inflection of another; a wing's package only a docstring; tests/core reaches no Drake module
+through any chain of imports."""
 import ast
 from pathlib import Path
 
@@ -141,6 +142,51 @@ def test_module_names_are_unique():
     twice = {n: p for n, p in seen.items() if len(p) > 1 and not all(
         q.split("/")[0] in ("core", "systems") for q in p)}
     assert not twice, twice
+
+
+def _stem(name: str) -> str:
+    """A module name without its inflection: "handovers" and "handover", "tracking" and
+    "tracked", "loads" and "loading" share a stem."""
+    for suffix in ("ing", "ed", "s"):
+        if name.endswith(suffix) and len(name) - len(suffix) >= 4:
+            return name[:-len(suffix)]
+    return name
+
+
+# A compiled kernel and the pure-Python reference it compiles: one thing twice, by design.
+KERNEL_TWINS = [{"core/couple.py", "core/kernels/couples.py"},
+                {"core/covers.py", "core/kernels/cover.py"},
+                {"core/seeking.py", "core/kernels/seek.py"}]
+
+
+def test_no_two_modules_are_inflections_of_one_name():
+    """Two modules whose names differ only by an inflection (a plural, "-ing", "-ed") say the
+    same thing for different contents, wherever they are; the kernel twins apart."""
+    by_stem = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if path.name not in ("__init__.py", "__main__.py"):
+            by_stem.setdefault(_stem(path.stem), set()).add(str(path.relative_to(PACKAGE)))
+    clashes = [sorted(paths) for paths in by_stem.values()
+               if len({Path(p).stem for p in paths}) > 1 and paths not in KERNEL_TWINS]
+    assert not clashes, clashes
+
+
+def test_an_impact_is_made_in_one_place_and_no_caller_writes_a_system_s_private_fields():
+    """`Impact` records are constructed only in systems/impacts.py; no module reaches into
+    another object's private attributes of the contact system's state (``x._mode_index`` for
+    an ``x`` other than ``self``)."""
+    made, reached = [], []
+    for name, path in _modules().items():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call):
+                f = node.func
+                called = f.id if isinstance(f, ast.Name) else getattr(f, "attr", None)
+                if called == "Impact" and name != "drake_dock.systems.impacts":
+                    made.append(name)
+            if isinstance(node, ast.Attribute) and node.attr == "_mode_index" and not (
+                    isinstance(node.value, ast.Name) and node.value.id == "self"):
+                reached.append(name)
+    assert not made and not reached, (made, reached)
 
 
 def _reachable(start_files):

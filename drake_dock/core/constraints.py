@@ -24,7 +24,7 @@ both modes fail: a couple whose gap has drifted open by g as it unloads (at omeg
 drift of 1e-8 m opens 4e-6 m/s^2, past ``TIE_RTOL`` of the 1 m/s^2 floor). Once detached, its
 drift is watched by its gap witness.
 
-`select_modes` enumerates the modes of the contact set (3^k choices, k <= 8) and keeps the
+`select_contact_modes` enumerates the modes of the contact set (3^k choices, k <= 8) and keeps the
 consistent ones, within ``rtol`` of the force and acceleration scales (each with a floor of
 1 N and 1 m/s^2). At a transition round-off can leave every mode just outside ``rtol``: then the
 modes consistent within ``TIE_RTOL`` (1e-6) of those scales are taken, with the same
@@ -350,7 +350,8 @@ def _consistent(sol, rows, omega, tol_f, tol_a):
     return True
 
 
-def select_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9, avoid=None):
+def select_contact_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9,
+                         avoid=None):
     """One consistent choice of modes for the contact set (see the module docstring).
 
     A couple whose sliding speed exceeds ``v_slip`` slides in its direction of motion (or

@@ -31,7 +31,7 @@ class Mode(enum.IntEnum):
 
     @classmethod
     def of_selection(cls, m: str) -> Mode:
-        """The pair's mode for the mode `select_modes` chose for its couple."""
+        """The pair's mode for the mode `select_contact_modes` chose for its couple."""
         return {DETACH: cls.TRACKED, SLIDE: cls.SLIDING, STICK: cls.STICKING}[m]
 
 
@@ -121,8 +121,9 @@ def closed_after_impact(vn_plus, approach: float) -> list[bool]:
 
 
 def contact_candidates(modes, gap, vn, hit: bool, closed, gap_tol: float, v_slip: float):
-    """The new modes and the candidates of the contact set (sorted), whose modes `select_modes`
-    then chooses (ties within its TIE_RTOL resolved against the modes being left).
+    """The new modes and the candidates of the contact set (sorted), whose modes
+    `select_contact_modes` then chooses (ties within its TIE_RTOL resolved against the modes
+    being left).
 
     Rule: after an impact (``hit``) a couple in contact that is not in ``closed`` (the couples
     closed at its end) is TRACKED again; the candidates are ``closed``, the couples still in

@@ -22,13 +22,13 @@ the smaller step keeps the number of steps per contact oscillation (whose period
 Per condition: both outcomes and their reasons, both capture times (and the refined run's), both
 peak interface forces and the wall times (each run's build, simulation and measures). The peak
 interface force is the largest \\|net contact force on the target APDS\\| over the run: rigid
-from the couples' forces (`drake_dock.docking.report.loads.interface_loads`; impulses excluded),
-compliant from the chaser's momentum change over each step less the thrust (contact acts only
-between the chaser and the target APDS). A compliant impact's force peak grows with the square
-root of the stiffness and a rigid one has none, so the two are also compared as the peak mean
-over ``window`` seconds: the chaser's contact impulse over a window (its momentum change less
-the thrust's impulse, impacts included), divided by the window, the largest over windows that
-start or end at a sample.
+from the couples' forces (`drake_dock.docking.report.interface_loads.interface_loads`; impulses
+excluded), compliant from the chaser's momentum change over each step less the thrust (contact
+acts only between the chaser and the target APDS). A compliant impact's force peak grows with
+the square root of the stiffness and a rigid one has none, so the two are also compared as the
+peak mean over ``window`` seconds: the chaser's contact impulse over a window (its momentum
+change less the thrust's impulse, impacts included), divided by the window, the largest over
+windows that start or end at a sample.
 
 How each run came to the capture box (`approach`): the first time it came within
 ``near_margin`` of it (the distance to capture, `CaptureRule.to_go`, within the margin of the
@@ -56,7 +56,7 @@ import numpy as np
 from drake_dock.docking.model.outcome import CaptureRule, misalignment
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import place
-from drake_dock.docking.report.loads import interface_loads
+from drake_dock.docking.report.interface_loads import interface_loads
 from drake_dock.docking.report.out_dir import atomic_directory
 from drake_dock.docking.report.results import thrust_impulses, timeseries
 from drake_dock.errors import DrakeDockError, InputError

@@ -207,7 +207,7 @@ def grazing_case(deltas, *, v0=0.1, vx=0.5, e=0.5, log=print) -> dict:
         vz_cf = (e_used * va + G * (T - t_cf)) if delta < 0 else (-v0 + G * T)
         gaps = np.array([s[1] for s in run.samples])
         rows.append(dict(delta=delta, impacts=len(imp),
-                         impact_time=imp[0]["t"] if imp else None, closed_form_time=t_cf,
+                         impact_time=imp[0].t if imp else None, closed_form_time=t_cf,
                          approach_speed=va, vz_end=float(x[12]), vz_closed_form=vz_cf,
                          min_gap=float(gaps.min()), t=[s[0] for s in run.samples],
                          gap=gaps.tolist()))
@@ -235,7 +235,7 @@ def zeno_case(zeno_speeds, *, h=0.05, e=0.5, max_impacts_off=10, log=print) -> d
         imp = run.impacts
         c = run.couple("rim_plane")
         rows.append(dict(zeno_speed=zs, impacts=len(imp), closed_form_impacts=n_cf,
-                         last_impact=imp[-1]["t"], closed_form_last_impact=t_last,
+                         last_impact=imp[-1].t, closed_form_last_impact=t_last,
                          resting_lambda_n=float(c["lambda_n"]), weight=sc.params["mass"] * G,
                          evaluations=sc.system.evaluations - n0,
                          wall_time=_time.perf_counter() - w0,

@@ -33,7 +33,7 @@ decided by a function of `drake_dock.core.hybrid`:
   persistent contact after finitely many impacts. Couples closed at the end of an impact enter
   the contact set; the others, and the couples in contact left out of the impact, are TRACKED.
 - lambda_n reaches zero, the sliding velocity reaches zero or reverses, the sticking force
-  reaches the static cone: the modes of the contact set are selected again (`select_modes`).
+  reaches the static cone: the modes of the contact set are selected again (`select_contact_modes`).
 - a couple reaches a declared edge of its surface, or an edge couple's hand-over guard
   reaches zero (its curve passes over the surface): the couple is handed to the linked pair
   with its mode (`Handover`, `drake_dock.core.handover`; docs/model.md, "Hand-over between an
@@ -74,9 +74,9 @@ from drake_dock.systems.contact_types import (COUPLE_FIELDS, COUPLE_OUTPUT_SIZE,
 from drake_dock.systems.engine import Engine, frame_list
 from drake_dock.systems.evaluation import Evaluation
 from drake_dock.systems.far_pairs import FarPairs
-from drake_dock.systems.handovers import HandoverLinks
+from drake_dock.systems.handover_links import HandoverLinks
 from drake_dock.systems.memo import Memo
-from drake_dock.systems.outputs import CoupleRows
+from drake_dock.systems.couple_ports import CoupleRows
 from drake_dock.systems.profiling import Timing
 from drake_dock.systems.reseek import reseek_far
 from drake_dock.systems.transitions import Transitions
@@ -245,7 +245,7 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     @staticmethod
     def first_contact_time(modes) -> float:
         """The time of the first impact (s; every contact starts with one), +inf before it."""
-        return modes.impacts[0]["t"] if modes.impacts else math.inf
+        return modes.impacts[0].t if modes.impacts else math.inf
 
     def _calc_eval(self, context, value):
         t, modes = context.get_time(), self.get_modes(context)

@@ -149,7 +149,7 @@ class ContactModes:
     sealed (`seal`): then nothing of them changes, and a change raises."""
 
     pairs: list                     # a tuple once sealed
-    impacts: list = dataclasses.field(default_factory=list)   # dicts: t, couples, impulses
+    impacts: list = dataclasses.field(default_factory=list)   # `impacts.Impact`s, in order
     impact_loss: float = 0.0
     mode_changes: int = 0           # events that resolved transitions
     reseeks: int = 0                # steps whose start sought far pairs again, nothing else

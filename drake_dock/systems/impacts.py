@@ -1,10 +1,11 @@
-"""The impulsive transitions of a contact set, logged in its `ContactModes`: the LZB impact of
-the couples hit (Sect. 6, with the Zeno guard) and the impact without collision at a Painleve
-paradox (`drake_dock.core.iwc`). ``ev`` is the `RigidContactSystem`. Each entry of the log holds
-v_plus, the velocity just after its impulse, and impact_loss_plus, the impact loss booked by
-then (`Transitions.resolve` turns them into the states just before and after it)."""
+"""The impulsive transitions of a contact set and their log: the LZB impact of the couples hit
+(Sect. 6, with the Zeno guard) and the impact without collision at a Painleve paradox
+(`drake_dock.core.iwc`). ``ev`` is the `RigidContactSystem`. An event solves its impulses in
+turn (`EventImpulses`) and logs each, at its end, as an `Impact` in its `ContactModes`: the
+only place an `Impact` is made, with the states just before and after it."""
 from __future__ import annotations
 
+import dataclasses
 import os
 
 import numpy as np
@@ -13,95 +14,158 @@ from drake_dock.core import hybrid
 from drake_dock.core.iwc import impact_without_collision
 from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.errors import NumericalError, PainleveInconsistency, ZenoError
-from drake_dock.systems.contact_types import copied_states
+from drake_dock.systems.contact_types import ContactModes, copied_states
 
 
-def admit(ev, t, modes, couples):
-    """The Zeno guard's last resort: an impulse of the couples named (an LZB impact or an
-    impact without collision) beyond ``max_impacts`` logged raises `ZenoError`."""
-    if len(modes.impacts) >= ev.options.max_impacts:
-        raise ZenoError(f"more than max_impacts = {ev.options.max_impacts} impacts", time=t,
-                        couples=couples)
+@dataclasses.dataclass(frozen=True)
+class Impact:
+    """One impulse of the contact set, as logged: at time ``t`` on the couples named, with the
+    restitution used (0 for an impact without collision), the couples' normal and tangential
+    impulses (in their order) and the kinetic energy it removed. ``x_minus`` and ``x_plus``
+    are the contact system's state just before and just after it, ``pairs_plus`` the pair
+    states it left and ``impact_loss_plus`` the impact loss booked by then. Never changed once
+    logged."""
+
+    t: float
+    couples: list
+    restitution: float
+    normal_impulse: list
+    tangential_impulse: list
+    energy_lost: float
+    without_collision: bool
+    x_minus: np.ndarray
+    x_plus: np.ndarray
+    pairs_plus: tuple
+    impact_loss_plus: float
+
+    def modes_after(self, mode_changes: int) -> ContactModes:
+        """The sealed modes just after the impulse, ``mode_changes`` the events resolved by
+        then, with no impact logged (a logger's sample, not a state to go on from)."""
+        return ContactModes(copied_states(self.pairs_plus), [], self.impact_loss_plus,
+                            mode_changes).seal()
 
 
-def lzb_impact(ev, t, modes, kin, evs, S, v):
-    """The LZB impact of the couples S (their couples in evs, the bodies' `Kinematics` kin),
-    logged in ``modes`` (`admit`); returns (v+, the couples' v_n+, the approach speed)."""
-    opt, law = ev.options, ev.law
-    names = [ev.pairs[i].name for i in S]
-    admit(ev, t, modes, names)
-    rows = [ev.engine.row(i, evs[i], kin) for i in S]
-    Wn = np.column_stack([r.Wn for r in rows])
-    Wt = np.column_stack([r.Wt for r in rows])
-    M = ev.engine.mass_matrix(kin)
-    approach = float(-min(r.vn for r in rows))
-    e = hybrid.zeno_restitution(approach, law.restitution, opt.zeno_speed)
-    def solve(compiled):
-        return solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt, mu=law.mu,
-                         mu_s=law.static_mu, law=law.impact_law, rtol=opt.impact_rtol,
-                         compiled=compiled)
-    try:
+def enter_after(system, context, impact: Impact, mode_changes: int):
+    """Puts the contact system ``system``'s ``context`` (a logger's scratch context) in the
+    state just after ``impact``: its ``x_plus`` and `Impact.modes_after`."""
+    context.SetContinuousState(impact.x_plus)
+    system.set_modes(context, impact.modes_after(mode_changes))
+
+
+@dataclasses.dataclass
+class _Impulse:
+    """An impulse solved by an event, before the event's end gives its state after."""
+    couples: list
+    restitution: float
+    normal_impulse: list
+    tangential_impulse: list
+    energy_lost: float
+    without_collision: bool
+    v_plus: np.ndarray
+    impact_loss_plus: float
+    pairs_plus: tuple | None = None
+
+
+class EventImpulses:
+    """The impulses of one event at time t on the working `ContactModes` ``modes`` of the
+    `RigidContactSystem` ``ev``: solved in turn (`lzb_impact`, `without_collision`), then
+    logged as `Impact`s (`log`)."""
+
+    def __init__(self, ev, t, modes):
+        self.ev, self.t, self.modes = ev, t, modes
+        self.solved: list[_Impulse] = []
+
+    def admit(self, couples):
+        """The Zeno guard's last resort: an impulse of the couples named (an LZB impact or an
+        impact without collision) beyond ``max_impacts`` logged or solved raises `ZenoError`."""
+        n, most = len(self.modes.impacts) + len(self.solved), self.ev.options.max_impacts
+        if n >= most:
+            raise ZenoError(f"more than max_impacts = {most} impacts", time=self.t,
+                            couples=couples)
+
+    def _add(self, couples, restitution, P_n, P_t, lost, without_collision, v_plus):
+        """Books a solved impulse and its energy lost."""
+        self.modes.impact_loss += lost
+        self.solved.append(_Impulse(couples, restitution, P_n.tolist(), P_t.tolist(), lost,
+                                    without_collision, v_plus.copy(), self.modes.impact_loss))
+
+    def left(self, states):
+        """The pair states the last impulse left (before the modes are selected again)."""
+        self.solved[-1].pairs_plus = tuple(copied_states(states))
+
+    def lzb_impact(self, kin, evs, S, v):
+        """The LZB impact of the couples S (their couples in evs, the bodies' `Kinematics`
+        kin; `admit`), solved by `solve_lzb` (compiled, then by the reference where the
+        compiled driver's steps stall); returns (v+, the couples' v_n+, the approach speed)."""
+        ev, t = self.ev, self.t
+        opt, law = ev.options, ev.law
+        names = [ev.pairs[i].name for i in S]
+        self.admit(names)
+        rows = [ev.engine.row(i, evs[i], kin) for i in S]
+        Wn = np.column_stack([r.Wn for r in rows])
+        Wt = np.column_stack([r.Wt for r in rows])
+        M = ev.engine.mass_matrix(kin)
+        approach = float(-min(r.vn for r in rows))
+        e = hybrid.zeno_restitution(approach, law.restitution, opt.zeno_speed)
+        def solve(compiled):
+            return solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt, mu=law.mu,
+                             mu_s=law.static_mu, law=law.impact_law, rtol=opt.impact_rtol,
+                             compiled=compiled)
         try:
-            res = solve(opt.lzb_compiled)
-        except NumericalError:
-            if not opt.lzb_compiled:
-                raise
-            # The compiled driver's steps can stall where the reference's DOP853 steps over
-            # (two couples that stick and slip in turn): the impact is solved again by it.
-            res = solve(False)
-    except NumericalError as err:
-        if os.environ.get("DRAKE_DOCK_DUMP_LZB"):
-            np.savez(os.environ["DRAKE_DOCK_DUMP_LZB"], M=M, Wn=Wn, Wt=Wt, v=v, e=e)
-        raise NumericalError(f"{err} (approach speed {approach:.3e} m/s)", time=t,
-                             couples=names) from None
-    lost = res.kinetic_energy_minus - res.kinetic_energy_plus
-    modes.impact_loss += lost
-    modes.impacts.append({"t": t, "couples": names, "restitution": e,
-                          "normal_impulse": res.normal_impulse.tolist(),
-                          "tangential_impulse": res.tangential_impulse.tolist(),
-                          "energy_lost": lost, "v_plus": res.v_plus.copy(),
-                          "impact_loss_plus": modes.impact_loss})
-    return res.v_plus, Wn.T @ res.v_plus, approach
+            try:
+                res = solve(opt.lzb_compiled)
+            except NumericalError:
+                if not opt.lzb_compiled:
+                    raise
+                # The compiled driver's steps can stall where the reference's DOP853 steps over
+                # (two couples that stick and slip in turn): the impact is solved again by it.
+                res = solve(False)
+        except NumericalError as err:
+            if os.environ.get("DRAKE_DOCK_DUMP_LZB"):
+                np.savez(os.environ["DRAKE_DOCK_DUMP_LZB"], M=M, Wn=Wn, Wt=Wt, v=v, e=e)
+            raise NumericalError(f"{err} (approach speed {approach:.3e} m/s)", time=t,
+                                 couples=names) from None
+        self._add(names, e, res.normal_impulse, res.tangential_impulse,
+                  res.kinetic_energy_minus - res.kinetic_energy_plus, False, res.v_plus)
+        return res.v_plus, Wn.T @ res.v_plus, approach
 
+    def without_collision(self, M, rows, v, paradox):
+        """The impact without collision of the contact set ``rows`` (`ContactRow`s) at the
+        Painleve paradox ``paradox`` (`drake_dock.core.iwc`; restitution 0, `admit`); returns
+        v+. Raises the paradox, with the reason, when no sticking impulse is admissible."""
+        ev = self.ev
+        self.admit([r.name for r in rows])
+        Wn = np.column_stack([r.Wn for r in rows])
+        Wt = np.column_stack([r.Wt for r in rows])
+        res = impact_without_collision(M, Wn, Wt, v, ev.law.static_mu)
+        if res is None:
+            raise PainleveInconsistency(
+                "no consistent contact mode (Painleve inconsistency), and the impact without "
+                "collision has no sticking impulse (a couple would pull or leave the friction "
+                "cone)", time=self.t, couples=paradox.couples) from None
+        self._add([r.name for r in rows], 0.0, res.P_n, res.P_t, res.energy_lost, True,
+                  res.v_plus)
+        return res.v_plus
 
-def without_collision(ev, t, modes, M, rows, v, paradox):
-    """The impact without collision of the contact set ``rows`` (`ContactRow`s) at the
-    Painleve paradox ``paradox`` (`drake_dock.core.iwc`), logged in ``modes`` like an impact
-    (marked ``without_collision``, restitution 0; `admit`); returns v+. Raises the paradox,
-    with the reason, when no sticking impulse is admissible."""
-    admit(ev, t, modes, [r.name for r in rows])
-    Wn = np.column_stack([r.Wn for r in rows])
-    Wt = np.column_stack([r.Wt for r in rows])
-    res = impact_without_collision(M, Wn, Wt, v, ev.law.static_mu)
-    if res is None:
-        raise PainleveInconsistency(
-            "no consistent contact mode (Painleve inconsistency), and the impact without "
-            "collision has no sticking impulse (a couple would pull or leave the friction "
-            "cone)", time=t, couples=paradox.couples) from None
-    modes.impact_loss += res.energy_lost
-    modes.impacts.append({"t": t, "couples": [r.name for r in rows], "without_collision": True,
-                          "restitution": 0.0, "normal_impulse": res.P_n.tolist(),
-                          "tangential_impulse": res.P_t.tolist(),
-                          "energy_lost": res.energy_lost, "v_plus": res.v_plus.copy(),
-                          "impact_loss_plus": modes.impact_loss})
-    return res.v_plus
-
-
-def states_around(ev, modes, n, x, x_new):
-    """The states just before and just after each impulse logged in ``modes`` from entry n on
-    by the event that took state x to x_new, for loggers (a step-end sample is the state
-    before the event; its result is not seen by any step end): x_minus, x_plus, pairs_plus
-    and impact_loss_plus. An event can log two (an LZB impact, then an impact without
-    collision where the modes after it have no consistent one): the first one's x_plus is the
-    second's x_minus, with its pairs as the impact left them (before the modes were
-    selected); the last one's is the event's result."""
-    new = modes.impacts[n:]
-    for j, imp in enumerate(new):
-        x_plus = x_new.copy()
-        if j < len(new) - 1:
-            x_plus[ev.nq:ev.nq + ev.nv] = imp["v_plus"]
-        else:
-            imp.update(pairs_plus=copied_states(modes.pairs),
-                       impact_loss_plus=modes.impact_loss)
-        del imp["v_plus"]
-        imp.update(x_minus=x.copy() if j == 0 else new[j - 1]["x_plus"], x_plus=x_plus)
+    def log(self, x, x_new):
+        """Logs each impulse as an `Impact` with the states just before and just after it, the
+        event having taken state x to x_new (a step-end sample is the state before the event;
+        its result is not seen by any step end). An event can solve two (an LZB impact, then
+        an impact without collision where the modes after it have no consistent one): the
+        first one's x_plus is the second's x_minus, with its pairs as the impact left them
+        (`left`, before the modes were selected); the last one's is the event's result."""
+        ev, modes = self.ev, self.modes
+        x_minus = x.copy()
+        for j, imp in enumerate(self.solved):
+            x_plus = x_new.copy()
+            if j < len(self.solved) - 1:
+                x_plus[ev.nq:ev.nq + ev.nv] = imp.v_plus
+                pairs, loss = imp.pairs_plus, imp.impact_loss_plus
+            else:
+                pairs, loss = tuple(copied_states(modes.pairs)), modes.impact_loss
+            modes.impacts.append(Impact(
+                self.t, imp.couples, imp.restitution, imp.normal_impulse,
+                imp.tangential_impulse, imp.energy_lost, imp.without_collision, x_minus, x_plus,
+                pairs, loss))
+            x_minus = x_plus
+        self.solved = []

@@ -13,10 +13,9 @@ from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import (DriftError, InputError, PainleveInconsistency, SeekingError,
                                SingularCoupleError)
-from drake_dock.systems import handovers, impacts
-from drake_dock.systems.contact_types import copied_states
+from drake_dock.systems import handover_links, impacts
 from drake_dock.systems.evaluation import Kinematics
-from drake_dock.systems.handovers import applied
+from drake_dock.systems.handover_links import applied
 
 
 def _reseek(p, c, margin, R2, conditioning_min) -> bool:
@@ -103,13 +102,13 @@ class Transitions:
         for i, after in sought:
             self.carry(i, after, modes.pairs)
         # 2. Impacts and 3. modes.
-        n_impacts = len(modes.impacts)
+        impulses = impacts.EventImpulses(ev, t, modes)
         with self.timing.measure("impacts"):
-            v = self.impacts_and_modes(t, modes, q, v, u, inputs, current, handed)
+            v = self.impacts_and_modes(t, modes, impulses, q, v, u, inputs, current, handed)
         x_new = x.copy()
         x_new[ev.nq:ev.nq + ev.nv] = v
         x_new[ev.nq + ev.nv:ev.ie] = u
-        impacts.states_around(ev, modes, n_impacts, x, x_new)
+        impulses.log(x, x_new)
         return x_new, modes.seal()
 
     def _handovers(self, states, kin, u, t) -> tuple[dict, dict]:
@@ -124,7 +123,7 @@ class Transitions:
             c = couples[i]
             u[ev.couple_slice(i)] = c.u
             to = ev.links.target(i, c.u, c.n, poses[ev.fidx[i][1]][0], states)
-            if to is not None and handovers.accepts(ev, i, to, c.n, kin):
+            if to is not None and handover_links.accepts(ev, i, to, c.n, kin):
                 due[i] = to
         handed = applied(due)
         for j, i in handed.items():
@@ -253,9 +252,10 @@ class Transitions:
         st.mode, st.slide_dir = mode, None
         return c.distance, crossing, was_contact, due
 
-    def impacts_and_modes(self, t, modes, q, v, u, inputs, current, handed=None):
+    def impacts_and_modes(self, t, modes, impulses, q, v, u, inputs, current, handed=None):
         """2. The LZB impact of the couples hit (Sect. 6) and 3. the modes of the contact set
-        (Eq. 48-52), then the velocity projection onto the new constraints; returns v.
+        (Eq. 48-52), then the velocity projection onto the new constraints; returns v. The
+        impulses are solved into ``impulses`` (`EventImpulses`), which the caller logs.
         ``handed`` maps a pair handed a couple to the pair it continues, whose forces it
         takes; ``inputs`` is the inputs' generalized force."""
         handed = handed or {}
@@ -288,13 +288,13 @@ class Transitions:
         closed = []
         if hit:
             S = hybrid.impact_set(hit, [st.mode for st in states], vn)
-            v, vn_plus, approach = impacts.lzb_impact(ev, t, modes, kin, evs, S, v)
+            v, vn_plus, approach = impulses.lzb_impact(kin, evs, S, v)
             for i, c in zip(S, hybrid.closed_after_impact(vn_plus, approach)):
                 if c:
                     closed.append(i)       # closed at the end of the impact: in contact
                 else:
                     states[i].track()      # separating
-            modes.impacts[-1]["pairs_plus"] = copied_states(states)
+            impulses.left(states)
             kin = evaluate_all(v)
             gap, vn = gaps_and_rates()
         new, cand = hybrid.contact_candidates([st.mode for st in states], gap, vn, bool(hit),
@@ -304,7 +304,7 @@ class Transitions:
                 st.track()
         rows = [eng.row(i, evs[i], kin) for i in cand]
         M, Minv, a0 = eng.dynamics(q, v, inputs)[:3]
-        select = compiled_constraints.select_modes
+        select = compiled_constraints.select_contact_modes
         avoid = [() if hit else leaving.get(i, ()) for i in cand]
         try:
             sol = select(Minv, a0, rows, v_slip=opt.v_slip, omega=opt.baumgarte, time=t,
@@ -313,7 +313,7 @@ class Transitions:
             if opt.painleve != "impact":
                 raise
             # The impact without collision (`drake_dock.core.iwc`), then the modes again.
-            v = impacts.without_collision(ev, t, modes, M, rows, v, paradox)
+            v = impulses.without_collision(M, rows, v, paradox)
             kin = evaluate_all(v)
             rows = [eng.row(i, evs[i], kin) for i in cand]
             M, Minv, a0 = eng.dynamics(q, v, inputs)[:3]

@@ -19,9 +19,10 @@ OMEGA = 20.0          # the contact system's Baumgarte omega (rad/s)
 
 
 @pytest.fixture(params=["python", "compiled"])
-def select_modes(request):
+def select_contact_modes(request):
     """Mode selection by the reference or by the compiled kernels."""
-    return {"python": constraints.select_modes, "compiled": compiled.select_modes}[request.param]
+    return {"python": constraints.select_contact_modes,
+            "compiled": compiled.select_contact_modes}[request.param]
 
 
 def body_mass(m, inertia):
@@ -56,7 +57,7 @@ def tip_A(theta, l, mass, mu, s):
 def modes_by_enumeration(M, a0, rows, omega, rtol=1e-9):
     """Every consistent choice of {slide, detach} for couples that all slide, each solved from
     the Newton-Euler equations and the constraint rows together (a KKT system in M, not the
-    select_modes' Schur complement): [(modes, vdot, lam_n)]."""
+    select_contact_modes' Schur complement): [(modes, vdot, lam_n)]."""
     nv, out = len(a0), []
     for modes in itertools.product((SLIDE, DETACH), repeat=len(rows)):
         on = [r for r, m in zip(rows, modes) if m == SLIDE]
@@ -106,7 +107,7 @@ LIFT_OFF = dict(gap=8.273e-9, vn=-1.875e-10, vt=[-0.0803, 0.0])
 GDDOT_FREE = -3.2909e-6
 
 
-def test_a_sliding_couple_lifting_off_with_an_open_drift_detaches(select_modes):
+def test_a_sliding_couple_lifting_off_with_an_open_drift_detaches(select_contact_modes):
     """The free motion's stabilised normal acceleration is +1.1e-8 m/s^2: sliding would need
     lambda_n = -1.1e-8 / A < 0 (a pull), detaching leaves the stabilised row >= 0, so
     detaching is the one consistent mode (Eq. 50-52). The unstabilised g'' < 0 of the free
@@ -120,7 +121,7 @@ def test_a_sliding_couple_lifting_off_with_an_open_drift_detaches(select_modes):
     # of the force (1 N) and acceleration (1 m/s^2) floors:
     lam_slide = -stab_free / tip_A(theta, l, mass, mu, -1.0)
     assert stab_free > 0 and GDDOT_FREE < -TIE_RTOL * 1.01 and lam_slide < -TIE_RTOL
-    sol = select_modes(np.linalg.inv(M), a0, [row], omega=OMEGA, time=1.96525946,
+    sol = select_contact_modes(np.linalg.inv(M), a0, [row], omega=OMEGA, time=1.96525946,
                        avoid=[("stick", "slide")])
     assert sol.modes == (DETACH,)
     np.testing.assert_array_equal(sol.vdot, a0)
@@ -128,16 +129,16 @@ def test_a_sliding_couple_lifting_off_with_an_open_drift_detaches(select_modes):
     (modes, vdot, lam_n), = modes_by_enumeration(M, a0, [row], OMEGA)
     assert modes == (DETACH,)
     # Without the avoid hint the choice is the same: it is the only consistent one.
-    assert select_modes(np.linalg.inv(M), a0, [row], omega=OMEGA).modes == (DETACH,)
+    assert select_contact_modes(np.linalg.inv(M), a0, [row], omega=OMEGA).modes == (DETACH,)
 
 
-def test_a_loaded_sliding_couple_with_the_same_drift_keeps_sliding(select_modes):
+def test_a_loaded_sliding_couple_with_the_same_drift_keeps_sliding(select_contact_modes):
     """Gravity on the same rod: lambda_n = -(b + 2 omega g' + omega^2 g) / A, the sliding
     tip's closed form (Eq. 50, 52)."""
     theta, l, mass, mu = math.radians(30.0), 1.0, 1000.0, 0.1
     M, row = rod(theta, l, mass, mu, gap=LIFT_OFF["gap"], vn=LIFT_OFF["vn"], vt=[-0.08, 0.0])
     a0 = np.array([0.0, 0.0, -G, 0.0, 0.0, 0.0])
-    sol = select_modes(np.linalg.inv(M), a0, [row], omega=OMEGA)
+    sol = select_contact_modes(np.linalg.inv(M), a0, [row], omega=OMEGA)
     assert sol.modes == (SLIDE,)
     b = -G + 2 * OMEGA * row.vn + OMEGA ** 2 * row.gap
     np.testing.assert_allclose(sol.lam_n[0], -b / tip_A(theta, l, mass, mu, -1.0), rtol=1e-12)
@@ -145,7 +146,7 @@ def test_a_loaded_sliding_couple_with_the_same_drift_keeps_sliding(select_modes)
 
 
 @pytest.mark.parametrize("drift", [dict(gap=0.0, vn=0.0), LIFT_OFF])
-def test_painleve_rod_above_the_critical_friction_is_inconsistent(drift, select_modes):
+def test_painleve_rod_above_the_critical_friction_is_inconsistent(drift, select_contact_modes):
     """mu = 3 at 30 deg: A = (1 + 3 c (c + mu s sn)) / m < 0 for the tip sliding towards -x, and
     gravity presses it on the plane: sliding needs lambda_n = G / A < 0 and detaching has
     g'' = -G. No consistent mode: PainleveError."""
@@ -155,7 +156,7 @@ def test_painleve_rod_above_the_critical_friction_is_inconsistent(drift, select_
     a0 = np.array([0.0, 0.0, -G, 0.0, 0.0, 0.0])
     assert modes_by_enumeration(M, a0, [row], OMEGA) == []
     with pytest.raises(PainleveError, match="no consistent contact mode") as err:
-        select_modes(np.linalg.inv(M), a0, [row], omega=OMEGA, time=0.5)
+        select_contact_modes(np.linalg.inv(M), a0, [row], omega=OMEGA, time=0.5)
     assert err.value.time == 0.5 and list(err.value.couples) == ["tip_plane"]
 
 
@@ -178,7 +179,7 @@ def random_scene(rng):
     return body_mass(mass, inertia), a0, rows
 
 
-def test_random_sliding_contacts_match_the_enumeration(select_modes):
+def test_random_sliding_contacts_match_the_enumeration(select_contact_modes):
     """Random scenes in the lift-off window: mode selection always succeeds at mu = 0.1, and
     its choice is a consistent mode of the brute-force enumeration with the same
     accelerations."""
@@ -186,7 +187,7 @@ def test_random_sliding_contacts_match_the_enumeration(select_modes):
     detached = 0
     for _ in range(300):
         M, a0, rows = random_scene(rng)
-        sol = select_modes(np.linalg.inv(M), a0, rows, omega=OMEGA)
+        sol = select_contact_modes(np.linalg.inv(M), a0, rows, omega=OMEGA)
         check_solution(M, a0, rows, sol, OMEGA)
         found = modes_by_enumeration(M, a0, rows, OMEGA, rtol=TIE_RTOL)
         assert found

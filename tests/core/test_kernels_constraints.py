@@ -122,7 +122,7 @@ def test_non_finite_equations_raise_a_typed_error():
 
 
 @pytest.mark.parametrize("scene", ["plane", "general"])
-def test_select_modes_equals_the_reference(scene):
+def test_select_contact_modes_equals_the_reference(scene):
     """The choice (modes, directions of sliding, forces, accelerations) or the error of mode
     selection on random scenes: contacts on a plane in the lift-off window
     (test_constraints.random_scene), and general scenes with couples at rest, with and
@@ -136,8 +136,8 @@ def test_select_modes_equals_the_reference(scene):
         if n % 2:
             avoid = [tuple(m for m in (ref.STICK, ref.SLIDE, ref.DETACH) if rng.random() < 0.3)
                      for _ in rows]
-        a = outcome(ref.select_modes, Minv, a0, rows, omega=OMEGA, time=0.5, avoid=avoid)
-        b = outcome(KC.select_modes, Minv, a0, rows, omega=OMEGA, time=0.5, avoid=avoid)
+        a = outcome(ref.select_contact_modes, Minv, a0, rows, omega=OMEGA, time=0.5, avoid=avoid)
+        b = outcome(KC.select_contact_modes, Minv, a0, rows, omega=OMEGA, time=0.5, avoid=avoid)
         assert_same_outcome(a, b)
         kinds.update([a[0].__name__] if isinstance(a, tuple) else a.modes)
     # The scenes reach every mode (and, on general scenes, the Painleve paradox).
@@ -162,7 +162,7 @@ def test_painleve_rod_on_both_sides_of_the_critical_friction(factor):
     M, row = rod(theta, l, mass, mu, gap=0.0, vn=0.0, vt=[-1.0, 0.0])
     a0 = np.array([0.0, 0.0, -G, 0.0, 0.0, 0.0])
     results = [outcome(s, np.linalg.inv(M), a0, [row], omega=OMEGA, time=0.5)
-               for s in (ref.select_modes, KC.select_modes)]
+               for s in (ref.select_contact_modes, KC.select_contact_modes)]
     a, b = results
     assert_same_outcome(a, b)
     if factor > 1:

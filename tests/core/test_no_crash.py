@@ -21,7 +21,7 @@ from drake_dock.core.couple import closest_point_conditions, evaluate_couple
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
 from drake_dock.core.seeking import contact_couple, seek_couple
-from drake_dock.core.tracking import couple_rate
+from drake_dock.core.couple_rate import couple_rate
 from drake_dock.docking.geometry.apds import apds_patches
 from drake_dock.docking.geometry.pairs import R_MATCHED
 from drake_dock.docking.geometry.rotations import rot_vec, rot_x, rot_z

@@ -20,8 +20,9 @@ G, OMEGA = 9.81, 20.0
 
 
 @pytest.fixture(params=["python", "compiled"])
-def select_modes(request):
-    return {"python": constraints.select_modes, "compiled": compiled.select_modes}[request.param]
+def select_contact_modes(request):
+    return {"python": constraints.select_contact_modes,
+            "compiled": compiled.select_contact_modes}[request.param]
 
 
 def point_row(name, r, n, mu):
@@ -61,7 +62,7 @@ def test_a_couple_the_squeeze_does_not_move_is_inside_for_every_s_or_none():
 
 @pytest.mark.parametrize("theta_deg", [20.0, 35.0, 50.0])
 @pytest.mark.parametrize("mu", [0.05, 0.1, 0.3, 0.5])
-def test_a_ball_in_a_v_groove_sticks_with_forces_in_the_cone(select_modes, theta_deg, mu):
+def test_a_ball_in_a_v_groove_sticks_with_forces_in_the_cone(select_contact_modes, theta_deg, mu):
     """A ball of radius R at rest in a groove whose faces' normals lean theta from the vertical.
     The minimum-norm forces are vertical (mg/2 each: tangential/normal = tan theta, outside the
     cone for mu < tan theta); forces along the normals (mg / (2 cos theta)) hold it. Sticking is
@@ -73,7 +74,7 @@ def test_a_ball_in_a_v_groove_sticks_with_forces_in_the_cone(select_modes, theta
                                                                      math.cos(th)])
     rows = [point_row("A", -R * nA, nA, mu), point_row("B", -R * nB, nB, mu)]
     a0 = np.array([0.0, 0.0, -G, 0.0, 0.0, 0.0])
-    sol = select_modes(np.linalg.inv(M), a0, rows, omega=OMEGA)
+    sol = select_contact_modes(np.linalg.inv(M), a0, rows, omega=OMEGA)
     assert sol.modes == (STICK, STICK)
     assert np.abs(sol.vdot).max() < 1e-9
     force = sum(r.Wn * ln + r.Wt @ lt for r, ln, lt in zip(rows, sol.lam_n, sol.lam_t))
@@ -84,7 +85,8 @@ def test_a_ball_in_a_v_groove_sticks_with_forces_in_the_cone(select_modes, theta
         assert sol.lam_n == pytest.approx([0.5 * m * G * math.cos(th)] * 2, rel=1e-9)
 
 
-def test_a_block_on_two_points_of_a_steep_incline_slides_at_the_closed_form_rate(select_modes):
+def test_a_block_on_two_points_of_a_steep_incline_slides_at_the_closed_form_rate(
+        select_contact_modes):
     """A body on two points of an incline of angle alpha > atan(mu), its mass centre on the
     line through them (no moment about it): no squeeze makes sticking consistent, and it
     slides down at g (sin alpha - mu cos alpha) without turning."""
@@ -95,7 +97,7 @@ def test_a_block_on_two_points_of_a_steep_incline_slides_at_the_closed_form_rate
     rows = [point_row(k, y * np.array([0.0, 1.0, 0.0]), n, mu)
             for k, y in (("A", -0.1), ("B", 0.1))]
     a0 = np.array([0.0, 0.0, -G, 0.0, 0.0, 0.0])
-    sol = select_modes(np.linalg.inv(M), a0, rows, omega=OMEGA)
+    sol = select_contact_modes(np.linalg.inv(M), a0, rows, omega=OMEGA)
     assert sol.modes == (SLIDE, SLIDE)
     a = sol.vdot[:3]
     assert a == pytest.approx(G * (math.sin(alpha) - mu * math.cos(alpha)) * down, abs=1e-9)
@@ -124,13 +126,13 @@ def _slip_angles(Minv, a0, rows, v1, omega, th):
     return np.array(angle), np.array(along)
 
 
-def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_modes, monkeypatch):
+def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_contact_modes, monkeypatch):
     """A docking selection (tests/core/slide_start_docking.json): couple 0 at rest, couple 1
     sliding. Couple 0 sticking needs more than its cone; the fixed point s = a_t/|a_t| for its
     start of sliding does not converge. A dense sampling of its direction (3600 angles, no
     bisection) finds where a_t lies along s; the selection slides along that direction."""
     Minv, a0, rows, d = _docking_selection()
-    sol = select_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
+    sol = select_contact_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
                        avoid=[tuple(a) for a in d["avoid"]])
     assert sol.modes == (SLIDE, SLIDE)
     s = sol.dirs[0]
@@ -151,7 +153,7 @@ def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_modes, monkey
                                         d["omega"], None)[1]
 
 
-def test_two_couples_starting_to_slide_are_found(select_modes):
+def test_two_couples_starting_to_slide_are_found(select_contact_modes):
     """A docking selection (tests/core/slide_start_two.json): both couples at rest and leaving
     stick. Least squares from each point of a 36 x 36 grid of their two directions (scipy, an
     independent solver) finds where both tangential accelerations lie along their directions;
@@ -162,7 +164,7 @@ def test_two_couples_starting_to_slide_are_found(select_modes):
                        np.array(r["bt"]), r["gap"], r["vn"], np.array(r["vt"]), r["mu"],
                        r["mu_s"]) for r in d["rows"]]
     Minv, a0 = np.array(d["Minv"]), np.array(d["a0"])
-    sol = select_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
+    sol = select_contact_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
                        avoid=[tuple(a) for a in d["avoid"]])
     assert sol.modes == (SLIDE, SLIDE) and (sol.lam_n > 0).all()
 
@@ -180,7 +182,7 @@ def test_two_couples_starting_to_slide_are_found(select_modes):
         assert s == pytest.approx([math.cos(t), math.sin(t)], abs=1e-6)
 
 
-def test_two_couples_at_the_stick_slip_transition_start_to_slide(select_modes):
+def test_two_couples_at_the_stick_slip_transition_start_to_slide(select_contact_modes):
     """A docking selection (tests/core/slide_start_transition.json): both couples at rest and
     leaving stick at once. No squeeze puts the sticking forces in both cones (the intervals of
     `cone_interval`, checked on a dense sampling of the squeeze), and the sliding directions
@@ -201,13 +203,13 @@ def test_two_couples_at_the_stick_slip_transition_start_to_slide(select_modes):
     inside = ((np.hypot(L[:, 1], L[:, 2]) <= 0.1 * L[:, 0])
               & (np.hypot(L[:, 4], L[:, 5]) <= 0.1 * L[:, 3]))
     assert not inside.any()
-    sol = select_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
+    sol = select_contact_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
                        avoid=[tuple(a) for a in d["avoid"]])
     assert sol.modes == (SLIDE, SLIDE) and (sol.lam_n > 0).all()
     assert np.abs(sol.at).max() <= 1e-6 * (1.0 + np.abs(sol.vdot).max())
 
 
-def test_a_start_of_sliding_next_to_the_stick_slip_transition_is_found(select_modes):
+def test_a_start_of_sliding_next_to_the_stick_slip_transition_is_found(select_contact_modes):
     """A docking selection (tests/core/slide_start_steep.json): couple 0 at rest and leaving
     stick, its sticking force 2 % outside its cone; couple 1 sliding. Sliding, couple 0's
     tangential acceleration is small and turns fast with its direction: on the scan's grid
@@ -219,7 +221,7 @@ def test_a_start_of_sliding_next_to_the_stick_slip_transition_is_found(select_mo
                                           omega=d["omega"])
     ratio = np.hypot(*stick.lam_t[0]) / (rows[0].mu_s * stick.lam_n[0])
     assert 1.0 < ratio < 1.05
-    sol = select_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
+    sol = select_contact_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
                        avoid=[tuple(a) for a in d["avoid"]])
     assert sol.modes == (SLIDE, SLIDE) and (sol.lam_n > 0).all()
     s = sol.dirs[0]

@@ -40,7 +40,7 @@ def _run(data):
     s = load_scenario(data=data)
     r = simulate(s, place(s))
     return (r.capture_time, r.end_time, r.evaluations, r.mode_changes, np.array(r.record.x),
-            np.array(r.record.couples), [(imp["t"], imp["couples"]) for imp in r.impacts],
+            np.array(r.record.couples), [(imp.t, imp.couples) for imp in r.impacts],
             r.timing["screens_per_pair"])
 
 

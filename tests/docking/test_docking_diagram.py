@@ -52,10 +52,10 @@ def test_three_symmetric_couples_impact_at_declared_travel(first_impact, axisymm
     imp = dd.contact.get_modes(ctx).impacts
     assert len(imp) == 1
     s = axisymmetric_scenario
-    np.testing.assert_allclose(imp[0]["t"], s.initial.approach_travel / s.initial.chaser_speed,
+    np.testing.assert_allclose(imp[0].t, s.initial.approach_travel / s.initial.chaser_speed,
                                atol=1e-8)
-    assert sorted(imp[0]["couples"]) == sorted(state.closing_pairs)
-    P = np.array(imp[0]["normal_impulse"])
+    assert sorted(imp[0].couples) == sorted(state.closing_pairs)
+    P = np.array(imp[0].normal_impulse)
     assert P.min() > 0
     np.testing.assert_allclose(P, P.mean(), rtol=1e-6)      # 3-fold symmetry
     # Only the pairs near contact are tracked; the ring-surface pairs stay far.

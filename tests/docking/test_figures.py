@@ -14,7 +14,7 @@ from drake_dock.docking.model.control import WrenchController, with_controller
 from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
 from drake_dock.docking.model.outcome import misalignment
 from drake_dock.docking.report.figure_kit import PALETTE, decades
-from drake_dock.docking.report.loads import interface_loads
+from drake_dock.docking.report.interface_loads import interface_loads
 from drake_dock.docking.report.run_figures import IMPULSE_FLOOR
 from drake_dock.docking.scenario.loading import load_scenario
 from drake_dock.run import run

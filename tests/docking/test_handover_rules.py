@@ -1,10 +1,11 @@
-"""The rules that keep a hand-over from going to and fro (`drake_dock.systems.handovers.accepts`): on the
-paper example with `contact.pairs: complete` and the edge/surface hand-overs declared, the
-ring's circles stay clear of the petals while the rings are coaxial, where a circle has no
-isolated couple with a cone and the edge guard of a symmetric motion sits at zero. Every
-hand-over that falls due there is refused, and the run equals the run without hand-overs
-(second implementation: no pair can be handed over) to the integrator's tolerance; without
-the rules the same run hands couples to and fro."""
+"""The rules that keep a hand-over from going to and fro
+(`drake_dock.systems.handover_links.accepts`): on the paper example with
+`contact.pairs: complete` and the edge/surface hand-overs declared, the ring's circles stay
+clear of the petals while the rings are coaxial, where a circle has no isolated couple with a
+cone and the edge guard of a symmetric motion sits at zero. Every hand-over that falls due
+there is refused, and the run equals the run without hand-overs (second implementation: no
+pair can be handed over) to the integrator's tolerance; without the rules the same run hands
+couples to and fro."""
 import math
 
 import pytest
@@ -15,7 +16,7 @@ from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import contact_approach, place
 from drake_dock.docking.scenario.loading import load_scenario
 from drake_dock.errors import NumericalError
-from drake_dock.systems import handovers
+from drake_dock.systems import handover_links
 
 COMPLETE = "contact: {pairs: complete}"
 
@@ -33,13 +34,13 @@ def _run(scenario, handovers):
 
 def test_refused_handovers_leave_the_run_unchanged(scenario, monkeypatch):
     decided = []
-    accepts = handovers.accepts
+    accepts = handover_links.accepts
 
     def counted(*args):
         decided.append(accepts(*args))
         return decided[-1]
 
-    monkeypatch.setattr(handovers, "accepts", counted)
+    monkeypatch.setattr(handover_links, "accepts", counted)
     r = _run(scenario, True)
     ref = _run(scenario, False)
     assert len(decided) > 0 and not any(decided)
@@ -60,7 +61,7 @@ def test_without_the_rules_the_couples_go_to_and_fro(scenario, monkeypatch):
         taken.append(args)
         return True
 
-    monkeypatch.setattr(handovers, "accepts", take)
+    monkeypatch.setattr(handover_links, "accepts", take)
     s, _ = scenario
     declared = DockingScene.of(s).handovers
     ref = _run(scenario, False)
@@ -95,4 +96,4 @@ def test_the_complete_set_shifts_the_paper_example_by_its_first_contact(scenario
     assert r.outcome == ref.outcome == "captured" and len(r.impacts) == len(ref.impacts) > 0
     assert abs(r.capture_time - ref.capture_time - shift) <= 1e-6
     for a, b in zip(r.impacts, ref.impacts):
-        assert a["couples"] == b["couples"] and abs(a["t"] - b["t"] - shift) <= 1e-6
+        assert a.couples == b.couples and abs(a.t - b.t - shift) <= 1e-6

@@ -50,7 +50,7 @@ def test_idss_sample_139_lifts_off_and_runs_to_a_named_outcome():
     `drake_dock.core.constraints`) and the run goes on, without a numerical error, to a named
     outcome whose reason agrees with the time series (no couple active at its end). Over its
     6 s and its impacts the energy ledger closes to 1e-6 with the default integration scheme
-    (RK5; docs/model.md, "Integration")."""
+    (RK5; docs/algorithms.md, "Integration")."""
     import numpy as np
     from drake_dock.campaign.plan import load_plan
     from drake_dock.campaign.sample import sample_scenario

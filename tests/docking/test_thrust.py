@@ -75,7 +75,7 @@ def test_thrust_impulse_and_work_in_closed_form(coaxial_run):
     window (the trapezoid rule on the 2 ms samples: second order, so to 1e-4 here), and the
     ledger closes."""
     s, r, ts, summ = coaxial_run
-    tc = r.impacts[0]["t"]
+    tc = r.impacts[0].t
     assert r.end_time > tc + 0.15
     masses = [getattr(s.bodies, n).mass for n in ts["body_names"]]
     P = np.einsum("b,nbx->nx", np.asarray(masses), ts["v_WB"])
@@ -103,7 +103,7 @@ def test_thrust_switches_end_steps(coaxial_run):
     """A witness at each switch ends a step there (to the isolation window): the samples hold
     the switching times."""
     s, r, ts, summ = coaxial_run
-    tc = r.impacts[0]["t"]
+    tc = r.impacts[0].t
     for switch in (tc + 0.05, tc + 0.15):
         assert np.min(np.abs(ts["t"] - switch)) < 1e-6
     assert summ["thrust"]["first_contact_time_s"] == tc

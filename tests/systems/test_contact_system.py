@@ -284,12 +284,12 @@ def test_painleve_inconsistency_is_an_impact_without_collision():
     sc, X, V, _ = painleve_start(3.0)
     sim, root, ctx = start(sc.system, lambda c: sc.set_state(c, X, V))
     imp = sc.system.get_modes(ctx).impacts
-    assert len(imp) == 1 and imp[0]["without_collision"] and imp[0]["t"] == 0.0
+    assert len(imp) == 1 and imp[0].without_collision and imp[0].t == 0.0
     Px, Pz, lost = _tip_impulse(sc.params, (-1.0, 0.0))
     assert Pz > 0 and abs(Px) <= sc.params["mu"] * Pz
-    np.testing.assert_allclose(imp[0]["normal_impulse"], [Pz], rtol=1e-9)
-    np.testing.assert_allclose(imp[0]["tangential_impulse"][0][0], Px, rtol=1e-9)
-    np.testing.assert_allclose(imp[0]["energy_lost"], lost, rtol=1e-9)
+    np.testing.assert_allclose(imp[0].normal_impulse, [Pz], rtol=1e-9)
+    np.testing.assert_allclose(imp[0].tangential_impulse[0][0], Px, rtol=1e-9)
+    np.testing.assert_allclose(imp[0].energy_lost, lost, rtol=1e-9)
     e0 = energy(sc.system, ctx)
     total0 = e0[0] + e0[1] + lost
     for T in (0.1, 0.3):
@@ -354,7 +354,7 @@ def test_bouncing_disk_lzb_and_zeno_guard():
     sim.AdvanceTo(t1 + 0.01)
     imp = sc.system.get_modes(ctx).impacts
     assert len(imp) == 1
-    np.testing.assert_allclose(imp[0]["t"], t1, rtol=1e-7)
+    np.testing.assert_allclose(imp[0].t, t1, rtol=1e-7)
     x = ctx.get_continuous_state_vector().CopyToVector()
     np.testing.assert_allclose(x[12], e * math.sqrt(2 * G * h) - G * 0.01, rtol=1e-7)
     # Sum of the bounce flight times: 2 e v / g / (1 - e) after the first impact.
@@ -367,7 +367,7 @@ def test_bouncing_disk_lzb_and_zeno_guard():
     n = len(sc.system.get_modes(ctx).impacts)
     # Impacts at v1 e^k while that is at least the Zeno speed, then one plastic impact.
     assert n == math.floor(math.log(opt.zeno_speed / v1) / math.log(e)) + 2
-    assert sc.system.get_modes(ctx).impacts[-1]["restitution"] == 0.0
+    assert sc.system.get_modes(ctx).impacts[-1].restitution == 0.0
 
 
 def test_stool_three_couples_share_weight():
@@ -393,9 +393,9 @@ def test_stool_dropped_flat_lands_on_three_feet(mu):
         (np.zeros(3), np.zeros(3))))
     sim.AdvanceTo(0.05)
     imp = sc.system.get_modes(ctx).impacts
-    assert len(imp) == 1 and len(imp[0]["couples"]) == 3
-    np.testing.assert_allclose(imp[0]["t"], math.sqrt(2 * h / G), rtol=1e-7)
-    np.testing.assert_allclose(imp[0]["normal_impulse"],
+    assert len(imp) == 1 and len(imp[0].couples) == 3
+    np.testing.assert_allclose(imp[0].t, math.sqrt(2 * h / G), rtol=1e-7)
+    np.testing.assert_allclose(imp[0].normal_impulse,
                                sc.params["mass"] * math.sqrt(2 * G * h) / 3, rtol=1e-7)
     lam = [couple(sc.system, ctx, f"foot{k}_plane")["lambda_n"] for k in range(3)]
     np.testing.assert_allclose(lam, sc.params["mass"] * G / 3, rtol=1e-8)

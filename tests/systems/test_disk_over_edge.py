@@ -142,7 +142,7 @@ def test_the_handovers_applied_do_not_depend_on_the_pairs_labels():
     """`applied` on random hand-overs due among 6 pairs (single ones, chains, exchanges, two
     couples due to one pair): relabelling the pairs relabels the hand-overs made, and each made
     one is a pair taking the only couple due to it while not handing its own on."""
-    from drake_dock.systems.handovers import applied
+    from drake_dock.systems.handover_links import applied
     rng = np.random.default_rng(5)
     made_some = waited = 0
     for _ in range(200):

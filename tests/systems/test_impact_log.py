@@ -5,6 +5,7 @@ follows has no consistent mode, resolved by an impact without collision at the s
 impulse's logged states against the momentum balance of the rod written out (linear and
 angular momentum about the mass centre), and the recorder of `drake_dock.docking.model.simulate`
 replaying them; `max_impacts` counting both kinds."""
+import dataclasses
 import math
 import types
 
@@ -74,26 +75,26 @@ def test_two_impulses_in_one_event_carry_their_states(frictionless_lzb):
     sc, diagram, sim, r, I_W = initialized()
     root = sim.get_context()
     imp = sc.system.get_modes(sc.system.GetMyContextFromRoot(root)).impacts
-    assert len(imp) == 2 and not imp[0].get("without_collision")
-    assert imp[1]["without_collision"] and imp[0]["t"] == imp[1]["t"] == 0.0
+    assert len(imp) == 2 and not imp[0].without_collision
+    assert imp[1].without_collision and imp[0].t == imp[1].t == 0.0
     m = sc.params["mass"]
     lost = 0.0
     for e in imp:
-        (P_n,), ((P_ta, P_tb),) = e["normal_impulse"], e["tangential_impulse"]
+        (P_n,), ((P_ta, P_tb),) = e.normal_impulse, e.tangential_impulse
         P = np.array([P_ta, P_tb, P_n])
-        w0, v0 = e["x_minus"][7:10], e["x_minus"][10:13]
-        w1, v1 = e["x_plus"][7:10], e["x_plus"][10:13]
+        w0, v0 = e.x_minus[7:10], e.x_minus[10:13]
+        w1, v1 = e.x_plus[7:10], e.x_plus[10:13]
         scale = np.abs(P).max()
         np.testing.assert_allclose(m * (v1 - v0), P, atol=1e-9 * scale)
         np.testing.assert_allclose(I_W @ (w1 - w0), np.cross(r, P), atol=1e-9 * scale)
         ke = lambda w, v: 0.5 * (m * v @ v + w @ I_W @ w)  # noqa: E731
-        np.testing.assert_allclose(ke(w0, v0) - ke(w1, v1), e["energy_lost"], rtol=1e-8)
-        lost += e["energy_lost"]
-        np.testing.assert_allclose(e["impact_loss_plus"], lost, rtol=1e-9)
-        assert len(e["pairs_plus"]) == 1
-    np.testing.assert_array_equal(imp[1]["x_minus"], imp[0]["x_plus"])
-    assert imp[0]["x_plus"][12] > VZ          # the LZB impact stopped the approach, not the slip
-    w1, v1 = imp[1]["x_plus"][7:10], imp[1]["x_plus"][10:13]
+        np.testing.assert_allclose(ke(w0, v0) - ke(w1, v1), e.energy_lost, rtol=1e-8)
+        lost += e.energy_lost
+        np.testing.assert_allclose(e.impact_loss_plus, lost, rtol=1e-9)
+        assert len(e.pairs_plus) == 1
+    np.testing.assert_array_equal(imp[1].x_minus, imp[0].x_plus)
+    assert imp[0].x_plus[12] > VZ          # the LZB impact stopped the approach, not the slip
+    w1, v1 = imp[1].x_plus[7:10], imp[1].x_plus[10:13]
     assert np.abs(v1 + np.cross(w1, r)).max() < 1e-12
     # The recorder after Initialize (as `simulate` calls it): no step end before the event,
     # the state after each impulse, then the state the event left.
@@ -101,8 +102,12 @@ def test_two_impulses_in_one_event_carry_their_states(frictionless_lzb):
     rec.sample(root)
     assert rec.record.kind == [POST_IMPACT, POST_IMPACT, STEP]
     for k, e in enumerate(imp):
-        np.testing.assert_array_equal(rec.record.x[k], e["x_plus"][:13])
-    np.testing.assert_array_equal(rec.record.x[2], imp[1]["x_plus"][:13])
+        np.testing.assert_array_equal(rec.record.x[k], e.x_plus[:13])
+        assert [st.mode for st in rec.record.modes[k].pairs] == [st.mode for st in e.pairs_plus]
+    assert imp[1].pairs_plus[0].mode.name == "STICKING"    # the tip at rest, as above
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        imp[0].t = 1.0                          # logged once, never changed
+    np.testing.assert_array_equal(rec.record.x[2], imp[1].x_plus[:13])
 
 
 @pytest.mark.parametrize("landing", [True, False])

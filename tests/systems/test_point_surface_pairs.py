@@ -66,8 +66,8 @@ def test_dropped_point_bounces_at_the_closed_form_times():
     t1 = math.sqrt(2 * h / gc)
     t = t1 + 0.2
     run.sim.AdvanceTo(t)
-    times = [i["t"] for i in run.impacts]
-    assert all(i["couples"] == ["ps"] for i in run.impacts)
+    times = [i.t for i in run.impacts]
+    assert all(i.couples == ["ps"] for i in run.impacts)
     want = t1 + np.cumsum([0.0] + [2 * e ** k * gc * t1 / gc for k in (1, 2)])
     np.testing.assert_allclose(times[:3], want, atol=1e-7)
     np.testing.assert_allclose(position(run), [0.5 * G * math.sin(THETA) * t ** 2, 0.0, 0.0],

@@ -29,7 +29,7 @@ def bounce(approach: bool):
     v1 = math.sqrt(2 * G * H)
     t1 = math.sqrt(2 * H / G)
     sim.AdvanceTo(t1 + 2 * v1 / G * (E + E**2) + 0.01)      # the first three impacts
-    return [i["t"] for i in sc.system.get_modes(ctx).impacts], sc.system.evaluations - n0
+    return [i.t for i in sc.system.get_modes(ctx).impacts], sc.system.evaluations - n0
 
 
 def test_same_impact_times_with_fewer_evaluations():

@@ -2,9 +2,9 @@
 friction, the Baumgarte-stabilised normal rows) compiled, over plain arrays:
 
 - `solve_given_modes` (the contact forces and accelerations for given modes) and
-  `select_modes` (the enumeration of the modes, the start of sliding, the consistency tests and
-  the preferences), with the signatures and results of the pure-Python reference, which the
-  tests compare them with (tests/core/test_kernels_constraints.py);
+  `select_contact_modes` (the enumeration of the modes, the start of sliding, the consistency
+  tests and the preferences), with the signatures and results of the pure-Python reference,
+  which the tests compare them with (tests/core/test_kernels_constraints.py);
 - `solve_packed`, the solve on rows already packed as arrays (`pack_rows`), for the derivative
   evaluation.
 
@@ -49,7 +49,7 @@ def _consistent(modes, lam_n, lam_t, gdd, vn, gap, mu_s, omega, tol_f, tol_a):
 
 @njit(cache=True)
 def _select(Minv, a0, W, bias, gap, vn, vt, mu, mu_s, avoid, v_slip, omega, rtol, tie_rtol):
-    """`constraints.select_modes` without its errors: returns (status, modes (n, k), dirs
+    """`constraints.select_contact_modes` without its errors: returns (status, modes (n, k), dirs
     (n, k, 2), vdot (n, nv), lam_n (n, k), lam_t (n, k, 2), gf (n, nv), best, other), with
     row ``best`` the choice, and for INDETERMINATE row ``other`` the second consistent
     choice."""
@@ -227,8 +227,9 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None):
     return ref.ContactSolution(tuple(modes), list(dirs), vdot, lam_n, lam_t, gf, list(rows))
 
 
-def select_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9, avoid=None):
-    """`constraints.select_modes` compiled: the same arguments, choice and errors."""
+def select_contact_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9,
+                         avoid=None):
+    """`constraints.select_contact_modes` compiled: the same arguments, choice and errors."""
     k = len(rows)
     names = [r.name for r in rows]
     if k == 0:

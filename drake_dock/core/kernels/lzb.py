@@ -11,9 +11,9 @@ scaled by atol + rtol max(|y|, |y_new|), step factor 0.9 err^(-1/5) within [0.2,
 
 The phases (right-hand side, events, laws) are in `drake_dock.core.kernels.lzb_phases`. The
 kernel applies the events of the states with no sticking and no locked couple (maximal
-compression with e > 0, end of expansion, separation, re-compression, a frictionless
-re-impact, a slip reversal). An event that needs a stick-slip decision (`select_modes`) or a
-lock (e = 0) is handed back, undone, as status `PYEVENT` with the step's dense output: the
+compression with e > 0, end of expansion, separation, re-compression, a frictionless re-impact,
+a slip reversal). An event that needs a stick-slip decision (`select_impact_friction_modes`) or
+a lock (e = 0) is handed back, undone, as status `PYEVENT` with the step's dense output: the
 wrapper (`drake_dock.core.lzb.compiled`) applies it in Python, and integrates the states with
 sticking or locked couples by the reference (scipy's DOP853) until they end.
 

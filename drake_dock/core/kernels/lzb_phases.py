@@ -158,7 +158,7 @@ def apply_event(y, kind, j, impulse, s, nu, friction, kappa, eta, e, law, phase,
         for i in range(s, s + nu):
             scale = max(scale, abs(y[i]))
         if nt <= max(1e-9 * scale, 2.0 * v_rest):     # `friction.rest_speed`
-            return False, log           # came to rest: `select_modes`
+            return False, log           # came to rest: `select_impact_friction_modes`
         slip_dir[j, 0], slip_dir[j, 1] = y[o] / nt, y[o + 1] / nt
         return True, log
     if kind == APPROACH:

@@ -26,7 +26,7 @@ def rest_speed(prob, scale) -> float:
     return max(1e-9 * scale, 2.0 * prob.settle)
 
 
-def select_modes(prob, y, js, events, impulse):
+def select_impact_friction_modes(prob, y, js, events, impulse):
     """Stick or slip for the couples ``js`` (loaded or loading, Eq. 27), decided jointly with
     the couples that stick now, since their sticking forces depend on each other: a couple
     that moves tangentially slips along its motion; the couples at rest all stick if the
@@ -89,11 +89,11 @@ def on_friction_event(prob, y, j, events, impulse):
         events.append(ImpactEvent(impulse, "slip", j))
         others = [k for k in np.flatnonzero(prob.stuck) if k != j]
         if others:
-            select_modes(prob, y, others, events, impulse)
+            select_impact_friction_modes(prob, y, others, events, impulse)
     else:
         ut = tangential_pairs(prob, y)[j]
         scale = np.abs(y[prob.layout.u]).max()
         if np.linalg.norm(ut) <= rest_speed(prob, scale):
-            select_modes(prob, y, [j], events, impulse)
+            select_impact_friction_modes(prob, y, [j], events, impulse)
         else:
             prob.slip_dir[j] = ut / np.linalg.norm(ut)

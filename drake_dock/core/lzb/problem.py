@@ -9,7 +9,7 @@ import numpy as np
 
 from drake_dock.core.lzb import laws
 from drake_dock.core.lzb.forces import force_rates, forces, probe_loads, tangential_pairs
-from drake_dock.core.lzb.friction import on_friction_event, select_modes
+from drake_dock.core.lzb.friction import on_friction_event, select_impact_friction_modes
 from drake_dock.core.lzb.state import COMPRESSION, EXPANSION, LOCKED, ImpactEvent, StateLayout
 
 # Rows of `ImpactProblem.event_values`.
@@ -194,7 +194,7 @@ class ImpactProblem:
             x[j] = 0.0
             events.append(ImpactEvent(impulse, "re_impact", j))
             if self.friction:
-                select_modes(self, y, [j], events, impulse)
+                select_impact_friction_modes(self, y, [j], events, impulse)
 
     def _max_compression(self, y, j, events, impulse):
         """Maximal compression of couple j: the compression work of this episode,

@@ -77,7 +77,7 @@ import dataclasses
 import numpy as np
 
 from drake_dock.core.lzb.driver import integrate
-from drake_dock.core.lzb.friction import select_modes
+from drake_dock.core.lzb.friction import select_impact_friction_modes
 from drake_dock.core.lzb.inputs import check_inputs, per_couple
 from drake_dock.core.lzb.laws import LAWS
 from drake_dock.core.lzb.problem import ImpactProblem
@@ -183,7 +183,8 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     events = []
     y = prob.y0.copy()
     if friction:
-        select_modes(prob, y, [j for j in range(s) if x0[j] > 0 or un0[j] < 0], events, 0.0)
+        select_impact_friction_modes(prob, y, [j for j in range(s) if x0[j] > 0 or un0[j] < 0],
+                                     events, 0.0)
     if compiled:
         # Imported here: it imports numba, and this module.
         from drake_dock.core.lzb.compiled import integrate_compiled

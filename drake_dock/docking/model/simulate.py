@@ -27,8 +27,8 @@ from drake_dock.docking.model.initial_state import InitialState
 from drake_dock.docking.model.outcome import OutcomeWatch, progress_fraction
 from drake_dock.docking.model.plant import relative_kinetic_energy, set_initial_state
 from drake_dock.errors import numerical_failure
-from drake_dock.systems.contact_system import COUPLE_OUTPUT_SIZE, COUPLE_SLICES, ContactModes
-from drake_dock.systems.contact_types import copied_states
+from drake_dock.systems.contact_system import COUPLE_OUTPUT_SIZE, COUPLE_SLICES
+from drake_dock.systems.impacts import enter_after
 from drake_dock.systems.simulator import make_simulator, make_witness_approach
 
 STEP, PRE_IMPACT, POST_IMPACT = 0, 1, 2
@@ -181,7 +181,7 @@ class _Recorder:
         new = modes.impacts[self.n_impacts:]
         r = self.record
         for imp in new:
-            if r.t and r.t[-1] == imp["t"] and r.kind[-1] == STEP:
+            if r.t and r.t[-1] == imp.t and r.kind[-1] == STEP:
                 r.kind[-1] = PRE_IMPACT
             self._post_impact(root, imp, modes)
         self.n_impacts = len(modes.impacts)
@@ -191,13 +191,9 @@ class _Recorder:
     def _post_impact(self, root, imp, modes):
         s = self._scratch
         s.SetTimeStateAndParametersFrom(root)
-        s.SetTime(imp["t"])
+        s.SetTime(imp.t)
         contact = self.dd.contact
-        cc = contact.GetMyMutableContextFromRoot(s)
-        cc.SetContinuousState(imp["x_plus"])
-        after = ContactModes(copied_states(imp["pairs_plus"]), [], imp["impact_loss_plus"],
-                             modes.mode_changes)
-        contact.set_modes(cc, after.seal())
+        enter_after(contact, contact.GetMyMutableContextFromRoot(s), imp, modes.mode_changes)
         self._append(s, POST_IMPACT)
 
 

@@ -7,7 +7,7 @@ import numpy as np
 
 from drake_dock.docking.report.figure_kit import (PALETTE, Sheet, impact_lines, legend_beside,
                                                   time_axes, with_data)
-from drake_dock.docking.report.loads import interface_loads
+from drake_dock.docking.report.interface_loads import interface_loads
 from drake_dock.docking.report.results import IN_CONTACT, relative_text
 
 

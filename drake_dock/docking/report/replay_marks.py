@@ -17,7 +17,7 @@ import numpy as np
 from pydrake.geometry import Cylinder, MeshcatCone, Rgba, Sphere
 from pydrake.math import RigidTransform, RollPitchYaw
 
-from drake_dock.docking.report.loads import couple_forces_W
+from drake_dock.docking.report.interface_loads import couple_forces_W
 from drake_dock.docking.report.results import IN_CONTACT
 
 ROOT = "/contact"

@@ -29,7 +29,7 @@ from drake_dock.docking.model.outcome import misalignment
 from drake_dock.docking.model.plant import APDS_NAMES, BODY_NAMES
 from drake_dock.docking.model.simulate import PRE_IMPACT
 from drake_dock.docking.model.thrust import ThrustSchedule
-from drake_dock.docking.report.loads import peak_loads
+from drake_dock.docking.report.interface_loads import peak_loads
 from drake_dock.docking.scenario.loading import scenario_dict
 from drake_dock.systems.contact_system import COUPLE_SLICES
 
@@ -72,8 +72,8 @@ def timeseries(result, couples: bool = True) -> dict:
         sample_kind=np.asarray(rec.kind, dtype=np.int8),
         ring_distance=np.asarray(rec.ring_distance), energy=energy,
         energy_names=np.array(energy_names),
-        impact_t=np.array([imp["t"] for imp in result.impacts], dtype=float),
-        impact_restitution=np.array([imp["restitution"] for imp in result.impacts], dtype=float),
+        impact_t=np.array([imp.t for imp in result.impacts], dtype=float),
+        impact_restitution=np.array([imp.restitution for imp in result.impacts], dtype=float),
         thrust_force_W=thrust_forces(result, np.asarray(rec.t), R_WB[:, BODY_NAMES.index(
             "chaser")]))
     if not couples:
@@ -87,7 +87,7 @@ def timeseries(result, couples: bool = True) -> dict:
     imp_n = np.zeros((M, len(names)))
     imp_t = np.zeros((M, len(names), 2))
     for m, imp in enumerate(result.impacts):
-        for c, pn, pt in zip(imp["couples"], imp["normal_impulse"], imp["tangential_impulse"]):
+        for c, pn, pt in zip(imp.couples, imp.normal_impulse, imp.tangential_impulse):
             j = names.index(c)
             imp_c[m, j], imp_n[m, j], imp_t[m, j] = True, pn, pt
     return dict(
@@ -100,7 +100,7 @@ def timeseries(result, couples: bool = True) -> dict:
 
 def first_contact_time(result) -> float:
     """The time of the run's first impact (s; every contact starts with one), inf without."""
-    return float(result.impacts[0]["t"]) if result.impacts else math.inf
+    return float(result.impacts[0].t) if result.impacts else math.inf
 
 
 def thrust_forces(result, t, R_WC) -> np.ndarray:
@@ -317,10 +317,11 @@ def non_finite_key(node, path=""):
 
 def summary(result, ts: dict) -> dict:
     """The numbers of a run for a docking engineer (summary.json): the outcome and its reason,
-    capture, the final misalignment, the peak loads (`drake_dock.docking.report.loads.peak_loads`),
-    the relative kinetic energy at contact, the energy ledger, the impacts, the momentum drift,
-    the first contact and the couples that came near (`couples_table`). The solver's cost is
-    apart (`drake_dock.docking.report.cost.run_cost`)."""
+    capture, the final misalignment, the peak loads
+    (`drake_dock.docking.report.interface_loads.peak_loads`), the relative kinetic energy at
+    contact, the energy ledger, the impacts, the momentum drift, the first contact and the
+    couples that came near (`couples_table`). The solver's cost is apart
+    (`drake_dock.docking.report.cost.run_cost`)."""
     s = result.scenario
     b = s.bodies
     params = [getattr(b, n) for n in ts["body_names"]]

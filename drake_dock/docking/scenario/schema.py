@@ -109,7 +109,7 @@ def default_simulator_config() -> SimulatorConfig:
     and its step capped at ``max_step_size`` (s), which is also the sample spacing of the
     outputs. At that cap the step is mostly the cap's, so the scheme's order sets the error:
     Bogacki-Shampine (3 evaluations a step against RK5's 6) leaves the energy ledger open by
-    a few 1e-6 over an off-nominal run, RK5 closes it to 1e-7 (docs/model.md, "Integration";
+    a few 1e-6 over an off-nominal run, RK5 closes it to 1e-7 (docs/algorithms.md, "Integration";
     bench/paper_example.py runs both)."""
     return SimulatorConfig(integration_scheme="runge_kutta5", max_step_size=0.002,
                            accuracy=1e-6, use_error_control=True)

@@ -7,7 +7,7 @@ from scipy.integrate import solve_ivp
 
 from drake_dock.core.patches import Segment, posed
 from drake_dock.core.seeking import newton_closest, seek_couple
-from drake_dock.core.tracking import SingularCoupleError, couple_rate
+from drake_dock.core.couple_rate import SingularCoupleError, couple_rate
 from drake_dock.docking.geometry.pairs import R_MATCHED
 from drake_dock.docking.geometry.rotations import rot_x, rot_z
 from drake_dock.docking.geometry.scene import DockingScene
