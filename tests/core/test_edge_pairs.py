@@ -13,7 +13,6 @@ from scipy.integrate import solve_ivp
 from drake_dock.core.couple import evaluate_couple
 from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.kernels.jets import jet, patch_spec
-from drake_dock.core.kernels.tracked import TrackedCouples
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.docking.apds import ApdsGeometry, apds_patches, corner_point
@@ -128,39 +127,6 @@ def test_handover_at_the_tip_corner():
     sol = _track(arc, (t_h, 1.0), u_arc)
     for k, t in enumerate(sol.t):
         np.testing.assert_allclose(_wrap(sol.y[:, k] - arc.exact(t)[0], arc), 0, atol=1e-8)
-
-
-@pytest.mark.parametrize("name", SCENES)
-def test_kernels_equal_the_python_path(name):
-    """The compiled jets (the arc as a CIRCLE, the face as ANNULUS) and couple evaluation equal
-    the Python reference to 1e-12, at the couple and perturbed off it, both sigmas."""
-    s = SCENES[name]()
-    rng = np.random.default_rng(3)
-    for patch in (s.patch1, s.patch2):
-        kind, prm = patch_spec(patch)
-        for _ in range(10):
-            u = patch.lower + rng.random(patch.dim) * patch.span
-            r, T, K = patch.jet(u)
-            got = jet(kind, prm, u[0], u[1] if patch.dim == 2 else 0.0)
-            want = [r, T[0], K[0][0]] if patch.dim == 1 else [r, *T, K[0][0], K[0][1], K[1][1]]
-            got = [got[0], got[1], got[3]] if patch.dim == 1 else [got[0], *got[1:]]
-            np.testing.assert_allclose(np.array(got), np.array(want), rtol=0, atol=1e-15)
-    tc = TrackedCouples([(s.kind, s.patch1, s.patch2, (0, 1))])
-    assert tc.supported
-    for t in (0.1, 0.6):
-        X1, V1, X2, V2 = s.poses(t)
-        R, o = np.array([X1[0], X2[0]]), np.array([X1[1], X2[1]])
-        w, v = np.array([V1[0], V2[0]]), np.array([V1[1], V2[1]])
-        u0 = s.exact(t)[0]
-        for u, sigma in ((u0, 1.0), (u0 + 1e-3 * rng.normal(size=len(u0)), -1.0)):
-            out, _ = tc.evaluate(R, o, w, v, u, np.array([sigma]), np.ones(1, dtype=np.bool_))
-            ref = _evaluate(s, t, u, sigma)
-            got = tc.couple_eval(out, 0)
-            for f in ("u", "udot", "p1", "p2", "n", "ta", "tb", "gap", "vn", "vt", "bias_n",
-                      "bias_t"):
-                want = np.asarray(getattr(ref, f), dtype=float)
-                np.testing.assert_allclose(getattr(got, f), want, rtol=0,
-                                           atol=1e-12 * (1.0 + np.abs(want).max()), err_msg=f)
 
 
 def test_complete_set_names_and_patches(geom):

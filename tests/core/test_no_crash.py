@@ -19,6 +19,7 @@ import pytest
 
 from drake_dock.core.couple import closest_point_conditions, evaluate_couple
 from drake_dock.core.kernels import seek as compiled_seek
+from drake_dock.core.kernels.jets import jet, patch_spec, position
 from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.core.tracking import couple_rate
@@ -410,27 +411,47 @@ def test_finish_at_round_off_far_from_the_origin():
         np.testing.assert_allclose(f.u[1:] - 50.0, X1[1][:2], atol=1e-9)
 
 
-def test_patch_continuation_beyond_the_domain():
-    """Beyond their reach the guide surface holds theta_1 and the guide side holds rho: values
-    continuous across the reach, finite everywhere, and the derivatives there those of the held
-    curve (central differences)."""
+def _kernel_jet(patch, u):
+    """(r, T, K) of the compiled jet (`drake_dock.core.kernels.jets`) in the form of
+    `Patch.jet`."""
+    kind, prm = patch_spec(patch)
+    r, t0, t1, k00, k01, k11 = jet(kind, prm, u[0], u[1] if patch.dim == 2 else 0.0)
+    if patch.dim == 1:
+        return r, (t0,), ((k00,),)
+    return r, (t0, t1), ((k00, k01), (k01, k11))
+
+
+def _kernel_position(patch, u):
+    kind, prm = patch_spec(patch)
+    return np.array(position(kind, prm, u[0], u[1] if patch.dim == 2 else 0.0))
+
+
+@pytest.mark.parametrize("compiled", [False, True], ids=["patch", "kernel"])
+def test_patch_continuation_beyond_the_domain(compiled):
+    """Beyond their reach the guide surface holds theta_1 and the guide side holds rho, in the
+    patches and in the compiled jets alike: values continuous across the reach, finite
+    everywhere, and the derivatives there those of the held curve (central differences)."""
     P = apds_patches(G)
     surf, side = P.surfaces[1], P.sides[2]
+    jet_of = _kernel_jet if compiled else (lambda patch, u: patch.jet(u))
+    pos = _kernel_position if compiled else (lambda patch, u: patch.position(u))
     lo, hi = surf.phi.z_reach
     for z in (lo, hi):
-        a, b = surf.position([0.3, z - 1e-9]), surf.position([0.3, z + 1e-9])
+        a, b = pos(surf, [0.3, z - 1e-9]), pos(surf, [0.3, z + 1e-9])
         assert np.linalg.norm(a - b) < 1e-8
     for s in ([0.3, hi + 0.05], [0.7, lo - 0.3], [-2.0, 0.3], [0.5, 0.6], [3.0, 50.0]):
-        r, T, K = surf.jet(s)
+        r, T, K = jet_of(surf, s)
         assert np.all(np.isfinite(r)) and np.all(np.isfinite(T)) and np.all(np.isfinite(K))
+        np.testing.assert_allclose(r, surf.position(s), atol=1e-15)
         h = 1e-6
         for k in range(2):
             e = np.eye(2)[k] * h
-            fd = (surf.position(np.add(s, e)) - surf.position(np.subtract(s, e))) / (2 * h)
+            fd = (pos(surf, np.add(s, e)) - pos(surf, np.subtract(s, e))) / (2 * h)
             np.testing.assert_allclose(T[k], fd, atol=1e-6)
     # Side 2 (sigma = -1): w = alpha2 - (theta - pi/3) reaches 0 at theta = pi/3 + alpha2.
     for th in (math.pi / 3 + G.alpha2, math.pi / 3 + G.alpha2 + 0.1, math.pi / 3 - 2.0, -40.0):
-        r, T, K = side.jet([th])
+        r, T, K = jet_of(side, [th])
         assert np.all(np.isfinite(r)) and np.all(np.isfinite(T)) and np.all(np.isfinite(K))
-        fd = (side.position([th + 1e-6]) - side.position([th - 1e-6])) / 2e-6
+        np.testing.assert_allclose(r, side.position([th]), atol=1e-15)
+        fd = (pos(side, [th + 1e-6]) - pos(side, [th - 1e-6])) / 2e-6
         np.testing.assert_allclose(T[0], fd, atol=1e-6)
