@@ -139,6 +139,31 @@ def test_arc_seek_bounded(q):
     assert c.interior == inside
 
 
+@pytest.mark.parametrize("r_pt", [0.0, 0.002])
+@pytest.mark.parametrize("m1", MOVING)
+def test_both_orientations_and_the_projection(m1, r_pt):
+    """From the closed-form s 1e-3 off, one projection lands within 1e-5 of it and a second
+    within 1e-10 (Newton on F = t2 . d: quadratic), drift = s - s_state; with sigma = -1 the
+    normal is -d/|d| and the gap -|d| - r (closed form), the rate s' the same as with +1."""
+    point, ring = Point((0.03, -0.02, 0.04), r_pt), Circle(R_C)
+    rng = np.random.default_rng(3)
+    for t in (0.1, 0.45, 0.8):
+        X1, X2, V1, V2 = m1.pose(t), RING.pose(t), m1.twist(t), RING.twist(t)
+        s, dist, n = closed_form(X1[1] + X1[0] @ point.p, *X2)
+        s0 = s + 1e-3 * rng.normal()
+        ev = evaluate_couple("PC", point, X1, V1, ring, X2, V2, [s0], -1.0)
+        assert abs(ev.u[0] - s) < 1e-5 and ev.drift[0] == pytest.approx(ev.u[0] - s0, abs=1e-15)
+        again = evaluate_couple("PC", point, X1, V1, ring, X2, V2, ev.u, -1.0)
+        assert abs(again.u[0] - s) < 1e-10
+        plus = evaluate_couple("PC", point, X1, V1, ring, X2, V2, [s], 1.0)
+        minus = evaluate_couple("PC", point, X1, V1, ring, X2, V2, [s], -1.0)
+        np.testing.assert_allclose(minus.n, -n, atol=1e-12)
+        assert minus.gap == pytest.approx(-dist - r_pt, abs=1e-12)
+        assert plus.gap == pytest.approx(dist - r_pt, abs=1e-12)
+        assert minus.udot[0] == pytest.approx(plus.udot[0], abs=1e-12)
+        assert minus.vn == pytest.approx(-plus.vn, abs=1e-12)
+
+
 def test_scene_corner_pairs_random_poses_raise_only_typed_errors():
     """The 12 corner pairs of `contact.pairs: complete` at seeded random chaser poses (tilt to
     20 deg, offsets to 0.3 m, ring distances -0.2 to 0.4 m, any roll) and with the corner
