@@ -12,12 +12,11 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from drake_dock.core.couple import evaluate_couple
-from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.kernels.jets import jet, patch_spec
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.docking.apds import ApdsGeometry, apds_patches, corner_point
-from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec
+from drake_dock.docking.scene import apds_pairs
 from motions import PosedMotion, check_rates_by_finite_differences
 from edge_scenes import (CORNER, arc_over_cone, rim_over_face, ring_over_arc, ring_over_segment,
                          segment_over_arc, segment_over_segment, tip_handover)
@@ -54,19 +53,18 @@ def _track(scene, t_span, u0, events=None):
 
 @pytest.mark.parametrize("name", SCENES)
 def test_seek_finds_the_closed_form_couple(name):
-    """At t = 0 the seek (Python and compiled) finds the closed-form couple, interior, and the
+    """At t = 0 the seek finds the closed-form couple, interior, and the
     contact-form finish keeps it (a ring over a straight edge crosses it twice at the same
     distance: either couple)."""
     s = SCENES[name]()
     exact = [s.exact(0.0, b) for b in s.branches]
     X1, _, X2, _ = s.poses(0.0)
     P1, P2 = posed(s.patch1, *X1), posed(s.patch2, *X2)
-    for seek in (seek_couple, compiled_seek.seek_couple):
-        c = seek(P1, P2)
-        assert c.interior
-        u, gap = min(exact, key=lambda e: np.abs(_wrap(c.u - e[0], s)).max())[:2]
-        assert c.distance == pytest.approx(gap, abs=1e-12)
-        np.testing.assert_allclose(_wrap(c.u - u, s), 0.0, atol=1e-8)
+    c = seek_couple(P1, P2)
+    assert c.interior
+    u, gap = min(exact, key=lambda e: np.abs(_wrap(c.u - e[0], s)).max())[:2]
+    assert c.distance == pytest.approx(gap, abs=1e-12)
+    np.testing.assert_allclose(_wrap(c.u - u, s), 0.0, atol=1e-8)
     cc = contact_couple(s.kind, s.patch1, X1, s.patch2, X2, c, conditioning_min=1e-10)
     assert cc.usable
     np.testing.assert_allclose(_wrap(cc.u - u, s), 0.0, atol=1e-12)
@@ -245,26 +243,6 @@ def test_complete_set_names_and_patches(geom):
         apds_pairs(geom, "all")
 
 
-@pytest.mark.parametrize("g", [ApdsGeometry(), ApdsGeometry(R=0.9, Rs=0.55, H=0.3,
-                                                            alpha1_deg=50.0, alpha2_deg=25.0)])
-@pytest.mark.parametrize("d", [0.12, 0.02, -0.05])
-def test_complete_pairs_compiled_seek_equals_python(g, d):
-    """The 20 new C-C and C-S pairs, the chaser tilted, offset and at ring distance d: the compiled seek
-    gives the Python seek's distance to 1e-12 and the same interior flag."""
-    poses = {"target_apds": (np.eye(3), np.zeros(3)),
-             "chaser_apds": (rot_vec((0.03, -0.02, 0.01)) @ R_MATCHED,
-                             np.array([0.03, -0.02, d]))}
-    for pr in apds_pairs(g, "complete")[12:]:
-        P1, P2 = posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2])
-        if pr.kind in ("PC", "PS"):     # a point: sought in Python, not compiled
-            assert not compiled_seek.supported(P1, P2)
-            continue
-        assert compiled_seek.supported(P1, P2)
-        ref, got = seek_couple(P1, P2), compiled_seek.seek_couple(P1, P2)
-        assert got.distance == pytest.approx(ref.distance, rel=0, abs=1e-12), pr.name
-        assert got.interior == ref.interior, pr.name
-
-
 def test_tip_arcs_face_the_surfaces_their_pairs_name(geom):
     """A tip arc has a pair with a guide surface of the other APDS exactly when, at some
     relative roll in the scenario's range (-60 to 60 deg), a point of the arc lies over the
@@ -429,8 +407,8 @@ def _tip_tip_exact(geom, tips, j, k, R, p):
 
 def test_tip_tip_pairs_follow_the_closed_form(geom):
     """Each tip-tip pair (C-C, `tip_tip_pairs`) with the chaser level, rolled and offset so
-    that its tip arc crosses the target's over both arcs (seeded search): the seek (Python and
-    compiled) finds the closed-form couple and distance to 1e-12, the normal is along the
+    that its tip arc crosses the target's over both arcs (seeded search): the seek finds the
+    closed-form couple and distance to 1e-12, the normal is along the
     axis, and u* integrated by Eq. (47) along a motion (the chaser closing at 0.05 m/s and
     drifting sideways at 0.02 m/s) equals the closed form to 1e-8."""
     from drake_dock.docking.scene import relative_pose
@@ -451,10 +429,9 @@ def test_tip_tip_pairs_follow_the_closed_form(geom):
         target = (np.eye(3), np.zeros(3))
         (u0, dist), = _tip_tip_exact(geom, P.tips, j, k, *pose(0.0))
         P1, P2 = posed(pr.patch1, *pose(0.0)), posed(pr.patch2, *target)
-        for seek in (seek_couple, compiled_seek.seek_couple):
-            c = seek(P1, P2)
-            assert c.interior and c.distance == pytest.approx(dist, abs=1e-12), pr.name
-            np.testing.assert_allclose(c.u, u0, atol=1e-8)
+        c = seek_couple(P1, P2)
+        assert c.interior and c.distance == pytest.approx(dist, abs=1e-12), pr.name
+        np.testing.assert_allclose(c.u, u0, atol=1e-8)
         twist1 = (np.zeros(3), np.array([0.02, 0.0, -0.05]))
         still = (np.zeros(3), np.zeros(3))
         ev = evaluate_couple("CC", pr.patch1, pose(0.0), twist1, pr.patch2, target, still, u0,

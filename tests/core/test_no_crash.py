@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 
 from drake_dock.core.couple import closest_point_conditions, evaluate_couple
-from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.kernels.jets import jet, patch_spec, position
 from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
 from drake_dock.core.seeking import contact_couple, seek_couple
@@ -225,7 +224,7 @@ def test_ring_nearly_coaxial_over_tip_arcs(gap):
     """A ring's inside circle over the other APDS's tip arcs, of the same radius (Rs = R -
     H cot(alpha1)), coaxial to 0-1e-6 rad: a valley of couples at nearly one distance, whose
     bottom is at an arc end (a tilt of 2e-10 rad at 19.6 mm made the Newton creep along it,
-    50 iterations short of the end). Both seeks converge to the closed-form distance, against
+    50 iterations short of the end). The seek converges to the closed-form distance, against
     the tip arc and against the guide surface it bounds (nearest at its tip arc: the cone
     falls away below it)."""
     rng = np.random.default_rng(int(gap * 1e6))
@@ -240,8 +239,7 @@ def test_ring_nearly_coaxial_over_tip_arcs(gap):
                 X1, X2 = _scene_poses(pair, X_chaser)
                 want = _circle_to_arc(pair.patch1, X1, arc)
                 P1, P2 = posed(pair.patch1, *X1), posed(pair.patch2, *X2)
-                for seek in (seek_couple, compiled_seek.seek_couple):
-                    assert seek(P1, P2).distance == pytest.approx(want, abs=1e-12)
+                assert seek_couple(P1, P2).distance == pytest.approx(want, abs=1e-12)
 
 
 def _plane_normal(curve):
@@ -334,21 +332,18 @@ CREEPING_X2 = ([[0.9994844617295722, 0.028793339321968578, 0.014204026606468355]
 def test_seek_creeping_to_a_near_tangent_crossing():
     """The ring's circle cuts the guide surface next to its edge while nearly osculating it
     (J's smallest singular value 3e-6 of its largest): every Newton start creeps along the
-    valley for about 90 iterations before it converges (more than a limit of 50). Both
-    seeks find a crossing: distance below 1e-12, the circle's points on either side of the
-    couple on opposite sides of the surface's tangent plane; and they agree."""
+    valley for about 90 iterations before it converges (more than a limit of 50). The seek
+    finds a crossing: distance below 1e-12, the circle's points on either side of the couple
+    on opposite sides of the surface's tangent plane."""
     pair = next(p for p in PAIRS if p.name == "cs_Cring_T1")
     X1, X2 = ((np.array(R), np.array(p)) for R, p in (CREEPING_X1, CREEPING_X2))
     P1, P2 = posed(pair.patch1, *X1), posed(pair.patch2, *X2)
-    found = [seek(P1, P2, distance_rtol=1e-7, rtol_beyond=0.02)
-             for seek in (seek_couple, compiled_seek.seek_couple)]
-    for c in found:
-        assert c.distance < 1e-12
-        T = P2.first(c.u2)
-        nrm = np.cross(T[:, 0], T[:, 1])
-        sides = [nrm @ (P1.position(c.u1 + e) - P2.position(c.u2)) for e in (-1e-6, 1e-6)]
-        assert sides[0] * sides[1] < 0
-    assert np.linalg.norm(found[0].p1 - found[1].p1) < 1e-6
+    c = seek_couple(P1, P2, distance_rtol=1e-7, rtol_beyond=0.02)
+    assert c.distance < 1e-12
+    T = P2.first(c.u2)
+    nrm = np.cross(T[:, 0], T[:, 1])
+    sides = [nrm @ (P1.position(c.u1 + e) - P2.position(c.u2)) for e in (-1e-6, 1e-6)]
+    assert sides[0] * sides[1] < 0
 
 
 # ------------------------------------------------------------------- small scenes' patch types
