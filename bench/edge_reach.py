@@ -1,9 +1,10 @@
-"""Which guide sides reach which petal edges of the other APDS (`drake_dock.docking.reach`):
-over seeded random poses (roll -60..60 deg, tilt up to 10 deg, offset up to 0.15 m, ring-face
-distance -0.2..0.45 m), per candidate pair, the poses where its closest couple is interior and
-within 2 cm, the rolls where that happens and the least interior distance found; and whether
-`contact.pairs: complete` declares the pair (`drake_dock.docking.pairs.side_edge_pairs`). The
-tip arcs against the other APDS's tip arcs are swept too (`tip_tip_pairs`).
+"""Which guide sides reach which petal edges of the other APDS
+(`drake_dock.docking.geometry.reach`): over seeded random poses (roll -60..60 deg, tilt up to
+10 deg, offset up to 0.15 m, ring-face distance -0.2..0.45 m), per candidate pair, the poses
+where its closest couple is interior and within 2 cm, the rolls where that happens and the
+least interior distance found; and whether `contact.pairs: complete` declares the pair
+(`drake_dock.docking.geometry.pairs.side_edge_pairs`). The tip arcs against the other APDS's
+tip arcs are swept too (`tip_tip_pairs`).
 
     python bench/edge_reach.py [N]        (default 20000 poses)
 """
@@ -11,13 +12,13 @@ import math
 import sys
 import time
 
-from drake_dock.docking.apds import ApdsGeometry
-from drake_dock.docking.reach import reach_sweep, side_candidates, tip_candidates
-from drake_dock.docking.scene import apds_pairs
+from drake_dock.docking.geometry.reach import reach_sweep, side_candidates, tip_candidates
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.scenario.dimensions import ApdsGeometry
 
 n = int(sys.argv[1]) if len(sys.argv) > 1 else 20000
 g = ApdsGeometry()
-declared = {p.name for p in apds_pairs(g, "complete")}
+declared = {p.name for p in DockingScene(g, "complete").pairs}
 t0 = time.perf_counter()
 rows = reach_sweep(g, side_candidates(g) + tip_candidates(g), n)
 print(f"{n} poses, {len(rows)} candidate pairs, {time.perf_counter() - t0:.1f} s")

@@ -18,9 +18,10 @@ import sys
 import time
 
 from drake_dock.core.kernels.prepare import warm
-from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE, load_scenario
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import PlacementCache, place
+from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE, load_scenario
 from drake_dock.systems.contact_system import RigidContactSystem
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -44,8 +45,9 @@ def timed_run(scenario, duration):
 
     RigidContactSystem._calc_eval = clocked
     try:
-        dd = build_docking_diagram(scenario)
-        r = simulate(scenario, dd=dd, duration=duration)
+        dd = build_docking_diagram(DiagramSpec.of(scenario))
+        r = simulate(scenario, place(scenario, PlacementCache(dd.scene)), dd=dd,
+                     duration=duration)
     finally:
         RigidContactSystem._calc_eval = calc
     return r, spent[0]
@@ -63,7 +65,7 @@ def main():
     empty = empty_leaf_cost(scenes[0][1].simulator_config.integration_scheme)
     print(f"empty Python LeafSystem: {empty * 1e6:.1f} us per evaluation")
     for name, scenario, duration in scenes:
-        simulate(scenario, duration=0.01)        # loads every kernel and Drake's code once
+        simulate(scenario, place(scenario), duration=0.01)   # every kernel and Drake's code
         r, spent = timed_run(scenario, duration)
         n = r.evaluations
         u = spent / n

@@ -1,4 +1,4 @@
-"""The floors the bench scripts print (`target_floor.py`, `paper_example.py`,
+"""The floors the bench scripts print (`target_floor.py`, `paper_example.py`, `evaluation.py`,
 `offnominal.py`): the same plant integrated by Drake without contact, and the least a
 Python LeafSystem costs per derivative evaluation in Drake's simulator."""
 import time
@@ -6,7 +6,7 @@ import time
 from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder, LeafSystem
 
-from drake_dock.docking.plant import add_docking_plant, set_initial_state
+from drake_dock.docking.model.plant import PlantSpec, add_docking_plant, set_initial_state
 from drake_dock.systems.simulator import make_simulator
 
 
@@ -14,7 +14,7 @@ def free_flight(scenario, state, t_end):
     """Wall seconds and derivative evaluations of the scenario's plant alone (free flight with
     the Stewart element, no contact) from ``state`` to ``t_end`` with its `SimulatorConfig`."""
     builder = DiagramBuilder()
-    dp = add_docking_plant(builder, scenario)
+    dp = add_docking_plant(builder, PlantSpec.of(scenario))
     diagram = builder.Build()
     sim = make_simulator(diagram, scenario.simulator_config, lambda root: set_initial_state(
         dp, dp.plant.GetMyMutableContextFromRoot(root), state))

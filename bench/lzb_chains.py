@@ -22,9 +22,9 @@ import time
 import numpy as np
 
 from drake_dock.core.lzb.inputs import check_inputs, per_couple
-from drake_dock.core.lzb.solve import solve_lzb
-from drake_dock.core.lzb.problem import ImpactProblem
 from drake_dock.core.lzb.limit import continuous_limit_chain
+from drake_dock.core.lzb.problem import ImpactProblem
+from drake_dock.core.lzb.solve import solve_lzb
 
 E_GRID = (0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0)
 
@@ -138,13 +138,13 @@ def paper_example_impacts():
     """The paper example's impacts (recorded from a run) solved by both, and the example run
     with the compiled LZB on and off."""
     import dataclasses
-    from drake_dock.docking.diagram import build_docking_diagram
-    from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
-    from drake_dock.docking.scene import initial_state
-    from drake_dock.docking.simulate import simulate
+    from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+    from drake_dock.docking.model.simulate import simulate
+    from drake_dock.docking.placement.place import place
+    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
     from drake_dock.systems import transitions
     scenario = load_scenario(PAPER_EXAMPLE)
-    state = initial_state(scenario)
+    state = place(scenario)
     calls = []
 
     def recorder(*args, **kw):
@@ -152,7 +152,7 @@ def paper_example_impacts():
         return solve_lzb(*args, **kw)
     transitions.solve_lzb = recorder
     try:
-        dd = build_docking_diagram(scenario)
+        dd = build_docking_diagram(DiagramSpec.of(scenario))
         simulate(scenario, state=state, dd=dd)
     finally:
         transitions.solve_lzb = solve_lzb
@@ -170,10 +170,10 @@ def paper_example_impacts():
     runs = {}
     for on in (False, True):
         opts = dataclasses.replace(dd.contact.options, lzb_compiled=on)
-        simulate(scenario, state=state, dd=build_docking_diagram(scenario, options=opts))
+        simulate(scenario, state, dd=build_docking_diagram(DiagramSpec.of(scenario, options=opts)))
         walls = []
         for _ in range(3):
-            d = build_docking_diagram(scenario, options=opts)
+            d = build_docking_diagram(DiagramSpec.of(scenario, options=opts))
             t0 = time.perf_counter()
             res = simulate(scenario, state=state, dd=d)
             walls.append(time.perf_counter() - t0)

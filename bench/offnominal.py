@@ -1,5 +1,4 @@
-"""The off-nominal conditions of the conditions sweep, drake_dock side by side with Drake's own
-plant, measured in one run.
+"""The conditions sweep's first conditions, drake_dock against the plant alone, in one run.
 
 For the first ``--runs`` random conditions of `drake-dock study conditions` (its seed, order and
 contact set; the paper example's scenario unless one is given), prints per run drake_dock's
@@ -19,9 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from drake_dock.core.kernels.prepare import warm
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.docking.scene import initial_state
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.errors import DrakeDockError
 from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
 
@@ -40,15 +39,15 @@ def main():
     plan = ConditionsPlan(random=a.runs, corners=0)
     base = load_scenario(a.scenario)
     base.contact.pairs = plan.pairs
-    simulate(base, duration=0.01)               # loads every kernel and Drake's code once
+    simulate(base, place(base), duration=0.01)  # loads every kernel and Drake's code once
     rows = []
     print(f"{'condition':<11} {'outcome':<9} {'sim s':>6} {'evals':>7} {'drake_dock s':>13} "
           f"{'plant s':>8} {'ratio':>7}")
     for name, cond in conditions(plan):
         s = with_condition(base, cond)
         try:
-            state = initial_state(s)
-            r = simulate(s, state=state)
+            state = place(s)
+            r = simulate(s, state)
         except DrakeDockError as e:
             print(f"{name:<11} error: {type(e).__name__} (left out)")
             continue

@@ -20,18 +20,19 @@ from unittest import mock
 
 import numpy as np
 
-from drake_dock.docking import pairs as pair_sets
-from drake_dock.docking.pairs import cost_by_pair_type
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.geometry import pairs as pair_sets
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.report.cost import cost_by_pair_type
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
 
 LEFT_OUT = ("petal corner / guide surface", "tip arc / tip arc", "petal corner / tip land")
 
 
-def run(s):
+def run(s, state):
     t0 = time.perf_counter()
-    r = simulate(s)
+    r = simulate(s, state)
     return r, time.perf_counter() - t0
 
 
@@ -44,15 +45,16 @@ def main(argv=None):
     ratios = []
     warm = with_condition(base, conditions(ConditionsPlan())[0][1])
     warm.simulation.duration = 0.05
-    simulate(warm)
+    simulate(warm, place(warm))
     for name, cond in conditions(ConditionsPlan())[:args.conditions]:
         s = with_condition(base, cond)
-        full, wall_full = run(s)
+        state = place(s)                    # with the complete set, for both runs
+        full, wall_full = run(s, state)
         with mock.patch.object(pair_sets, "corner_surface_pairs", lambda *a, **k: []), \
                 mock.patch.object(pair_sets, "tip_tip_pairs", lambda *a, **k: []), \
                 mock.patch.object(pair_sets, "corner_land_pairs", lambda *a, **k: []):
-            less, wall_less = run(s)
-        costs = cost_by_pair_type(full.timing)
+            less, wall_less = run(s, state)
+        costs = cost_by_pair_type(full.timing, full.scene)
         seeks = {t: costs[t]["seeks"] for t in LEFT_OUT if t in costs}
         per = [wall / r.evaluations for wall, r in ((wall_full, full), (wall_less, less))]
         ratios.append(per[0] / per[1])

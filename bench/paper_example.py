@@ -1,4 +1,6 @@
-"""Wall time of the paper's example (Sect. 8.2) to capture, build excluded, side by side with
+"""Wall time of the paper's example to capture, against the plant alone, and its targets.
+
+The paper's example (Sect. 8.2) to capture, build excluded, side by side with
 the same plant integrated by Drake alone (free flight with the Stewart element, no contact) over
 the same simulated time and with the same integrator settings. Prints the wall time (the
 median of ``--repeats`` identical runs on fresh diagrams, each printed), the real-time factor (simulated s per wall s), the derivative evaluations and the share of them
@@ -11,9 +13,11 @@ times; and, per evaluation, drake_dock's time against the plant's own and an emp
 LeafSystem's. Also the set-up (the initial state: the first-contact
 placement, its seeks, and their number; and that of another approach of the same geometry)
 and the kernels' cold and warm start (a fresh process that compiles them into an empty cache
-directory, then one that loads them from it).
+directory, then one that loads them from it). Then the targets, each `met` or `NOT met`: the
+ratio to the plant alone <= 10x (5x the aim), the set-up <= 0.02 s, under 0.5 s of wall time.
 
-    python bench/paper_example.py [SCENARIO.yaml]
+    python bench/paper_example.py [SCENARIO.yaml] [--repeats 5] [--coarse-step 0.01]
+        [--compare-scheme bogacki_shampine3] [--skip-plain] [--skip-cold]
 """
 import argparse
 import copy
@@ -26,11 +30,13 @@ import time
 
 import numpy as np
 
-from drake_dock.docking.diagram import build_docking_diagram
 from drake_dock.core.kernels.prepare import warm
-from drake_dock.docking.scene import contact_approach, first_contact_seeks, initial_state
-from drake_dock.docking.simulate import simulate
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import PlacementCache, contact_approach, place
+from drake_dock.docking.placement.search import first_contact
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from floors import empty_leaf_cost, free_flight  # noqa: E402  (a sibling bench module)
@@ -69,19 +75,20 @@ def main():
     scenario = load_scenario(args.scenario)
     warm()      # the kernels loaded (their start is measured above), the set-up on its own
     t0 = time.perf_counter()
-    state = initial_state(scenario)
+    scene = DockingScene.of(scenario)
+    cache = PlacementCache(scene)
+    state = place(scenario, cache)
     t_state = time.perf_counter() - t0
-    # The set-up of another approach of the same geometry (the roll 1 deg more): the pairs'
-    # covers and coarse grids are kept per geometry, as for the next condition of a sweep.
+    # The set-up of another approach of the same scene (the roll 1 deg more), on the same
+    # cache: the pairs' covers and coarse grids are kept on the scene's patches.
     other_roll = copy.deepcopy(scenario)
     other_roll.initial.target_yaw_deg += 1.0
     t0 = time.perf_counter()
-    initial_state(other_roll)
+    place(other_roll, cache)
     t_state_warm = time.perf_counter() - t0
-    seeks = first_contact_seeks(scenario.geometry, contact_approach(scenario)[0],
-                                which=scenario.contact.pairs)
+    seeks = first_contact(cache, contact_approach(scenario, cache)[0]).seeks
     t0 = time.perf_counter()
-    dd = build_docking_diagram(scenario)
+    dd = build_docking_diagram(DiagramSpec.of(scenario, scene=scene))
     t_build = time.perf_counter() - t0
     steps = []
     r = simulate(scenario, state=state, dd=dd,
@@ -90,7 +97,7 @@ def main():
     iso = int(de[de > 50].sum())
     # The same run again on fresh diagrams: the wall time is the median of the runs (the first
     # run in a process also pays Python's warm-up; the machines are shared and noisy).
-    runs = [r] + [simulate(scenario, state=state, dd=build_docking_diagram(scenario))
+    runs = [r] + [simulate(scenario, state, dd=build_docking_diagram(DiagramSpec.of(scenario)))
                   for _ in range(args.repeats - 1)]
     if any(x.capture_time != r.capture_time or x.evaluations != r.evaluations for x in runs):
         raise SystemExit("repeated runs differ: the simulation is not deterministic")
@@ -98,22 +105,23 @@ def main():
     wall = float(np.median(walls))
     t_free, n_free = free_flight(scenario, state, r.end_time)
     t_leaf = empty_leaf_cost(scenario.simulator_config.integration_scheme)
-    py = simulate(scenario, state=state, dd=build_docking_diagram(
-        scenario, options=dataclasses.replace(dd.contact.options, lzb_compiled=False)))
+    reference_lzb = dataclasses.replace(dd.contact.options, lzb_compiled=False)
+    py = simulate(scenario, state, dd=build_docking_diagram(
+        DiagramSpec.of(scenario, options=reference_lzb)))
     plain = None
     if not args.skip_plain:
-        dd2 = build_docking_diagram(scenario)
+        dd2 = build_docking_diagram(DiagramSpec.of(scenario))
         plain = simulate(scenario, state=state, dd=dd2, witness_approach=False)
     coarse = None
     if args.coarse_step > 0:
         sc2 = copy.deepcopy(scenario)
         sc2.simulator_config.max_step_size = args.coarse_step
-        coarse = simulate(sc2, state=state, dd=build_docking_diagram(sc2))
+        coarse = simulate(sc2, state=state, dd=build_docking_diagram(DiagramSpec.of(sc2)))
     other = None
     if args.compare_scheme and args.compare_scheme != scenario.simulator_config.integration_scheme:
         sc3 = copy.deepcopy(scenario)
         sc3.simulator_config.integration_scheme = args.compare_scheme
-        other = simulate(sc3, state=state, dd=build_docking_diagram(sc3))
+        other = simulate(sc3, state=state, dd=build_docking_diagram(DiagramSpec.of(sc3)))
     print(f"scenario: {args.scenario}")
     if starts is not None:
         print(f"compiled kernels: cold start {starts[0]:.2f} s (compiling into an empty cache), "

@@ -1,6 +1,6 @@
 """What the two interpenetration checks cost over one run: the scenario is simulated once, then
-the analytic check (`drake_dock.docking.penetration`) and the triangle-mesh check
-(`drake_dock.docking.mesh_check`, its meshes built afresh and counted) each go over the run's
+the analytic check (`drake_dock.docking.checks.penetration`) and the triangle-mesh check
+(`drake_dock.docking.checks.mesh_check`, its meshes built afresh and counted) each go over the run's
 timeseries. Prints the run's samples and wall time, each check's wall time and deepest
 crossing, and the mesh check's time over the analytic one's.
 
@@ -9,11 +9,12 @@ crossing, and the mesh check's time over the analytic one's.
 import argparse
 import time
 
-from drake_dock.docking.mesh_check import apds_meshes, deepest_penetration_mesh
-from drake_dock.docking.penetration import deepest_penetration
-from drake_dock.docking.results import timeseries
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.checks.mesh_check import apds_meshes, deepest_penetration_mesh
+from drake_dock.docking.checks.penetration import deepest_penetration
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.report.results import timeseries
+from drake_dock.docking.scenario.loading import load_scenario
 
 
 def main(argv=None):
@@ -23,7 +24,7 @@ def main(argv=None):
     args = ap.parse_args(argv)
     s = load_scenario(args.scenario)
     t0 = time.perf_counter()
-    ts = timeseries(simulate(s, duration=args.duration))
+    ts = timeseries(simulate(s, place(s), duration=args.duration))
     print(f"run: {len(ts['t'])} samples to t = {ts['t'][-1]:.3f} s, "
           f"{time.perf_counter() - t0:.1f} s", flush=True)
     run_args = (s.geometry, ts["t"], ts["R_WA"], ts["p_WA"], ts["apds_names"].tolist())

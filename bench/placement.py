@@ -1,14 +1,15 @@
-"""What the placement (`initial_state`: the first contact of the scenario's contact set on a
-straight approach, the consistent aim with a lateral velocity, and the independent check of the
-path down to it) costs: the paper example, and the first ``--conditions`` conditions of
+"""What the placement (`place`: the first contact of the scenario's contact set on a straight
+approach, the consistent aim with a lateral velocity, and the independent check of the path
+down to it) costs: the paper example, and the first ``--conditions`` conditions of
 `drake-dock study conditions` (seed 2026, inside the IDSS box; 75 for all but the first), with
-the contact set ``--pairs`` (`complete`, or `paper` as the IDSS campaign plan). Per placement
-it prints the wall time, the first-contact searches it ran (its memo's hits not counted; those
-of a bracket among some pairs, and those stopped at a height, `_among_height`, also apart) and
-their time, and the path check's time; then one search alone on each final approach (the
-searches' memo cleared), and, for a placement whose bracket is closed among some pairs, the
-same placement with the bracket closed with the whole set; then the medians. A first placement
-loads the compiled kernels and is not counted.
+the contact set ``--pairs`` (`complete`, as the IDSS envelope plan, or `paper`). Per placement
+(on a fresh `PlacementCache` of the scenario's scene) it prints the wall time, the
+first-contact searches it ran (those its cache served not counted; those of a bracket among
+some pairs, and those stopped at a height, `_among_height`, also apart) and their time, and
+the path check's time; then one search alone on each final approach (on a fresh cache), and,
+for a placement whose bracket is closed among some pairs, the same placement with the bracket
+closed with the whole set; then the medians. A first placement loads the compiled kernels and
+is not counted.
 
     python bench/placement.py [--conditions 12] [--pairs complete|paper]
 """
@@ -18,48 +19,52 @@ from unittest import mock
 
 import numpy as np
 
-from drake_dock.docking import path_check, scene, search
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.placement import aim, path_check, search
+from drake_dock.docking.placement.place import PlacementCache, contact_approach, place
+from drake_dock.docking.placement.search import first_contact
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
 
 
 class _Timed:
-    """Wraps f: its calls and their wall time; for the memoised search, the searches it ran
-    with the whole set, among some pairs (its sixth argument) and stopped at a travel (its
-    seventh), its memo's hits not counted."""
+    """Wraps f: its calls and their wall time; for the search (`search._search`: scene,
+    approach, among, stop, step, xtol), the searches with the whole set, among some pairs and
+    stopped at a travel."""
 
     def __init__(self, f):
         self.f, self.calls, self.wall = f, 0, 0.0
         self.whole = self.among = self.stopped = 0
 
     def __call__(self, *args, **kwargs):
-        misses = self.f.cache_info().misses if hasattr(self.f, "cache_info") else None
         t0 = time.perf_counter()
         try:
             return self.f(*args, **kwargs)
         finally:
             self.calls += 1
             self.wall += time.perf_counter() - t0
-            if misses is not None and self.f.cache_info().misses > misses:
-                if len(args) > 5 and args[5] is not None:
+            if len(args) == 6:
+                if args[2] is not None:
                     self.among += 1
-                elif len(args) > 6 and args[6] is not None:
+                elif args[3] is not None:
                     self.stopped += 1
                 else:
                     self.whole += 1
 
 
+def _cache(s):
+    return PlacementCache(DockingScene.of(s))
+
+
 def _whole_set_bracket(s):
     """The placement's wall time and searches with the bracket closed with the whole set
-    (`_bracketed_height` for `_among_height`), the searches' and the path check's memos
-    cleared."""
-    search._first_contact.cache_clear()
-    path_check._checked.cache_clear()
-    timed = _Timed(search._first_contact)
-    with mock.patch.object(search, "_first_contact", timed), \
-            mock.patch.object(scene, "_among_height", scene._bracketed_height):
+    (`_bracketed_height` for `_among_height`), on a fresh cache."""
+    timed = _Timed(search._search)
+    cache = _cache(s)
+    with mock.patch.object(search, "_search", timed), \
+            mock.patch.object(aim, "_among_height", aim._bracketed_height):
         t0 = time.perf_counter()
-        scene.initial_state(s)
+        place(s, cache)
         wall = time.perf_counter() - t0
     return wall, timed.whole + timed.among + timed.stopped
 
@@ -72,24 +77,23 @@ def main(argv=None):
     base = load_scenario(PAPER_EXAMPLE)
     base.contact.pairs = args.pairs
     plan = conditions(ConditionsPlan())
-    scene.initial_state(with_condition(base, plan[0][1]))            # kernels loaded
+    place(with_condition(base, plan[0][1]))                          # kernels loaded
     cases = [("paper example", base)] + [(n, with_condition(base, c))
                                          for n, c in plan[1:1 + args.conditions]]
     totals, checks, alone, counts = [], [], [], []
     for name, s in cases:
-        cached = search._first_contact
-        cached.cache_clear()
-        timed, check = _Timed(cached), _Timed(path_check._crossing)
-        with mock.patch.object(search, "_first_contact", timed), \
+        cache = _cache(s)
+        timed, check = _Timed(search._search), _Timed(path_check._crossing)
+        with mock.patch.object(search, "_search", timed), \
                 mock.patch.object(path_check, "_crossing", check):
             t0 = time.perf_counter()
-            scene.initial_state(s)
+            place(s, cache)
             total = time.perf_counter() - t0
         searches = timed.whole + timed.among + timed.stopped
-        approach = scene.contact_approach(s)[0]
-        search._first_contact.cache_clear()
+        approach = contact_approach(s, cache)[0]
+        fresh = _cache(s)
         t0 = time.perf_counter()
-        scene.first_contact_or_faces(s.geometry, approach, s.contact.pairs)
+        first_contact(fresh, approach)
         one = time.perf_counter() - t0
         totals.append(total)
         counts.append(searches)

@@ -2,7 +2,8 @@
 
 For each metric: the fastest coarse compliant configuration (point contact, SAP at the coarse
 steps a Drake user tries first) within the tolerance of the rigid reference, the drake_dock
-wall time 10x would need, and that time against two floors measured here:
+wall time 10x would need, and that time against drake_dock's run and a floor, both measured
+here:
 
 - drake_dock's fastest run within the tolerance (accuracy 1e-3, step cap 0.01 s; median of
   ``--repeats`` identical runs) and its derivative evaluations;
@@ -14,7 +15,7 @@ wall time 10x would need, and that time against two floors measured here:
 Errors are relative to each metric's contact effect, as in the study
 (`drake_dock.studies.docking_metrics`).
 
-    python bench/target_floor.py [--repeats 5]
+    python bench/target_floor.py [--repeats 5] [--tolerance 1e-3]
 """
 import argparse
 import copy
@@ -23,11 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.compliant import (CompliantConfig, hunt_crossley_dissipation,
                                           run_compliant)
-from drake_dock.docking.scene import initial_state
-from drake_dock.docking.simulate import simulate
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.docking_metrics import (METRICS, compliant_metrics, contact_effect,
                                                 errors, rigid_metrics, scene_start)
 
@@ -42,7 +43,7 @@ def main():
     args = ap.parse_args()
     tol = args.tolerance
     scenario = load_scenario(PAPER_EXAMPLE)
-    state = initial_state(scenario)
+    state = place(scenario)
     start = scene_start(scenario, state)
     sc = copy.deepcopy(scenario)
     sc.simulator_config.accuracy = 1e-8

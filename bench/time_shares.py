@@ -27,12 +27,14 @@ def docking(name, path, pairs):
     """A docking scene with the contact set ``pairs``; the wall time per simulated second, as
     the two sets first close at different ring distances (docs/model.md)."""
     import yaml
-    from drake_dock.docking.scenario import load_scenario
-    from drake_dock.docking.simulate import simulate
+    from drake_dock.docking.model.simulate import simulate
+    from drake_dock.docking.placement.place import place
+    from drake_dock.docking.scenario.loading import load_scenario
     with open(path) as f:
         data = yaml.safe_load(f)
     data.setdefault("contact", {})["pairs"] = pairs
-    r = simulate(load_scenario(data=yaml.safe_dump(data)))
+    s = load_scenario(data=yaml.safe_dump(data))
+    r = simulate(s, place(s))
     print(f"{name}, {pairs} ({r.timing['pairs_declared']} pairs): {time_shares_line(r.timing)};"
           f" wall {r.wall_time:.3f} s for {r.end_time:.4f} s simulated "
           f"({r.wall_time / r.end_time:.2f} s/s, {r.evaluations} evaluations, {r.outcome})")
@@ -40,7 +42,7 @@ def docking(name, path, pairs):
 
 def main(argv=None):
     import argparse
-    from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE
+    from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true", help="the paper example only")
     args = ap.parse_args(argv)

@@ -6,7 +6,8 @@ Layers, each importing only the ones below it:
   rules of a pair, LZB in `core.lzb`); numpy and scipy only.
 - `drake_dock.systems`: the Drake boundary (the contact LeafSystem, the simulator, witness step
   control).
-- `drake_dock.docking`: the docking scene (scenario, APDS geometry, plant, diagram, outputs).
+- `drake_dock.docking`: the docking scene, in wings (scenario, geometry, checks, model,
+  placement, report: its docstring gives their order).
 - `drake_dock.studies`: small scenes, the compliant baseline, the speed-accuracy and stability
   studies.
 - `drake_dock.run` and `drake_dock.cli` on top.

@@ -36,8 +36,8 @@ import warnings
 from pathlib import Path
 
 from drake_dock import __version__
+from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE
 from drake_dock.errors import MISSING, DrakeDockError, InputError
-from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE
 
 FUNNEL = MODELS_DIR / "apds_funnel.yaml"
 
@@ -100,7 +100,7 @@ class ProgressBar:
 
     def __call__(self, t, t_end, fraction=None):
         """``fraction``: how far the run is (the rings' way towards capture or the time
-        towards the timeout, `drake_dock.docking.outcome.progress_fraction`); t / t_end if
+        towards the timeout, `drake_dock.docking.model.outcome.progress_fraction`); t / t_end if
         not given."""
         frac = min(max(t / t_end if fraction is None else fraction, 0.0), 1.0)
         step = int(frac * (100 if self.tty else 10))
@@ -227,10 +227,11 @@ def main(argv=None) -> int:
     if args.command == "campaign":
         return _campaign(args)
     # Imported here so that `--help` stays fast.
-    from drake_dock.docking.output import check_destination
+    from drake_dock.docking.report.out_dir import check_destination
+    from drake_dock.docking.scenario.loading import load_scenario
+    from drake_dock.docking.scenario.loading import scenario_yaml
+    from drake_dock.docking.scenario.validation import validate
     from drake_dock.run import format_summary, run
-    from drake_dock.docking.scenario import load_scenario, validate
-    from drake_dock.docking.scenario import scenario_yaml
 
     def scenario():
         s = load_scenario(args.scenario)
@@ -299,8 +300,8 @@ def _failed(code, kind, e, caught, finish) -> int:
 
 
 def _study(args) -> int:
-    from drake_dock.docking.output import check_destination
-    from drake_dock.docking.scenario import load_scenario
+    from drake_dock.docking.report.out_dir import check_destination
+    from drake_dock.docking.scenario.loading import load_scenario
     if args.which == "conditions":
         from drake_dock.studies.conditions import ConditionsPlan as Plan
         from drake_dock.studies.conditions import run_conditions as run_plan

@@ -2,6 +2,8 @@
 (input), or the time and the couple (numerical failure)."""
 from __future__ import annotations
 
+import contextlib
+
 
 class DrakeDockError(Exception):
     """Base class of every error raised on purpose by drake_dock."""
@@ -74,3 +76,21 @@ class SingularContactError(NumericalError):
 class SingularCoupleError(NumericalError):
     """The tracking Jacobian J of a couple is singular (Eq. 39 fails or the couple is not
     isolated): the couple must end, be handed over or be re-sought."""
+
+
+@contextlib.contextmanager
+def numerical_failure(what: str, where):
+    """Any failure but drake_dock's typed errors becomes a `NumericalError` at ``where() ->
+    (time, couples)``, naming the exception: Drake's integrator (a step below its minimum,
+    ...), the arithmetic of extreme values (overflow, NaN: Drake refuses non-finite states; a
+    C++ failure inside a Python callback arrives as SystemExit carrying its message)."""
+    try:
+        yield
+    except DrakeDockError:
+        raise
+    except (Exception, SystemExit) as e:
+        if isinstance(e, SystemExit) and not isinstance(e.code, str):
+            raise
+        time, couples = where()
+        raise NumericalError(f"{what} failed ({type(e).__name__}: {e})", time=time,
+                             couples=couples) from e

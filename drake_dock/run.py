@@ -5,53 +5,32 @@ during the run, which are kept off the terminal, but for the replay's Meshcat st
 (`QUIET`); without other lines no drake.log is written.
 
 A failed run (bad input, numerical failure) leaves no directory, or the previous complete one
-untouched (`drake_dock.docking.output.atomic_directory`). The destination is checked before anything is
-simulated (`drake_dock.docking.output.check_destination`): only a new path, an empty directory or a
-previous drake_dock output is replaced.
+untouched (`drake_dock.docking.report.out_dir.atomic_directory`). The destination is checked before
+anything is simulated (`drake_dock.docking.report.out_dir.check_destination`): only a new path, an
+empty directory or a previous drake_dock output is replaced.
 """
 from __future__ import annotations
 
 import contextlib
-import io
 import json
 import logging
 from types import SimpleNamespace
 
 import numpy as np
 
-from drake_dock.docking.replay import replay_html
-from drake_dock.docking.pairs import scenario_pairs
-from drake_dock.docking.results import (momenta, momentum_reference_point, near_timeseries,
-                                        relative_text, run_cost, summary, thrust_impulses,
-                                        timeseries)
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import PlacementCache, place
+from drake_dock.docking.report.cost import run_cost
+from drake_dock.docking.report.initial_figure import initial_configuration_figure
+from drake_dock.docking.report.out_dir import atomic_directory, check_destination, npz_bytes
+from drake_dock.docking.report.replay import replay_html
+from drake_dock.docking.report.results import (momenta, momentum_reference_point, near_timeseries,
+                                               non_finite_key, relative_text, summary,
+                                               thrust_impulses, timeseries)
+from drake_dock.docking.report.run_figures import run_figures
 from drake_dock.errors import NumericalError
-from drake_dock.docking.figures import run_figures
-from drake_dock.docking.initial_figure import initial_configuration_figure
-from drake_dock.docking.output import atomic_directory, check_destination
-
-
-def _npz_bytes(arrays: dict) -> bytes:
-    """np.savez_compressed into memory. Zip entries carry a fixed timestamp, so equal arrays
-    give equal bytes (bitwise reproducible files)."""
-    buf = io.BytesIO()
-    np.savez_compressed(buf, **arrays)
-    return buf.getvalue()
-
-
-def _non_finite(node, path=""):
-    """The dotted key of the first non-finite number in a summary, or None."""
-    if isinstance(node, dict):
-        items = node.items()
-    elif isinstance(node, (list, tuple)):
-        items = enumerate(node)
-    else:
-        return (path or "value") if isinstance(node, float) and not np.isfinite(node) else None
-    for k, v in items:
-        bad = _non_finite(v, f"{path}.{k}" if path else str(k))
-        if bad is not None:
-            return bad
-    return None
 
 
 # Lines Drake logs that say nothing about the run: the address of the Meshcat server that
@@ -86,24 +65,30 @@ def run(scenario, out_dir, *, progress=None, state=None, dd=None, full=False, na
     """Simulates ``scenario`` and writes everything into ``out_dir``; returns the summary, or
     with ``full`` a namespace (summary, cost, timeseries, result: the `RunResult`, figures: the
     `FigureRecord`s). ``name``: the scenario's name in the outputs (its file name without
-    extension, say; default "scenario"). ``dd``: a docking Diagram built by the caller (with a controller on
-    ``chaser_wrench``, say; `drake_dock.docking.simulate.simulate`). Raises `InputError` for a
-    destination that may not be replaced, before simulating, and `NumericalError` for a failed
-    simulation or a non-finite summary value (nothing written)."""
+    extension, say; default "scenario"). ``dd``: a docking Diagram built by the caller (with a
+    controller on ``chaser_wrench``, say; `drake_dock.docking.model.control`); ``state``: an
+    initial state (by default the scenario's, `drake_dock.docking.placement.place.place`).
+    The scene is made once (`DockingScene`, or the one of ``dd``) and serves the placement,
+    the Diagram and the report. Raises `InputError` for a destination that may not be
+    replaced, before simulating, and `NumericalError` for a failed simulation or a non-finite
+    summary value (nothing written)."""
     check_destination(out_dir)
     with drake_log() as log:
         return _run(scenario, out_dir, progress, state, dd, full, log, name or "scenario")
 
 
 def _run(scenario, out_dir, progress, state, dd, full, log, name):
-    result = simulate(scenario, progress=progress, state=state, dd=dd)
+    scene = DockingScene.of(scenario) if dd is None else dd.scene
+    state = state or place(scenario, PlacementCache(scene))
+    dd = dd or build_docking_diagram(DiagramSpec.of(scenario, scene=scene))
+    result = simulate(scenario, state, dd=dd, progress=progress)
     if hasattr(progress, "note"):
         progress.note(f"{result.outcome} at t = {result.end_time:.4f} s; writing the outputs "
                       f"(arrays, figures, replay)")
     ts = timeseries(result)
     summ = {"scenario_name": name, **summary(result, ts)}
     cost = run_cost(result, ts)
-    bad = _non_finite(summ)
+    bad = non_finite_key(summ)
     if bad is not None:
         raise NumericalError(f"the run's summary value {bad} is not finite (an overflow of "
                              f"extreme inputs)", time=result.end_time)
@@ -113,16 +98,16 @@ def _run(scenario, out_dir, progress, state, dd, full, log, name):
     J, H = thrust_impulses(result, ts, about)       # conserved: momentum less the impulse
     momentum = (P - J, L - H, sP, sL)
     nq = result.dd.dp.plant.num_positions()
-    html = replay_html(scenario, ts["t"], np.asarray(result.record.x)[:, :nq], ts=ts, title=name)
+    html = replay_html(dd.spec, ts["t"], np.asarray(result.record.x)[:, :nq], ts=ts, title=name)
     with atomic_directory(out_dir) as tmp:
-        (tmp / "timeseries.npz").write_bytes(_npz_bytes(near_timeseries(ts)))
-        records = run_figures(ts, summ, momentum, tmp, pairs=scenario_pairs(scenario))
+        (tmp / "timeseries.npz").write_bytes(npz_bytes(near_timeseries(ts)))
+        records = run_figures(ts, summ, momentum, tmp, pairs=scene.pairs)
         poses = {n: (ts["R_WA"][0, j], ts["p_WA"][0, j])
                  for j, n in enumerate(ts["apds_names"].tolist())}
         cn = ts["couple_names"].tolist()
         first = {c: SimpleNamespace(p1=ts["p1_W"][0, cn.index(c)], p2=ts["p2_W"][0, cn.index(c)])
                  for c in result.initial.closing_pairs}
-        records.append(initial_configuration_figure(scenario.geometry, poses, first, tmp))
+        records.append(initial_configuration_figure(scene, poses, first, tmp))
         summ = {**{k: v for k, v in summ.items() if k != "scenario"},
                 "figures": [r.name for r in records], "scenario": summ["scenario"]}
         (tmp / "replay.html").write_text(html)

@@ -4,13 +4,13 @@ import pytest
 
 @pytest.fixture(scope="session")
 def paper_scenario():
-    from drake_dock.docking.scenario import load_scenario
+    from drake_dock.docking.scenario.loading import load_scenario
     return load_scenario()
 
 
 @pytest.fixture(scope="session")
 def geom():
-    from drake_dock.docking.apds import ApdsGeometry
+    from drake_dock.docking.scenario.dimensions import ApdsGeometry
     return ApdsGeometry().validate()
 
 
@@ -22,7 +22,7 @@ def box_corner(tmp_path_factory):
     """The off-axis corner of the IDSS box (`models/idss_box_corner.yaml`), its first
     BOX_CORNER_SECONDS run once for the session with `drake_dock.run.run`: (the full namespace,
     the output directory)."""
-    from drake_dock.docking.scenario import MODELS_DIR, load_scenario
+    from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
     from drake_dock.run import run
     scenario = load_scenario(MODELS_DIR / "idss_box_corner.yaml")
     scenario.simulation.duration = BOX_CORNER_SECONDS

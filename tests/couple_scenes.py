@@ -4,7 +4,7 @@ scene tests (tests/docking): a ring outside a guide surface (C-S) and two facing
 import numpy as np
 
 from drake_dock.core.couple import closest_point_conditions
-from drake_dock.docking.apds import apds_patches
+from drake_dock.docking.geometry.apds import apds_patches
 from motions import Motion
 
 
@@ -47,7 +47,7 @@ def cs_scene(geom, gap=0.02):
 
 def cc_scene(geom):
     """Target side 2 fixed-ish, chaser side 4 of the matched facing, approaching."""
-    from drake_dock.docking.scene import R_MATCHED
+    from drake_dock.docking.geometry.pairs import R_MATCHED
     P = apds_patches(geom)
     m1 = Motion(R_MATCHED, [0.0, 0.0, 0.12], A=(0.02, 0.01, 0.02), W=(1.0, 0.7, 0.5),
                 V=(0, 0.01, -0.04), a=(0.08, 1.3), b=(0.05, 0.7))

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from drake_dock.core.patches import Annulus, Arc, Circle, Cone, Segment
-from drake_dock.docking.scene import rot_x, rot_z
+from drake_dock.docking.geometry.rotations import rot_x, rot_z
 
 EZ = np.array([0.0, 0.0, 1.0])
 
@@ -338,7 +338,8 @@ def ring_over_petal_tip():
     theta_0 (by the angle p / (r sin alpha1), so that the centre's velocity is continuous)
     while p >= 0. The cone's nearest point to a point of the meridian half-plane lies on the
     same meridian. Returns (surface scene, tip scene, `SurfaceEdge`, (0.25, 0.75))."""
-    from drake_dock.docking.apds import ApdsGeometry, guide_surface, petal_edges, tip_arc
+    from drake_dock.docking.geometry.apds import guide_surface, petal_edges, tip_arc
+    from drake_dock.docking.scenario.dimensions import ApdsGeometry
     g = ApdsGeometry()
     a1, r = g.alpha1, 0.4
     cot, Rt = 1.0 / math.tan(a1), g.R - g.H / math.tan(a1)

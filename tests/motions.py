@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from drake_dock.docking.scene import rot_x, rot_z
+from drake_dock.docking.geometry.rotations import rot_x, rot_z
 
 
 class Motion:

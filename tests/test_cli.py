@@ -9,7 +9,7 @@ import pytest
 from pathlib import Path
 
 from drake_dock.cli import STUDIES
-from drake_dock.docking.output import MARKER, atomic_directory
+from drake_dock.docking.report.out_dir import MARKER, atomic_directory
 
 EXE = [sys.executable, "-m", "drake_dock.cli"]
 
@@ -113,8 +113,8 @@ def test_binary_scenario_file_exit_2(tmp_path):
 
 def test_help_is_written_for_users():
     """The top-level help says what each command does, the outcomes and the exit codes, in the
-    words the rest of the tool uses (the outcomes of `drake_dock.docking.outcome`)."""
-    from drake_dock.docking.outcome import OUTCOMES
+    words the rest of the tool uses (the outcomes of `drake_dock.docking.model.outcome`)."""
+    from drake_dock.docking.model.outcome import OUTCOMES
     r = _run(["--help"])
     assert r.returncode == 0
     text = r.stdout

@@ -19,9 +19,9 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from drake_dock.cli import main
+from drake_dock.docking.report.out_dir import MARKER
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.errors import InputError
-from drake_dock.docking.output import MARKER
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 
 PAPER = yaml.safe_load(PAPER_EXAMPLE.read_text())
 TEXT = yaml.safe_dump(PAPER)          # without comments: every byte is content

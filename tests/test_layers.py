@@ -1,6 +1,7 @@
-"""The package's shape, read from its source with `ast` (nothing is imported): layers import only
-downwards, no import circles, no private name imported across modules, no module over 500 lines,
-no class over 300 lines, and tests/core reaches no Drake module through any chain of imports."""
+"""The package's shape, read from its source with `ast` (nothing is imported): layers, and the
+wings of `drake_dock.docking`, import only downwards; no import circles; no private name imported
+across modules; no module over 500 lines, no class over 300 lines; module names unique; a wing's
+package only a docstring; tests/core reaches no Drake module through any chain of imports."""
 import ast
 from pathlib import Path
 
@@ -12,6 +13,9 @@ PACKAGE = ROOT / "drake_dock"
 # A module may import its own layer or any layer below it (errors and the version at the bottom).
 LAYERS = {"errors": 0, "__init__": 0, "core": 1, "systems": 2, "docking": 3, "studies": 4,
           "campaign": 5, "run": 6, "cli": 7, "__main__": 8}
+# The wings of `drake_dock.docking` in their order (its docstring): a wing imports its own and
+# the wings before it.
+WINGS = {"scenario": 1, "geometry": 2, "checks": 3, "model": 4, "placement": 5, "report": 6}
 
 
 def _module_name(path: Path) -> str:
@@ -41,10 +45,12 @@ def _imports(path: Path, package: str):
             yield mod, [a.name for a in node.names]
 
 
-def _layer(module: str) -> int:
+def _layer(module: str) -> tuple[int, int]:
+    """(layer, wing): the wing is 0 outside `drake_dock.docking` and for its package face."""
     parts = module.split(".")
     key = parts[1] if len(parts) > 1 else "__init__"
-    return LAYERS[key]
+    wing = WINGS[parts[2]] if key == "docking" and len(parts) > 2 else 0
+    return LAYERS[key], wing
 
 
 def _internal_edges():
@@ -111,6 +117,32 @@ def test_module_and_class_sizes():
                 assert size < 300, f"{name}.{node.name}: {size} lines"
 
 
+def test_docking_has_its_wings_each_a_package_with_a_docstring_only():
+    """Every module of `drake_dock.docking` lies in one of the wings; each wing's __init__.py is a
+    docstring (what it holds, what it may import) and nothing else: no code, no re-export."""
+    docking = PACKAGE / "docking"
+    assert {p.name for p in docking.iterdir() if p.is_dir() and p.name != "__pycache__"} \
+        == set(WINGS)
+    assert [p.name for p in docking.glob("*.py")] == ["__init__.py"]
+    for wing in (docking, *(docking / w for w in WINGS)):
+        tree = ast.parse((wing / "__init__.py").read_text())
+        assert ast.get_docstring(tree), wing
+        assert len(tree.body) == 1, f"{wing}/__init__.py holds more than its docstring"
+
+
+def test_module_names_are_unique():
+    """No module of `drake_dock.docking` or of the layers above it shares its file name with
+    another module (packages' faces and ``__main__`` apart), so that a name says one thing
+    wherever it is met."""
+    seen = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if path.name not in ("__init__.py", "__main__.py"):
+            seen.setdefault(path.name, []).append(str(path.relative_to(PACKAGE)))
+    twice = {n: p for n, p in seen.items() if len(p) > 1 and not all(
+        q.split("/")[0] in ("core", "systems") for q in p)}
+    assert not twice, twice
+
+
 def _reachable(start_files):
     """Every module (internal or external top-level name) reachable from the files' imports."""
     mods = _modules()
@@ -146,7 +178,7 @@ def test_core_tests_reach_no_drake():
     files = sorted((ROOT / "tests" / "core").glob("*.py"))    # conftest imports in fixtures
     seen, external = _reachable(files)
     assert "pydrake" not in external, sorted(m for m in seen)
-    assert not [m for m in seen if m.split(".")[1:2] and _layer(m) > LAYERS["docking"]]
+    assert not [m for m in seen if m.split(".")[1:2] and _layer(m)[0] > LAYERS["docking"]]
 
 
 @pytest.mark.parametrize("layer", ["core"])

@@ -9,7 +9,7 @@ from pathlib import Path
 import yaml
 
 import drake_dock
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -23,7 +23,8 @@ def test_version_is_the_installed_distribution_version(tmp_path):
 def test_default_scenario_is_package_data_found_from_any_directory(tmp_path):
     package = Path(drake_dock.__file__).resolve().parent
     assert PAPER_EXAMPLE.is_file() and package in PAPER_EXAMPLE.resolve().parents
-    code = "from drake_dock.docking.scenario import load_scenario; print(load_scenario().initial)"
+    code = ("from drake_dock.docking.scenario.loading import load_scenario; "
+            "print(load_scenario().initial)")
     out = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
                          text=True, check=True)
     assert str(load_scenario(ROOT / "models" / "paper_example.yaml").initial) in out.stdout

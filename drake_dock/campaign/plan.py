@@ -20,7 +20,9 @@ from pathlib import Path
 import yaml
 from pydrake.common.yaml import yaml_load_typed
 
-from drake_dock.docking.scenario import Scenario, load_scenario, validate
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.schema import Scenario
+from drake_dock.docking.scenario.validation import validate
 from drake_dock.errors import InputError
 
 SAMPLERS = ("sobol", "lhs", "uniform", "edges")

@@ -6,7 +6,7 @@ import collections
 import sys
 import time
 
-from drake_dock.docking.outcome import OUTCOMES
+from drake_dock.docking.model.outcome import OUTCOMES
 
 ORDER = OUTCOMES + ("error",)
 

@@ -2,10 +2,11 @@
 reduced to a plain row (a dict of numbers and strings, which pickles; Drake's Diagrams,
 Simulators and Contexts do not).
 
-A process keeps the last few Diagrams it built (`diagram_for`) and reuses one for every sample
-whose values leave it unchanged; a run on a reused Diagram gives bitwise the same row as on a
-fresh one (tests/campaign). Any failure of a sample (a typed error of drake_dock, a value out of
-range, anything else) is its row's ``outcome: error`` with the message in ``error``; it never
+A process keeps the last few Diagrams it built (`diagram_for`), each under its `DiagramSpec`
+(exactly what the Diagram reads of a scenario), and reuses one for every sample of the same spec,
+its scene serving the sample's placement too; a run on a reused Diagram gives bitwise the same row
+as on a fresh one (tests/campaign). Any failure of a sample (a typed error of drake_dock, a value
+out of range, anything else) is its row's ``outcome: error`` with the message in ``error``; it never
 stops the campaign.
 """
 from __future__ import annotations
@@ -18,13 +19,13 @@ import time
 import numpy as np
 
 from drake_dock.campaign.plan import set_field
-from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.results import (energy_ledger, final_misalignment,
-                                        momenta, momentum_reference_point, relative,
-                                        thrust_impulses,
-                                        timeseries)
-from drake_dock.docking.scenario import validate
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import PlacementCache, place
+from drake_dock.docking.report.results import (energy_ledger, final_misalignment, momenta,
+                                               momentum_reference_point, relative,
+                                               thrust_impulses, timeseries)
+from drake_dock.docking.scenario.validation import validate
 from drake_dock.errors import DrakeDockError, NumericalError
 
 # The row's columns after the sample, its seed and the varied inputs (`Field.columns`).
@@ -38,24 +39,11 @@ CACHE_SIZE = 4
 _DIAGRAMS: collections.OrderedDict = collections.OrderedDict()
 
 
-def build_key(scenario) -> str:
-    """What `build_docking_diagram` reads from a scenario: the geometry, bodies, Stewart
-    element, chaser APDS offset, contact law, simulator configuration (the LZB tolerance follows
-    it), the capture rule's tolerances, the thrust and the closing speed (the energy scale of
-    the error control). Samples that differ only elsewhere (the misalignment, the roll, the
-    duration) share a Diagram."""
-    s, sim = scenario, scenario.simulation
-    return repr((s.geometry, s.bodies, s.stewart, s.chaser_apds_offset, s.contact,
-                 repr(s.simulator_config), sim.capture_distance, sim.capture_lateral,
-                 sim.capture_tilt_deg, s.thrust, s.initial.chaser_speed))
-
-
-def diagram_for(scenario):
-    """This process's Diagram for the scenario: built once per `build_key`, kept for the last
-    CACHE_SIZE keys."""
-    key = build_key(scenario)
-    dd = _DIAGRAMS.pop(key, None) or build_docking_diagram(scenario)
-    _DIAGRAMS[key] = dd
+def diagram_for(spec: DiagramSpec):
+    """This process's Diagram of ``spec``: built once per spec, kept for the last CACHE_SIZE
+    specs."""
+    dd = _DIAGRAMS.pop(spec, None) or build_docking_diagram(spec)
+    _DIAGRAMS[spec] = dd
     while len(_DIAGRAMS) > CACHE_SIZE:
         _DIAGRAMS.popitem(last=False)
     return dd
@@ -83,7 +71,8 @@ def input_columns(values: dict) -> dict:
 def stewart_peaks(ts: dict) -> tuple[float, float]:
     """The largest translational deflection (m) of the Stewart element and the largest force
     (N) it exerts on the target APDS, over the recorded samples of a `timeseries` (the values
-    of `drake_dock.docking.plant.stewart_history`, from the states the timeseries evaluates)."""
+    of `drake_dock.docking.model.plant.stewart_history`, from the states the timeseries
+    evaluates)."""
     stroke = np.array([np.linalg.norm(x) for x in ts["stewart_x"]])
     force = np.array([np.linalg.norm(f) for f in ts["stewart_force_W"]])
     return float(stroke.max(initial=0.0)), float(force.max(initial=0.0))
@@ -126,16 +115,24 @@ def failed(message: str, reason: str) -> dict:
     return row
 
 
+def scenario_row(scenario, *, reuse: bool = True) -> dict:
+    """The result columns (`measure`) of a run of ``scenario``: on this process's cached
+    Diagram of its `DiagramSpec` (``reuse``, `diagram_for`) or a fresh one, placed on that
+    Diagram's scene."""
+    spec = DiagramSpec.of(scenario)
+    dd = diagram_for(spec) if reuse else build_docking_diagram(spec)
+    return measure(simulate(scenario, place(scenario, PlacementCache(dd.scene)), dd=dd))
+
+
 def run_sample(base, spec, *, reuse: bool = True) -> dict:
-    """The row of one sample ``spec = (sample, seed, {path: value})``. ``reuse``: run on this
-    process's cached Diagram (`diagram_for`); otherwise build a fresh one."""
+    """The row of one sample ``spec = (sample, seed, {path: value})`` (`scenario_row`).
+    ``reuse``: run on this process's cached Diagram (`diagram_for`); otherwise build a fresh
+    one."""
     sample, seed, values = spec
     row = {"sample": int(sample), "seed": int(seed), **input_columns(values)}
     t0 = time.perf_counter()
     try:
-        scenario = sample_scenario(base, values)
-        result = simulate(scenario, dd=diagram_for(scenario) if reuse else None)
-        row.update(measure(result))
+        row.update(scenario_row(sample_scenario(base, values), reuse=reuse))
     except DrakeDockError as e:
         _DIAGRAMS.clear()            # nothing of a failed run is kept
         row.update(failed(str(e), f"{type(e).__name__}"))

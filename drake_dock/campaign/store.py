@@ -23,7 +23,7 @@ import pyarrow.parquet as pq
 
 from drake_dock import __version__
 from drake_dock.campaign.sample import RESULT_COLUMNS
-from drake_dock.docking.output import MARKER, PRODUCER, check_destination
+from drake_dock.docking.report.out_dir import MARKER, PRODUCER, check_destination
 from drake_dock.errors import InputError
 
 KIND = "campaign"

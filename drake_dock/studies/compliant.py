@@ -33,14 +33,14 @@ dissipation as linear Kelvin-Voigt with a relaxation time instead and ignores it
 stepping: discrete at ``time_step`` > 0 with the approximation ``approximation``, or
 continuous (``time_step`` = 0) with error-controlled Runge-Kutta 3 at ``accuracy``.
 
-Post-contact thrust (the scenario's ``thrust`` section, `drake_dock.docking.thrust`):
+Post-contact thrust (the scenario's ``thrust`` section, `drake_dock.docking.model.thrust`):
 `CompliantThrust` applies F e3 (e3 the chaser APDS frame's docking axis) at the chaser's mass
 centre through the plant's applied spatial force input, in the schedule's windows after the
 run's own first contact: the end of the first step with a non-zero contact force, which the
 run's monitor latches into the system's state.
 
 A simulator monitor records the time and the plant's state after every step and applies the
-outcome rules of the rigid model (`drake_dock.docking.outcome`): ``captured`` when the
+outcome rules of the rigid model (`drake_dock.docking.model.outcome`): ``captured`` when the
 distance to capture (`CaptureRule.to_go`) reaches the axial tolerance, the capture time
 interpolated linearly between the two steps around it; ``missed``, ``rebound`` and ``jammed``
 by `OutcomeWatch`; ``timeout`` at ``t_max``. After the run (outside its wall time) the states
@@ -70,12 +70,12 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 from scipy.spatial import ConvexHull
 
-from drake_dock.docking.apds import guide_surface
-from drake_dock.docking.diagram import ring_poses
-from drake_dock.docking.outcome import CaptureRule, OutcomeWatch, misalignment
-from drake_dock.docking.plant import (DockingPlant, populate_plant, set_initial_state,
-                                      stewart_history)
-from drake_dock.docking.thrust import ThrustSchedule
+from drake_dock.docking.geometry.apds import guide_surface
+from drake_dock.docking.model.capture import ring_poses
+from drake_dock.docking.model.outcome import CaptureRule, OutcomeWatch, misalignment
+from drake_dock.docking.model.plant import (DockingPlant, PlantSpec, populate_plant,
+                                            set_initial_state, stewart_history)
+from drake_dock.docking.model.thrust import ThrustSchedule
 from drake_dock.errors import InputError
 from drake_dock.systems.simulator import make_simulator
 
@@ -317,7 +317,7 @@ def build_compliant_diagram(scenario, cfg: CompliantConfig) -> CompliantDiagram:
                                                 props)
                 n[0] += 1
 
-    dp = populate_plant(plant, scene_graph, scenario, collision=collision)
+    dp = populate_plant(plant, scene_graph, PlantSpec.of(scenario), collision=collision)
     schedule = ThrustSchedule.of(scenario.thrust)
     thrust = None
     if schedule is not None:
@@ -346,7 +346,7 @@ class CompliantRun:
     stroke: np.ndarray                 # |Stewart deflection| at the step ends [m]
     error: str | None = None
     stopped: bool = False              # ended by the wall-time limit
-    outcome: str = "timeout"           # `drake_dock.docking.outcome.OUTCOMES`, or "error"
+    outcome: str = "timeout"           # `drake_dock.docking.model.outcome.OUTCOMES`, or "error"
     reason: str = ""
     first_contact_time: float = math.inf   # end of the first step with a contact force [s]
     peak_interface_force: float = 0.0  # peak |net contact force on the target APDS| [N]

@@ -1,7 +1,8 @@
 """The working-conditions sweep (`drake-dock study conditions`): seeded random conditions inside
 the International Docking System Standard's initial-contact box, and corners of it, each run to
 its outcome and checked by the two independent interpenetration checks: the analytic one
-(`drake_dock.docking.penetration`) and the triangle-mesh one (`drake_dock.docking.mesh_check`).
+(`drake_dock.docking.checks.penetration`) and the triangle-mesh one
+(`drake_dock.docking.checks.mesh_check`).
 
 The box (docs/model.md, "Initial conditions"): closing rate 0.05-0.10 m/s; lateral
 misalignment |offset| <= 0.10 m; lateral rate |v| <= 0.04 m/s; pitch and yaw (the tilt's two
@@ -28,12 +29,13 @@ import time as _time
 
 import numpy as np
 
-from drake_dock.docking.mesh_check import deepest_penetration_mesh
-from drake_dock.docking.output import atomic_directory
-from drake_dock.docking.penetration import deepest_penetration
-from drake_dock.docking.results import summary, timeseries
-from drake_dock.docking.scenario import validate
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.checks.mesh_check import deepest_penetration_mesh
+from drake_dock.docking.checks.penetration import deepest_penetration
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.report.out_dir import atomic_directory
+from drake_dock.docking.report.results import summary, timeseries
+from drake_dock.docking.scenario.validation import validate
 from drake_dock.errors import DrakeDockError
 
 IDSS_BOX = {"chaser_speed": (0.05, 0.10), "lateral_offset": 0.10, "lateral_velocity": 0.04,
@@ -128,7 +130,7 @@ def run_condition(scenario, name: str, condition: dict) -> dict:
     wall0 = _time.perf_counter()
     try:
         s = with_condition(scenario, condition)
-        result = simulate(s)
+        result = simulate(s, place(s))
         ts = timeseries(result)
         summ = summary(result, ts)
     except DrakeDockError as e:

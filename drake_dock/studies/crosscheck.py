@@ -1,7 +1,7 @@
 """The referee (`drake-dock study crosscheck`): conditions of the IDSS initial-contact box run
 both ways, with the same geometry, post-contact thrust and initial state:
 
-1. drake_dock's rigid model (`drake_dock.docking.simulate.simulate`);
+1. drake_dock's rigid model (`drake_dock.docking.model.simulate.simulate`);
 2. Drake's compliant contact (`drake_dock.studies.compliant`: point contact between convex
    pieces of the same APDS, Hunt-Crossley dissipation matched to the scenario's restitution at
    the condition's closing speed, the discrete ``similar`` approximation), an engine that
@@ -11,7 +11,7 @@ The conditions are the scenario's own initial conditions (``own``, the row named
 ``scenario``) and the conditions sweep's (`drake_dock.studies.conditions.conditions` with the
 sweep's seed): its first ``random`` random conditions and its first ``corners`` corners. The
 quick plan runs the scenario's own conditions only. Each run ends at a named outcome by the
-same rules (`drake_dock.docking.outcome`: captured, missed, rebound, jammed, timeout at
+same rules (`drake_dock.docking.model.outcome`: captured, missed, rebound, jammed, timeout at
 ``simulation.duration``).
 
 A compliant run *counts* where the refined run (stiffness x ``stiffness_factor``, step x
@@ -22,7 +22,7 @@ the smaller step keeps the number of steps per contact oscillation (whose period
 Per condition: both outcomes and their reasons, both capture times (and the refined run's), both
 peak interface forces and the wall times (each run's build, simulation and measures). The peak
 interface force is the largest \\|net contact force on the target APDS\\| over the run: rigid
-from the couples' forces (`drake_dock.docking.loads.interface_loads`; impulses excluded),
+from the couples' forces (`drake_dock.docking.report.loads.interface_loads`; impulses excluded),
 compliant from the chaser's momentum change over each step less the thrust (contact acts only
 between the chaser and the target APDS). A compliant impact's force peak grows with the square
 root of the stiffness and a rigid one has none, so the two are also compared as the peak mean
@@ -53,13 +53,12 @@ import time as _time
 
 import numpy as np
 
-from drake_dock.docking.loads import interface_loads
-from drake_dock.docking.outcome import CaptureRule, misalignment
-from drake_dock.docking.output import atomic_directory
-from drake_dock.docking.pairs import scenario_pairs
-from drake_dock.docking.results import thrust_impulses, timeseries
-from drake_dock.docking.scene import initial_state
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.outcome import CaptureRule, misalignment
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.report.loads import interface_loads
+from drake_dock.docking.report.out_dir import atomic_directory
+from drake_dock.docking.report.results import thrust_impulses, timeseries
 from drake_dock.errors import DrakeDockError, InputError
 from drake_dock.studies.compliant import (CompliantConfig, build_compliant_diagram,
                                           hunt_crossley_dissipation, run_compliant)
@@ -157,7 +156,7 @@ def peak_mean_force(t, P, window: float) -> float:
 
 def approach(t, axial, lateral, tilt, rule: CaptureRule, margin: float) -> dict:
     """How the run came to the capture box, from the rings' misalignment at the samples t
-    (`drake_dock.docking.outcome.misalignment`): ``near`` the first time the distance to
+    (`drake_dock.docking.model.outcome.misalignment`): ``near`` the first time the distance to
     capture (`CaptureRule.to_go`) is within ``margin`` of the capture tolerance (s, None if
     never), ``closest`` the least distance to capture less the tolerance (m, <= 0 once
     captured), and the final axial and lateral offset (m) and tilt (deg)."""
@@ -174,7 +173,7 @@ def rigid_measures(result, plan: "CrosscheckPlan") -> dict:
     """The rigid run's peak interface force (N, impulses excluded), peak mean interface force
     over ``plan.window`` (N, impulses included) and `approach`."""
     ts = timeseries(result)
-    F_A = interface_loads(ts, scenario_pairs(result.scenario))["F_A"]
+    F_A = interface_loads(ts, result.scene.pairs)["F_A"]
     j = ts["body_names"].tolist().index("chaser")
     J, _ = thrust_impulses(result, ts, np.zeros(3))
     P = result.scenario.bodies.chaser.mass * ts["v_WB"][:, j] - J
@@ -232,7 +231,7 @@ def run_condition(scenario, name: str, condition: dict, plan: CrosscheckPlan) ->
         v = getattr(s.initial, k)
         row[k] = json.dumps(list(v)) if isinstance(v, (list, tuple)) else v
     try:
-        state = initial_state(s)
+        state = place(s)
     except DrakeDockError as e:
         row.update(rigid_outcome="error", rigid_reason=f"{type(e).__name__}: {e}",
                    compliant_outcome="error", compliant_reason="no initial state",

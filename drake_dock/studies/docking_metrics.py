@@ -13,7 +13,7 @@ t_c); e3 is the docking axis, the target APDS's z at t = 0:
   lambda_n, lambda_t and frames at the samples, the window's start interpolated; compliant:
   the chaser's momentum change over each step (its only force is contact);
 - ``peak_stewart_stroke``: the peak over [0, t_c] of \\|x\\|, the translational deflection of
-  the target APDS on its Stewart element (`drake_dock.docking.plant.stewart_deflection`); the
+  the target APDS on its Stewart element (`drake_dock.docking.model.plant.stewart_deflection`); the
   largest sample is refined by the parabola through it and its two neighbours [m];
 - ``chaser_impulse``: \\|m_c (v_c(t_c) - v_c(0))\\|, the impulse the contact delivers to the
   chaser up to capture, impacts included (its only force is contact) [N s].
@@ -36,8 +36,8 @@ import dataclasses
 
 import numpy as np
 
-from drake_dock.docking.plant import stewart_history
-from drake_dock.docking.results import rigid_chaser_force
+from drake_dock.docking.model.plant import stewart_history
+from drake_dock.docking.report.results import rigid_chaser_force
 
 METRICS = ("capture_time", "apds_spin_rate", "chaser_axial_velocity", "peak_contact_force",
            "peak_stewart_stroke", "chaser_impulse")
@@ -57,7 +57,7 @@ class SceneStart:
 
 
 def scene_start(scenario, state) -> SceneStart:
-    """The `SceneStart` of a scenario and its `initial_state`."""
+    """The `SceneStart` of a scenario and its initial state (`InitialState`)."""
     e3 = state.X_WB["target_apds"][0][:, 2].copy()
     cap = scenario.simulation.capture_distance
     return SceneStart(e3, float(np.asarray(state.V_WB["target_apds"][0]) @ e3),

@@ -4,7 +4,7 @@ petal tips and the other ring's inside circle, and over a few thrust levels.
 
 The clearance is c = Rs - (Rp - H cot(alpha1)): how far off the axis a petal tip can meet the
 other APDS and still land inside its ring's passage rather than on its ring (Rp the petals'
-root radius, `drake_dock.docking.apds.ApdsGeometry.Rp`). The geometries:
+root radius, `drake_dock.docking.scenario.dimensions.ApdsGeometry.Rp`). The geometries:
 
 - the paper's (Rs = 0.4 m, petals on the outside circle R = 0.6 m, H = 0.2 m): c = 0;
 - petals on the outside circle with a wider passage (``rim_passages``): c > 0, but the other
@@ -33,10 +33,12 @@ import json
 import math
 import time as _time
 
-from drake_dock.docking.output import atomic_directory
-from drake_dock.docking.results import summary, timeseries
-from drake_dock.docking.scenario import ThrustParams, validate
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.report.out_dir import atomic_directory
+from drake_dock.docking.report.results import summary, timeseries
+from drake_dock.docking.scenario.schema import ThrustParams
+from drake_dock.docking.scenario.validation import validate
 from drake_dock.errors import DrakeDockError
 from drake_dock.studies.conditions import PENETRATION_LIMIT, penetrations
 
@@ -111,7 +113,7 @@ def run_probe(s, checks: bool) -> dict:
     ring and, with ``checks``, the interpenetration columns."""
     w0 = _time.perf_counter()
     try:
-        result = simulate(s)
+        result = simulate(s, place(s))
         ts = timeseries(result)
         summ = summary(result, ts)
     except DrakeDockError as e:

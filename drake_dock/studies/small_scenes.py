@@ -20,11 +20,11 @@ from pydrake.multibody.tree import FixedOffsetFrame, RotationalInertia, SpatialI
 from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.core.contact_law import ContactLaw
-from drake_dock.systems.contact_system import (COUPLE_SLICES, ContactOptions, ContactPair,
-                                               Handover, RigidContactSystem)
 from drake_dock.core.handover import SurfaceEdge
 from drake_dock.core.patches import Annulus, Circle, PlaneRect, Segment
-from drake_dock.docking.rotations import rot_x
+from drake_dock.docking.geometry.rotations import rot_x
+from drake_dock.systems.contact_system import (COUPLE_SLICES, ContactOptions, ContactPair,
+                                               Handover, RigidContactSystem)
 from drake_dock.systems.simulator import make_simulator, make_witness_approach
 
 G = 9.81

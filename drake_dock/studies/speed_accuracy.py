@@ -26,9 +26,9 @@ import dataclasses
 import math
 from pathlib import Path
 
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.docking.scene import initial_state
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.errors import DrakeDockError
 from drake_dock.studies.compliant import (CompliantConfig, build_compliant_diagram,
                                           hunt_crossley_dissipation, run_compliant)
@@ -106,7 +106,7 @@ def _rigid_run(scenario, state, start, acc, max_step=None, scheme=None):
 
 def run_scene(name, scenario, plan: StudyPlan, log=print) -> dict:
     """One scene's runs: {"scene", "points", "reference", "effect", "dissipation"}."""
-    state = initial_state(scenario)
+    state = place(scenario)
     start = scene_start(scenario, state)
     log(f"{name}: reference drake_dock at accuracy {plan.reference_accuracy:g}")
     ref, note, wall = _rigid_run(scenario, state, start, plan.reference_accuracy)
@@ -205,7 +205,7 @@ def speedup_lines(result) -> list:
 
 def write_study(result, out_dir):
     """points.csv, one chart per scene and the printed lines, atomically."""
-    from drake_dock.docking.output import atomic_directory
+    from drake_dock.docking.report.out_dir import atomic_directory
     with atomic_directory(out_dir, kind="study speed-accuracy") as tmp:
         (tmp / "points.csv").write_text(
             points_csv([p for scene in result["scenes"] for p in scene["points"]]))

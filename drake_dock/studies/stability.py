@@ -32,14 +32,14 @@ from pathlib import Path
 import numpy as np
 
 from drake_dock.core.hybrid import Mode
-from drake_dock.errors import PainleveError, ZenoError
-from drake_dock.systems.contact_system import COUPLE_SLICES, ContactOptions
-from drake_dock.errors import DrakeDockError, NumericalError
-from drake_dock.core.lzb.solve import solve_lzb
 from drake_dock.core.lzb.limit import continuous_limit_chain
-from drake_dock.docking.results import rigid_chaser_force
+from drake_dock.core.lzb.solve import solve_lzb
+from drake_dock.docking.report.results import rigid_chaser_force
+from drake_dock.errors import PainleveError, ZenoError
+from drake_dock.errors import DrakeDockError, NumericalError
 from drake_dock.studies.small_scenes import (G, PAINLEVE_THETA, SmallRun, disk_on_incline,
                                              painleve_closed_form, painleve_rod, painleve_state)
+from drake_dock.systems.contact_system import COUPLE_SLICES, ContactOptions
 
 SAWTOOTH = 0.05
 
@@ -63,11 +63,11 @@ RIGID_STEP_ACCURACY = 1e-8
 
 
 def step_size_case(scenario, *, output_steps, compliant_steps, stiffnesses, log=print) -> dict:
+    from drake_dock.docking.model.simulate import simulate
+    from drake_dock.docking.placement.place import place
     from drake_dock.studies.compliant import (CompliantConfig, hunt_crossley_dissipation,
                                               run_compliant)
-    from drake_dock.docking.scene import initial_state
-    from drake_dock.docking.simulate import simulate
-    state = initial_state(scenario)
+    state = place(scenario)
     rigid = []
     for H in output_steps:
         sc = copy.deepcopy(scenario)
@@ -161,13 +161,13 @@ def high_friction_case(mus, *, scenario=None, docking_mus=(), log=print) -> dict
         f"{max([r['mu'] for r in rod if r['error'] is None], default=None)}")
     docking = []
     if scenario is not None:
-        from drake_dock.docking.scene import initial_state
-        from drake_dock.docking.simulate import simulate
+        from drake_dock.docking.model.simulate import simulate
+        from drake_dock.docking.placement.place import place
         for mu in docking_mus:
             sc = copy.deepcopy(scenario)
             sc.contact.mu = sc.contact.mu_s = mu
             try:
-                r = simulate(sc, state=initial_state(sc))
+                r = simulate(sc, state=place(sc))
                 C = np.asarray(r.record.couples)
                 st = C[:, :, COUPLE_SLICES["status"]]
                 docking.append(dict(mu=mu, captured=r.captured, capture_time=r.capture_time,
@@ -328,7 +328,7 @@ def summary_lines(res) -> list:
 
 def write_stability(res, out_dir):
     """stability.json, summary.txt and one figure per case, atomically."""
-    from drake_dock.docking.output import atomic_directory
+    from drake_dock.docking.report.out_dir import atomic_directory
     from drake_dock.studies.stability_figures import stability_figures
     with atomic_directory(out_dir, kind="study stability") as tmp:
         (tmp / "stability.json").write_text(json.dumps(res, indent=1, default=_json))

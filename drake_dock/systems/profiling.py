@@ -28,19 +28,21 @@ class Timing:
     tracked: dict = dataclasses.field(default_factory=dict)    # evaluations with the pair tracked
 
     _tracked: object = None
-    _epochs: list = dataclasses.field(default_factory=list)
+    _epochs: list = dataclasses.field(default_factory=list)   # [near pairs, evaluations]
+    _last_index: object = None
 
     def reset(self):
         self.seeking = self.contact_dynamics = self.impacts = 0.0
         self.seeks, self.screens, self.seek_time, self.tracked = {}, {}, {}, {}
         self._tracked = None
         self._epochs = []
+        self._last_index = None
 
     def tracked_counts(self) -> dict:
         """Per pair, the evaluations in which it was tracked."""
         counts = {n: self.tracked.get(n, 0) for n in self.pairs}
-        for index, n in self._epochs:
-            for i in index.near:
+        for near, n in self._epochs:
+            for i in near:
                 counts[self.pairs[i]] += n
         if self._tracked is not None:
             for n, c in zip(self.pairs, self._tracked.tolist()):
@@ -67,12 +69,14 @@ class Timing:
 
     def count_tracked_epoch(self, index):
         """One evaluation with the pairs not far of the `ModesIndex` ``index`` tracked
-        (counted per index; summed over the pairs when asked, `tracked_counts`)."""
-        last = self._epochs[-1] if self._epochs else None
-        if last is not None and last[0] is index:
-            last[1] += 1
+        (counted per index; summed over the pairs when asked, `tracked_counts`). Only the
+        last index is kept, and of the others their near pairs: an index holds what the
+        engine derived of it."""
+        if self._epochs and self._last_index is index:
+            self._epochs[-1][1] += 1
         else:
-            self._epochs.append([index, 1])
+            self._last_index = index
+            self._epochs.append([tuple(int(i) for i in index.near), 1])
 
     def count_tracked_indices(self, index):
         """One evaluation with the pairs at the positions ``index`` (an array into ``pairs``)

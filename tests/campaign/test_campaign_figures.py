@@ -1,5 +1,5 @@
 """The campaign's capture-probability figure draws every outcome a run can end in
-(`drake_dock.docking.outcome.OUTCOMES`) and the errors: one legend entry per outcome present,
+(`drake_dock.docking.model.outcome.OUTCOMES`) and the errors: one legend entry per outcome present,
 with its count."""
 import numpy as np
 

@@ -29,7 +29,7 @@ vary:
     (("normal: [5.0, 0.5]", "lognormal: [5.0, 0.5]"), "vary.initial.target_yaw_deg"),
 ])
 def test_a_bad_plan_exits_2_naming_the_field(tmp_path, capsys, change, field):
-    from drake_dock.docking.scenario import PAPER_EXAMPLE
+    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE).replace(*change))
     out = tmp_path / "out"
@@ -41,14 +41,14 @@ def test_a_bad_plan_exits_2_naming_the_field(tmp_path, capsys, change, field):
 
 def test_the_good_plan_and_the_shipped_idss_plan_load(tmp_path):
     from drake_dock.campaign.plan import load_plan
-    from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE, load_scenario
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE))
     assert [f.path for f in load_plan(plan)[2]] == ["initial.lateral_offset",
                                                     "initial.target_yaw_deg"]
     idss, base, fields = load_plan(MODELS_DIR / "idss_envelope.yaml")
     # The paper example with the plan's `set`: every pair, and post-contact thrust.
-    from drake_dock.docking.scenario import ThrustParams
+    from drake_dock.docking.scenario.schema import ThrustParams
     paper = load_scenario(PAPER_EXAMPLE)
     assert paper.contact.pairs == "paper" and paper.thrust is None
     paper.contact.pairs = "complete"
@@ -71,7 +71,7 @@ def test_a_bad_set_is_named_before_anything_runs(tmp_path, set_, field, named):
     """A plan's `set` writes values into the base scenario: a path that is not a scenario
     field, or a value the scenario refuses, is an InputError naming `set` and the field."""
     from drake_dock.campaign.plan import load_plan
-    from drake_dock.docking.scenario import PAPER_EXAMPLE
+    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE
     from drake_dock.errors import InputError
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE) + f"set: {set_}\n")
@@ -82,7 +82,7 @@ def test_a_bad_set_is_named_before_anything_runs(tmp_path, set_, field, named):
 
 def test_set_values_reach_every_sample(tmp_path):
     from drake_dock.campaign.plan import load_plan
-    from drake_dock.docking.scenario import PAPER_EXAMPLE
+    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE)
                     + "set: {contact.mu: 0.05, simulation.capture_tilt_deg: null}\n")
@@ -106,7 +106,7 @@ def test_edges_sampler_follows_the_arcsine_law_and_sobol_points_keep_their_index
 @pytest.mark.parametrize("extra, field", [(["--workers", "0"], "--workers"),
                                           (["--resume"], "--resume")])
 def test_bad_options_exit_2_naming_them(tmp_path, capsys, extra, field):
-    from drake_dock.docking.scenario import PAPER_EXAMPLE
+    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE))
     out = tmp_path / "out"
@@ -119,7 +119,7 @@ def test_a_plan_varies_the_thrust_of_a_base_without_one(tmp_path):
     """A plan may vary the keys of the optional `thrust` section on a base scenario that has
     none: the section is added with its defaults, then the sampled key is set."""
     from drake_dock.campaign.plan import load_plan, set_field
-    from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE)
                     + "  thrust.force: {uniform: [100.0, 400.0]}\n")
@@ -131,21 +131,23 @@ def test_a_plan_varies_the_thrust_of_a_base_without_one(tmp_path):
 
 
 def test_the_diagram_key_holds_what_the_diagram_reads():
-    """`build_key` changes with every field the docking Diagram reads (the capture rule's
-    tolerances and the thrust among them), and not with the approach (misalignment, roll)."""
+    """The campaign's Diagram key, the `DiagramSpec`, changes with every field the docking
+    Diagram reads (the capture rule's tolerances and the thrust among them), and not with the
+    approach (misalignment, roll) or the run's length (tests/campaign/test_diagram_cache.py
+    walks every field)."""
     from drake_dock.campaign.plan import set_field
-    from drake_dock.campaign.sample import build_key
-    from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
-    base = load_scenario(PAPER_EXAMPLE)
+    from drake_dock.docking.model.diagram import DiagramSpec
+    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+    base = DiagramSpec.of(load_scenario(PAPER_EXAMPLE))
     for path, value in (("simulation.capture_lateral", 0.02),
                         ("simulation.capture_tilt_deg", 1.0),
                         ("simulation.capture_distance", 0.004), ("thrust.force", 100.0),
                         ("contact.mu", 0.2), ("geometry.Rs", 0.45)):
         s = load_scenario(PAPER_EXAMPLE)
         set_field(s, path, value)
-        assert build_key(s) != build_key(base), path
+        assert DiagramSpec.of(s) != base, path
     for path, value in (("initial.lateral_offset", [0.05, 0.0]),
                         ("initial.target_yaw_deg", 2.0), ("simulation.duration", 3.0)):
         s = load_scenario(PAPER_EXAMPLE)
         set_field(s, path, value)
-        assert build_key(s) == build_key(base), path
+        assert DiagramSpec.of(s) == base and hash(DiagramSpec.of(s)) == hash(base), path

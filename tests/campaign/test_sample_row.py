@@ -1,6 +1,6 @@
 """A campaign row (`drake_dock.campaign.sample.measure`, from the timeseries without its
 per-couple arrays) against two independent computations: its Stewart columns against the
-peaks of `drake_dock.docking.plant.stewart_history` (Drake's bushing on its own context, from
+peaks of `drake_dock.docking.model.plant.stewart_history` (Drake's bushing on its own context, from
 the recorded plant states), and its other columns against the run's `summary` (from the full
 timeseries: the couple table's normal forces, the loads and the ledger)."""
 import math
@@ -9,10 +9,11 @@ from pathlib import Path
 import pytest
 
 from drake_dock.campaign.sample import measure
-from drake_dock.docking.plant import stewart_history
-from drake_dock.docking.results import summary, timeseries
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.plant import stewart_history
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.report.results import summary, timeseries
+from drake_dock.docking.scenario.loading import load_scenario
 
 MODELS = Path(__file__).resolve().parents[2] / "models"
 
@@ -21,7 +22,7 @@ MODELS = Path(__file__).resolve().parents[2] / "models"
 def run():
     s = load_scenario(MODELS / "paper_example.yaml")
     s.initial.approach_travel = 0.005      # first contact within the 0.05 s run
-    return simulate(s, duration=0.05)
+    return simulate(s, place(s), duration=0.05)
 
 
 def test_the_rows_stewart_peaks_are_those_of_stewart_history(run):

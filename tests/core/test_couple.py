@@ -7,7 +7,7 @@ from scipy.integrate import solve_ivp
 from drake_dock.core.couple import closest_point_conditions, evaluate_couple
 from drake_dock.core.patches import Circle, PlaneRect, Segment, posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.scene import rot_x, rot_z
+from drake_dock.docking.geometry.rotations import rot_x, rot_z
 from couple_scenes import cc_scene, cs_scene, settle
 
 

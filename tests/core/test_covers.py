@@ -15,13 +15,15 @@ from drake_dock.core import covers
 from drake_dock.core.kernels import cover as compiled
 from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.apds import ApdsGeometry
-from drake_dock.docking.scene import (CHASER_APDS, COVER_CELLS, Approach, apds_pairs, travel_grid,
-                                      touch_steps)
+from drake_dock.docking.geometry.pairs import CHASER_APDS
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.placement.search import Approach
+from drake_dock.docking.placement.search import COVER_CELLS, touch_steps, travel_grid
+from drake_dock.docking.scenario.dimensions import ApdsGeometry
 
 
 def _patches():
-    pairs = apds_pairs(ApdsGeometry())
+    pairs = DockingScene(ApdsGeometry(), "paper").pairs
     apds = {id(p): p for pr in pairs for p in (pr.patch1, pr.patch2)}
     return list(apds.values()) + [Circle(0.3, 0.1), Cone(0.6, 0.8, (0.1, 1.2), (0.0, 0.2)),
                                   PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)),
@@ -65,7 +67,7 @@ APPROACHES = [Approach(math.radians(5.0)),
 @pytest.mark.parametrize("approach", APPROACHES)
 def test_compiled_touch_steps_equal_the_reference(approach):
     g = ApdsGeometry()
-    pairs = apds_pairs(g)
+    pairs = DockingScene(g, "paper").pairs
     grid = np.array(travel_grid(g, approach))
     got = touch_steps(pairs, approach, grid)
     for j, pr in enumerate(pairs):
@@ -98,7 +100,7 @@ def test_touch_steps_equal_a_brute_force(name):
     of spheres and slabs is <= 0 at one of 17 travels spread over the step."""
     g = ApdsGeometry()
     approach = APPROACHES[0]
-    pr = next(p for p in apds_pairs(g) if p.name == name)
+    pr = next(p for p in DockingScene(g, "paper").pairs if p.name == name)
     moving, fixed, e = _posed_covers(pr, approach)
     grid = np.array(travel_grid(g, approach))
     w = (moving.centres[:, None, :] - fixed.centres[None, :, :]).reshape(-1, 3)
@@ -124,7 +126,7 @@ def test_bound_lies_below_the_seek_distance():
     not touched."""
     g = ApdsGeometry()
     approach = APPROACHES[0]
-    pairs = apds_pairs(g)
+    pairs = DockingScene(g, "paper").pairs
     grid = np.array(travel_grid(g, approach))[::3]
     touched = touch_steps(pairs, approach, grid)
     for j, pr in enumerate(pairs):
@@ -146,10 +148,11 @@ def test_cover_gap_compiled_equals_reference_and_lies_below_the_seek():
     1e-12, and lies below the seek's distance, for the complete set's pairs at random
     relative poses of the two APDS (tilt up to 10 deg, offset up to 0.15 m, ring distance -0.2
     to 0.5 m)."""
-    from drake_dock.docking.scene import R_MATCHED, rot_vec, rot_z
+    from drake_dock.docking.geometry.pairs import R_MATCHED
+    from drake_dock.docking.geometry.rotations import rot_vec, rot_z
     g = ApdsGeometry()
     rng = np.random.default_rng(11)
-    pairs = apds_pairs(g, "complete")
+    pairs = DockingScene(g, "complete").pairs
     for trial in range(6):
         R = rot_vec((*rng.uniform(-0.17, 0.17, 2), 0.0)) @ rot_z(rng.uniform(-1, 1)) @ R_MATCHED
         X = {CHASER_APDS: (R, np.array([*rng.uniform(-0.1, 0.1, 2), rng.uniform(-0.2, 0.5)])),

@@ -15,8 +15,9 @@ from drake_dock.core.couple import evaluate_couple
 from drake_dock.core.kernels.jets import jet, patch_spec
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
-from drake_dock.docking.apds import ApdsGeometry, apds_patches, corner_point
-from drake_dock.docking.scene import apds_pairs
+from drake_dock.docking.geometry.apds import apds_patches, corner_point
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.scenario.dimensions import ApdsGeometry
 from motions import PosedMotion, check_rates_by_finite_differences
 from edge_scenes import (CORNER, arc_over_cone, rim_over_face, ring_over_arc, ring_over_segment,
                          segment_over_arc, segment_over_segment, tip_handover)
@@ -178,7 +179,7 @@ def test_complete_set_names_and_patches(geom):
     point-surface pairs, each corner a bare point), the petal corners against the other's tip
     lands they come over (12 point-surface pairs); no rim on rim (the faces reach past the
     rims)."""
-    paper, complete = apds_pairs(geom), apds_pairs(geom, "complete")
+    paper, complete = DockingScene(geom, "paper").pairs, DockingScene(geom, "complete").pairs
     assert [p.name for p in complete[:12]] == [p.name for p in paper] and len(paper) == 12
     new = {p.name: p for p in complete[12:]}
     assert len(new) == len(complete) - 12 == 122
@@ -240,16 +241,16 @@ def test_complete_set_names_and_patches(geom):
         np.testing.assert_allclose(tip.position(tip.upper), surf.position([1.0, geom.H]),
                                    atol=1e-15)
     with pytest.raises(ValueError, match="contact.pairs"):
-        apds_pairs(geom, "all")
+        DockingScene(geom, "all").pairs
 
 
 def test_tip_arcs_face_the_surfaces_their_pairs_name(geom):
     """A tip arc has a pair with a guide surface of the other APDS exactly when, at some
     relative roll in the scenario's range (-60 to 60 deg), a point of the arc lies over the
     surface's angular span at its base, the widest (Eq. 13): sampled rolls and arc points."""
-    from drake_dock.docking.scene import relative_pose
+    from drake_dock.docking.placement.search import relative_pose
     P = apds_patches(geom)
-    names = {p.name for p in apds_pairs(geom, "complete") if p.name.startswith("cs_") and
+    names = {p.name for p in DockingScene(geom, "complete").pairs if p.name.startswith("cs_") and
              "tip" in p.name}
     reach = set()
     for yaw in np.radians(np.linspace(-60.0, 60.0, 241)):
@@ -271,9 +272,9 @@ def test_corners_reach_the_surfaces_their_pairs_name(geom):
     when, at some relative roll in the scenario's range (-60 to 60 deg), the corner lies over
     the surface's angular span at its base (sampled rolls): a second rule beside the code's
     (the corner's azimuth at the matched facing within 70 deg of the span)."""
-    from drake_dock.docking.scene import relative_pose
+    from drake_dock.docking.placement.search import relative_pose
     P = apds_patches(geom)
-    names = {p.name for p in apds_pairs(geom, "complete") if p.kind == "PS"
+    names = {p.name for p in DockingScene(geom, "complete").pairs if p.kind == "PS"
              and "tip" not in p.name}
     reach = set()
     for yaw in np.radians(np.linspace(-60.0, 60.0, 241)):
@@ -293,9 +294,10 @@ def test_corners_come_over_the_tip_lands_their_pairs_name(geom):
     relative roll strictly inside the scenario's range (sampled rolls, -59.9 to 59.9 deg), the
     corner lies over the tip arc's span: a second rule beside the code's (`LAND_REACH`). Each
     corner comes over one tip, from a roll of 2 theta_end on (closed form)."""
-    from drake_dock.docking.scene import relative_pose
+    from drake_dock.docking.placement.search import relative_pose
     P = apds_patches(geom)
-    names = {p.name for p in apds_pairs(geom, "complete") if p.kind == "PS" and "tip" in p.name}
+    names = {p.name for p in DockingScene(geom, "complete").pairs
+             if p.kind == "PS" and "tip" in p.name}
     reach, first = set(), {}
     for yaw in np.radians(np.linspace(-59.9, 59.9, 1199)):
         R = relative_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
@@ -326,10 +328,10 @@ def test_sides_reach_the_edges_their_pairs_name(geom):
     one comes within 10 deg of a point of the other about the axis (the margin for tilt and
     offset): sampled rolls and curve points. These are the sides 60 deg from the partner and
     the tip arcs 30 and 90 deg from the side's root."""
-    from drake_dock.docking.pairs import CC_SIDE_PAIRS
-    from drake_dock.docking.scene import relative_pose
+    from drake_dock.docking.geometry.pairs import CC_SIDE_PAIRS
+    from drake_dock.docking.placement.search import relative_pose
     P = apds_patches(geom)
-    names = {p.name for p in apds_pairs(geom, "complete")[12:]
+    names = {p.name for p in DockingScene(geom, "complete").pairs[12:]
              if p.name.startswith("cc_") and "ring" not in p.name and "rim" not in p.name
              and not p.name.startswith("cc_Ctip")}
     margin = math.radians(10.0)
@@ -357,14 +359,14 @@ def test_sides_reach_the_edges_their_pairs_name(geom):
 
 def test_the_reach_sweep_finds_no_undeclared_side_pair(geom):
     """Over 2000 seeded random poses (roll -60..60 deg, tilt up to 10 deg, offset up to 0.15 m,
-    ring faces -0.2..0.45 m apart; `drake_dock.docking.reach`), every candidate side pair whose
-    closest couple comes interior within 2 cm is declared by `complete`; the declared pairs
+    ring faces -0.2..0.45 m apart; `drake_dock.docking.geometry.reach`), every candidate side pair
+    whose closest couple comes interior within 2 cm is declared by `complete`; the declared pairs
     whose azimuth spans come within 50 deg (the sides 60 deg from the partner, the tip arcs 30
     deg from the side's root) are all reached. bench/edge_reach.py runs the sweep at 20000."""
-    from drake_dock.docking.reach import reach_sweep, side_candidates
-    from drake_dock.docking.apds import azimuth_span, spans_within
-    from drake_dock.docking.scene import R_MATCHED
-    declared = {p.name: p for p in apds_pairs(geom, "complete")}
+    from drake_dock.docking.geometry.apds import azimuth_span, spans_within
+    from drake_dock.docking.geometry.pairs import R_MATCHED
+    from drake_dock.docking.geometry.reach import reach_sweep, side_candidates
+    declared = {p.name: p for p in DockingScene(geom, "complete").pairs}
     rows = reach_sweep(geom, side_candidates(geom), 2000)
     reached = {k for k, (hits, _, _) in rows.items() if hits}
     assert reached <= set(declared), sorted(reached - set(declared))
@@ -411,9 +413,9 @@ def test_tip_tip_pairs_follow_the_closed_form(geom):
     closed-form couple and distance to 1e-12, the normal is along the
     axis, and u* integrated by Eq. (47) along a motion (the chaser closing at 0.05 m/s and
     drifting sideways at 0.02 m/s) equals the closed form to 1e-8."""
-    from drake_dock.docking.scene import relative_pose
+    from drake_dock.docking.placement.search import relative_pose
     P = apds_patches(geom)
-    pairs = [p for p in apds_pairs(geom, "complete") if p.name.startswith("cc_Ctip")]
+    pairs = [p for p in DockingScene(geom, "complete").pairs if p.name.startswith("cc_Ctip")]
     assert len(pairs) == 6
     rng = np.random.default_rng(7)
     for pr in pairs:
@@ -450,16 +452,16 @@ def test_tip_tip_pairs_follow_the_closed_form(geom):
 
 
 def test_declared_handovers_map_each_edge_onto_its_surface(geom):
-    """Every hand-over of the complete set (`pair_handovers`, 24): the two pairs share Body 1's
-    curve, and along the edge curve (the edge pair's patch 2) the surface point at the mapped
-    parameters (`surface_params`) is the edge's point, 21 samples to 1e-12 m, and maps back."""
+    """Every hand-over of the complete set (`DockingScene.handovers`, 24): the two pairs are the
+    scene's, share Body 1's curve, and along the edge curve (the edge pair's patch 2) the
+    surface point at the mapped parameters (`surface_params`) is the edge's point, 21 samples
+    to 1e-12 m, and maps back."""
     from drake_dock.core.handover import surface_params
-    from drake_dock.docking.pairs import pair_handovers
-    pairs = {p.name: p for p in apds_pairs(geom, "complete")}
-    found = pair_handovers(geom, list(pairs.values()))
-    assert len(found) == 24
-    for e_name, s_name, edge in found:
-        e, s = pairs[e_name], pairs[s_name]
+    scene = DockingScene(geom, "complete")
+    assert len(scene.handovers) == 24
+    for h in scene.handovers:
+        e, s, edge = h.edge_pair, h.surface_pair, h.edge
+        assert scene.pair(e.name) is e and scene.pair(s.name) is s
         assert (e.kind, s.kind) == ("CC", "CS") and e.patch1 is s.patch1
         assert (e.body1, e.body2) == (s.body1, s.body2)
         E, S = e.patch2, s.patch2

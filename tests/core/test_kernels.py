@@ -16,8 +16,11 @@ from drake_dock.core.couple import closest_point_conditions, evaluate_couple
 from drake_dock.core.seeking import seek_couple
 from drake_dock.core.kernels.jets import jet, patch_spec, position
 from drake_dock.core.patches import Circle, Cone, PlaneRect, PolarCurve, Segment, posed
-from drake_dock.docking.apds import ApdsGeometry, apds_patches
-from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec, rot_x
+from drake_dock.docking.geometry.apds import apds_patches
+from drake_dock.docking.geometry.pairs import R_MATCHED
+from drake_dock.docking.geometry.rotations import rot_vec, rot_x
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.scenario.dimensions import ApdsGeometry
 from motions import Motion, check_rates_by_finite_differences
 
 GEOMETRIES = [ApdsGeometry(), ApdsGeometry(R=0.9, Rs=0.55, H=0.3, alpha1_deg=50.0,
@@ -210,7 +213,7 @@ def _moving_pairs(g, d):
     m_t = Motion(A=(0.002, -0.001, 0.003), W=(0.8, 1.4, 0.6), a=(0.012, 0.5), b=(0.006, 1.2))
     motion = {"target_apds": m_t, "chaser_apds": m_c}
     out = []
-    for pr in apds_pairs(g, "complete"):
+    for pr in DockingScene(g, "complete").pairs:
         m1, m2 = motion[pr.body1], motion[pr.body2]
         X1, X2 = m1.pose(0.0), m2.pose(0.0)
         c = seek_couple(posed(pr.patch1, *X1), posed(pr.patch2, *X2))

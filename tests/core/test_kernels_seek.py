@@ -18,8 +18,10 @@ from closest_reference import brute_force_closest
 from drake_dock.core.kernels.seek import CREEP_TOUCH
 from drake_dock.core.patches import Circle, Cone, PlaneRect, Point, PolarCurve, Segment, posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.apds import ApdsGeometry
-from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec, rot_x
+from drake_dock.docking.geometry.pairs import R_MATCHED
+from drake_dock.docking.geometry.rotations import rot_vec, rot_x
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.scenario.dimensions import ApdsGeometry
 
 EYE = (np.eye(3), np.zeros(3))
 
@@ -49,7 +51,7 @@ def test_complete_pairs_against_dense_sampling(g, d):
              "chaser_apds": (rot_vec((0.03, -0.02, 0.01)) @ R_MATCHED,
                              np.array([0.01, -0.005, d]))}
     kinds = set()
-    for pr in apds_pairs(g, "complete"):
+    for pr in DockingScene(g, "complete").pairs:
         P1, P2 = posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2])
         c = seek_couple(P1, P2)
         radius = getattr(pr.patch1, "radius", 0.0) if pr.kind in ("PC", "PS") else 0.0
@@ -167,7 +169,7 @@ def test_a_circle_through_a_face_near_its_edge_is_a_touch(case):
     The seek takes it as a touch within CREEP_TOUCH, at the distance of a bounded 1-D
     minimisation of the closed-form point-to-annulus distance over the circle."""
     from scipy.optimize import minimize_scalar
-    pair = next(p for p in apds_pairs(ApdsGeometry(), "complete") if p.name == case["pair"])
+    pair = next(p for p in DockingScene(ApdsGeometry(), "complete").pairs if p.name == case["pair"])
     P1 = posed(pair.patch1, np.array(case["R1"]), np.array(case["o1"]))
     P2 = posed(pair.patch2, np.array(case["R2"]), np.array(case["o2"]))
     rtol, beyond = case["kw"]

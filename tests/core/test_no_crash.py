@@ -22,16 +22,19 @@ from drake_dock.core.kernels.jets import jet, patch_spec, position
 from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.core.tracking import couple_rate
-from drake_dock.docking.apds import ApdsGeometry, apds_patches
-from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec, rot_x, rot_z
+from drake_dock.docking.geometry.apds import apds_patches
+from drake_dock.docking.geometry.pairs import R_MATCHED
+from drake_dock.docking.geometry.rotations import rot_vec, rot_x, rot_z
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.scenario.dimensions import ApdsGeometry
 from drake_dock.errors import DrakeDockError, SingularCoupleError
 
 COND_MIN = 1e-6          # the contact system's default conditioning_min
 G = ApdsGeometry()
-PAIRS = apds_pairs(G)
+PAIRS = DockingScene(G, "paper").pairs
 # Every C-C, C-S and point-surface pair of the complete set (the point-curve corners:
 # tests/core/test_point_curve.py).
-COMPLETE = [p for p in apds_pairs(G, "complete") if p.kind != "PC"]
+COMPLETE = [p for p in DockingScene(G, "complete").pairs if p.kind != "PC"]
 TARGET = (np.eye(3), np.zeros(3))
 
 

@@ -170,10 +170,12 @@ def test_scene_corner_pairs_random_poses_raise_only_typed_errors():
     placed on the ring's axis and on the circle: the seek, the contact-form finish and the
     evaluation give finite results in the domain or a typed error, never a Python or numpy
     one."""
-    from drake_dock.docking.apds import ApdsGeometry
-    from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_vec, rot_z
+    from drake_dock.docking.geometry.pairs import R_MATCHED
+    from drake_dock.docking.geometry.rotations import rot_vec, rot_z
+    from drake_dock.docking.geometry.scene import DockingScene
+    from drake_dock.docking.scenario.dimensions import ApdsGeometry
     from drake_dock.errors import DrakeDockError
-    pairs = [p for p in apds_pairs(ApdsGeometry(), "complete") if p.kind == "PC"]
+    pairs = [p for p in DockingScene(ApdsGeometry(), "complete").pairs if p.kind == "PC"]
     assert len(pairs) == 12
     rng = np.random.default_rng(18)
     usable = 0

@@ -9,7 +9,9 @@ from closest_reference import scipy_closest
 from drake_dock.core.patches import Segment, posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.core.tracking import SingularCoupleError, couple_rate
-from drake_dock.docking.scene import R_MATCHED, apds_pairs, rot_x, rot_z
+from drake_dock.docking.geometry.pairs import R_MATCHED
+from drake_dock.docking.geometry.rotations import rot_x, rot_z
+from drake_dock.docking.geometry.scene import DockingScene
 
 
 def chaser_motion(t, offset=0.0):
@@ -31,7 +33,7 @@ def chaser_motion(t, offset=0.0):
 # a ring passing through a surface.
 @pytest.mark.parametrize("name, offset", [("cc_T2_C4", 0.0), ("cc_T6_C6", 0.0)])
 def test_tracking_matches_reseeking(geom, name, offset):
-    pair = next(p for p in apds_pairs(geom) if p.name == name)
+    pair = next(p for p in DockingScene(geom, "paper").pairs if p.name == name)
     fixed = (np.eye(3), np.zeros(3))
 
     def placed(t):

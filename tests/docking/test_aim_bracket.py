@@ -1,4 +1,4 @@
-"""The consistent aim's root finding on hand-made mismatches (`drake_dock.docking.scene`):
+"""The consistent aim's root finding on hand-made mismatches (`drake_dock.docking.placement.aim`):
 the bracket that stops on a jump of the first contact (`_bracketed_height`, `JUMP_SLOPE`) and
 the secant steps from the axial height (`_local_height`). Each is checked against a closed
 form or against scipy's brentq."""
@@ -7,8 +7,8 @@ import math
 import pytest
 from scipy.optimize import brentq
 
-from drake_dock.docking.scene import (AIM_TOL, JUMP_SLOPE, LOCAL_STEPS, _bracketed_height,
-                                      _local_height)
+from drake_dock.docking.placement.aim import (AIM_TOL, JUMP_SLOPE, LOCAL_STEPS, _bracketed_height,
+                                              _local_height)
 
 
 def _counted(f):

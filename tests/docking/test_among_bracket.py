@@ -1,5 +1,5 @@
 """The consistent aim's bracket closed among the pairs that close at its ends
-(`drake_dock.docking.scene._among_height`), on hand-made scenes of a few pairs whose closing
+(`drake_dock.docking.placement.aim._among_height`), on hand-made scenes of a few pairs whose closing
 heights are closed forms: checked against the bracket with the whole set
 (`_bracketed_height`), bit for bit where no other pair shows, and against the jump's rule
 where one does."""
@@ -7,12 +7,12 @@ import math
 
 import pytest
 
-from drake_dock.docking.scene import JUMP_SLOPE, _among_height, _bracketed_height
+from drake_dock.docking.placement.aim import JUMP_SLOPE, _among_height, _bracketed_height
 from drake_dock.errors import SeekingError
 
 
 class _Scene:
-    """A mismatch as `scene._Mismatch` gives it: ``pairs`` maps a name to s -> the height at
+    """A mismatch as `aim._Mismatch` gives it: ``pairs`` maps a name to s -> the height at
     which the pair closes on the approach s (None: it does not close). Counts the searches
     with the whole set, and those that stop at a height (`below`)."""
 
@@ -36,8 +36,8 @@ class _Scene:
         return self._first(s, self.pairs if names is None else names)
 
     def below(self, s, T):
-        """As `search.first_contact_above`: None where no pair closes at the height s - T or
-        above (none closing at all included)."""
+        """As a search stopped at the height s - T (`first_contact`'s ``stop``): None where no
+        pair closes there or above (none closing at all included)."""
         self.stopped.append(s)
         hs = [h for h in (f(s) for f in self.pairs.values()) if h is not None]
         return None if not hs or max(hs) < s - T else self._first(s, self.pairs)

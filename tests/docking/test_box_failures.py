@@ -14,9 +14,10 @@ import pytest
 import yaml
 
 from drake_dock.cli import main
-from drake_dock.docking.results import summary, timeseries
-from drake_dock.docking.scenario import MODELS_DIR, load_scenario
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.report.results import summary, timeseries
+from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
 
 
 def _run(tmp_path, data: dict, name: str, *extra) -> dict:
@@ -62,7 +63,8 @@ def test_box_corner_pushed_at_500_newtons_runs_past_the_old_failure():
     data = yaml.safe_load((MODELS_DIR / "idss_box_corner.yaml").read_text())
     data["thrust"] = {"force": 500.0, "duration": 5.0}
     data.setdefault("simulation", {})["duration"] = 3.2
-    result = simulate(load_scenario(data=yaml.safe_dump(data)))
+    s = load_scenario(data=yaml.safe_dump(data))
+    result = simulate(s, place(s))
     s = summary(result, timeseries(result))
     assert s["outcome"] in ("timeout", "missed", "jammed")
     assert s["end_time_s"] >= 3.04 or s["outcome"] == "missed"

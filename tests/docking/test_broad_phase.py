@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 from drake_dock.core.hybrid import Mode
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import load_scenario
 from drake_dock.systems.transitions import Transitions
 
 SCENES = {"paper example": "contact: {pairs: complete}",
@@ -36,7 +37,8 @@ def _narrow_phase(checks):
 
 
 def _run(data):
-    r = simulate(load_scenario(data=data))
+    s = load_scenario(data=data)
+    r = simulate(s, place(s))
     return (r.capture_time, r.end_time, r.evaluations, r.mode_changes, np.array(r.record.x),
             np.array(r.record.couples), [(imp["t"], imp["couples"]) for imp in r.impacts],
             r.timing["screens_per_pair"])
@@ -62,13 +64,15 @@ def test_options_a_caller_passes_take_the_scenes_broad_phase_policy(pairs, scree
     """Options passed to `build_docking_diagram` with other fields changed and broad_phase left
     at its default: the complete set's far pairs are screened (the run's screening counters),
     the paper's are all sought; an explicit False is kept."""
-    from drake_dock.docking.diagram import build_docking_diagram
+    from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
     from drake_dock.systems.contact_types import ContactOptions
     s = load_scenario(data=f"contact: {{pairs: {pairs}}}")
-    dd = build_docking_diagram(s, options=ContactOptions(reseek_early=0.8, impact_rtol=1e-9))
+    dd = build_docking_diagram(DiagramSpec.of(
+        s, options=ContactOptions(reseek_early=0.8, impact_rtol=1e-9)))
     assert dd.contact.options.broad_phase is screens
     assert dd.contact.options.reseek_early == 0.8 and dd.contact.options.impact_rtol == 1e-9
-    r = simulate(s, dd=dd, duration=0.01)
+    r = simulate(s, place(s), dd=dd, duration=0.01)
     assert (sum(r.timing["screens_per_pair"].values()) > 0) is screens
-    off = build_docking_diagram(s, options=ContactOptions(reseek_early=0.8, broad_phase=False))
+    off = build_docking_diagram(DiagramSpec.of(
+        s, options=ContactOptions(reseek_early=0.8, broad_phase=False)))
     assert off.contact.options.broad_phase is False

@@ -6,7 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from drake_dock.docking import cone_reach, penetration as pen
+from drake_dock.docking.checks import cone_reach
+from drake_dock.docking.checks import penetration as pen
 
 N_SAMPLES = 20001
 

@@ -9,10 +9,13 @@ import math
 import numpy as np
 import pytest
 
-from drake_dock.docking.penetration import deepest_penetration
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.scene import (Approach, _consistent_height, contact_approach,
-                                      first_contact_or_faces, travel_grid)
+from drake_dock.docking.checks.penetration import deepest_penetration
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.placement.aim import _consistent_height
+from drake_dock.docking.placement.place import PlacementCache, contact_approach
+from drake_dock.docking.placement.search import Approach
+from drake_dock.docking.placement.search import first_contact, travel_grid
+from drake_dock.docking.scenario.loading import load_scenario
 from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
 from tests.docking.test_placement import full_scan
 
@@ -33,12 +36,19 @@ def _depth_down_to(g, approach, lam):
                                graze=1e-6).depth
 
 
+def _height(g, approach) -> float:
+    """The height of the first contact of the complete set on ``approach`` (the ring-face
+    plane's where none closes), by a search on a cache of its own."""
+    found = first_contact(PlacementCache(DockingScene(g, "complete")), approach)
+    return approach.height(found.travel())
+
+
 def _mismatch(g, yaw, tilt, offset, slope, direction):
     """h_c(aim(x)) - x: the first contact's height on the line aimed at offset + x slope,
     less x (the complete set)."""
     def mismatch(x):
-        aimed = Approach(yaw, tilt, tuple((offset + x * slope).tolist()), direction)
-        return aimed.height(first_contact_or_faces(g, aimed, "complete")[0]) - x
+        return _height(g, Approach(yaw, tilt, tuple((offset + x * slope).tolist()),
+                                   direction)) - x
     return mismatch
 
 
@@ -80,7 +90,7 @@ def _placed_and_axial(name):
     slope = np.array(ic.lateral_velocity) / ic.chaser_speed
     yaw, tilt = math.radians(ic.target_yaw_deg), tuple(math.radians(t) for t in ic.tilt_deg)
     axial = Approach(yaw, tilt, tuple(offset.tolist()))
-    h_axial = axial.height(first_contact_or_faces(g, axial, "complete")[0])
+    h_axial = _height(g, axial)
     return g, offset, slope, contact_approach(s), yaw, tilt, h_axial
 
 
@@ -94,7 +104,7 @@ def test_an_axial_pose_the_approach_does_not_first_touch_is_not_taken(name):
     full scan's."""
     g, offset, slope, (a, lam, closing), yaw, tilt, h_axial = _placed_and_axial(name)
     through = Approach(yaw, tilt, tuple((offset + h_axial * slope).tolist()), a.direction)
-    h_through = through.height(first_contact_or_faces(g, through, "complete")[0])
+    h_through = _height(g, through)
     assert abs(h_through - h_axial) > 1e-6
     np.testing.assert_allclose(np.array(a.aim) - a.height(lam) * slope, offset, rtol=0,
                                atol=1e-8 * np.linalg.norm(slope))
@@ -109,22 +119,22 @@ def test_a_failed_seek_on_a_shortcut_leaves_the_aim_to_the_bracket(monkeypatch, 
     on the axial line, or on the straight approach through the axial pose (the first try's
     mismatch), the placement is the whole-range bracket's, to the bit, and still consistent to
     1e-10 m."""
-    from drake_dock.docking import search
+    from drake_dock.docking.placement import search
     from drake_dock.errors import SeekingError
     g, offset, slope, (a0, _, _), yaw, tilt, h_axial = _placed_and_axial("random 2")
     failing = {"axial": Approach(yaw, tilt, tuple(offset.tolist())),
                "through": Approach(yaw, tilt, tuple((offset + h_axial * slope).tolist()),
                                    a0.direction)}[line]
-    original = search._first_contact
+    original = search._search
 
-    def failing_on_the_line(geometry, approach, *rest):
+    def failing_on_the_line(scene, approach, *rest):
         if approach == failing:
             raise SeekingError("a closest-couple Newton that does not converge")
-        return original(geometry, approach, *rest)
+        return original(scene, approach, *rest)
 
     mismatch = _mismatch(g, yaw, tilt, offset, slope, a0.direction)
     expected = _consistent_height(mismatch, 2.0 * g.H + 0.05)
-    monkeypatch.setattr(search, "_first_contact", failing_on_the_line)
+    monkeypatch.setattr(search, "_search", failing_on_the_line)
     a, lam, _ = contact_approach(_condition("random 2"))
     assert a.aim == tuple((offset + expected * slope).tolist())
     np.testing.assert_allclose(np.array(a.aim) - a.height(lam) * slope, offset, rtol=0,
@@ -133,7 +143,7 @@ def test_a_failed_seek_on_a_shortcut_leaves_the_aim_to_the_bracket(monkeypatch, 
 
 def test_a_closing_by_touch_is_placed_by_the_first_try():
     """Random 26 (the target ring's circle touching a chaser guide surface and then cutting
-    it, `_touch`): the straight approach through the axial pose first touches within
+    it, `search.march_root`): the straight approach through the axial pose first touches within
     `AIM_TOL` of h_axial, so that pose is the placement: its aim is offset + h_axial slope, bit
     for bit. On the full scan (a second search) the mismatch next to h_axial is smooth in the
     aim: its slope over 2e-9 m agrees with its slope over 2e-7 m to 1 %, and its root lies

@@ -7,10 +7,10 @@ bound of its points' distance. On a docking run with the complete set, before co
 its impacts (far, tracked and in-contact pairs alike); every couple port equals its row."""
 import numpy as np
 
-from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.scene import initial_state
-from drake_dock.docking.simulate import docking_simulator
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.model.simulate import docking_simulator
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import load_scenario
 from drake_dock.systems.contact_types import COUPLE_SLICES as S
 
 
@@ -19,8 +19,8 @@ def test_the_table_is_the_pairs_points_frames_and_gaps():
     s.contact.pairs = "complete"
     s.initial.tilt_deg = [1.0, 0.5]
     s.initial.lateral_offset = [0.02, -0.01]
-    dd = build_docking_diagram(s)
-    sim = docking_simulator(dd, initial_state(s), s.simulator_config)
+    dd = build_docking_diagram(DiagramSpec.of(s))
+    sim = docking_simulator(dd, place(s), s.simulator_config)
     system = dd.contact
     plant = dd.dp.plant
     modes_seen = set()

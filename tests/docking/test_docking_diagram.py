@@ -4,10 +4,10 @@ import pytest
 from pydrake.systems.analysis import SimulatorConfig
 
 from drake_dock.core.hybrid import Mode
-from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.plant import body_momenta
-from drake_dock.docking.scene import initial_state
-from drake_dock.docking.simulate import docking_simulator
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.model.plant import body_momenta
+from drake_dock.docking.model.simulate import docking_simulator
+from drake_dock.docking.placement.place import place
 
 
 @pytest.fixture(scope="module")
@@ -16,7 +16,7 @@ def axisymmetric_scenario():
     chaser, I = (40211, 6402, 40242), is not: see docs/model.md). Only then are the three
     couples' forces equal by symmetry."""
     import yaml
-    from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
     data = yaml.safe_load(PAPER_EXAMPLE.read_text())
     data["bodies"]["target"]["inertia"] = [778.0, 778.0, 829.0]
     data["bodies"]["chaser"]["inertia"] = [40226.5, 40226.5, 6402.0]
@@ -26,8 +26,8 @@ def axisymmetric_scenario():
 @pytest.fixture(scope="module")
 def first_impact(axisymmetric_scenario):
     s = axisymmetric_scenario
-    state = initial_state(s)
-    dd = build_docking_diagram(s)
+    state = place(s)
+    dd = build_docking_diagram(DiagramSpec.of(s))
     sim = docking_simulator(dd, state, SimulatorConfig(
         integration_scheme="runge_kutta5", accuracy=1e-10, max_step_size=0.01),
         witness_accuracy=1e-8)

@@ -3,20 +3,20 @@ series, every series a figure function lists is on the image in its colour (outs
 legend), no legend sits on the data, no axis spans more than 12 decades; and the interface loads
 against the chaser's momentum balance and the Stewart stroke against the body poses. Three runs,
 one each for the module: the paper's example (symmetric: three equal forces, zero transverse
-rates), the same with a lateral push on the chaser (`drake_dock.docking.control`), and
+rates), the same with a lateral push on the chaser (`drake_dock.docking.model.control`), and
 `models/idss_box_corner.yaml` (off the axis, many impacts; its first 1.5 s)."""
 import numpy as np
 import pytest
 from PIL import Image
 
-from drake_dock.docking.control import WrenchController, with_controller
-from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.figure_kit import PALETTE, decades
-from drake_dock.docking.figures import IMPULSE_FLOOR
-from drake_dock.docking.loads import interface_loads
-from drake_dock.docking.outcome import misalignment
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.scene import apds_pairs
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.model.control import WrenchController, with_controller
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.model.outcome import misalignment
+from drake_dock.docking.report.figure_kit import PALETTE, decades
+from drake_dock.docking.report.loads import interface_loads
+from drake_dock.docking.report.run_figures import IMPULSE_FLOOR
+from drake_dock.docking.scenario.loading import load_scenario
 from drake_dock.run import run
 from matplotlib.colors import to_rgb
 
@@ -35,7 +35,7 @@ def runs(tmp_path_factory, box_corner):
     base = tmp_path_factory.mktemp("figures")
     scenario = load_scenario()
     paper = run(scenario, base / "paper", full=True)
-    dd = build_docking_diagram(scenario)
+    dd = build_docking_diagram(DiagramSpec.of(scenario))
     n = dd.dp.plant.num_positions() + dd.dp.plant.num_velocities()
     pushed = run(scenario, base / "pushed", dd=with_controller(dd, WrenchController(n, _push)),
                  full=True)
@@ -121,7 +121,7 @@ def test_couple_forces_legend_says_normal_and_friction(runs):
 def test_initial_configuration_states_offset_and_tilt(runs):
     """The initial configuration's views give the chaser ring centre's offset and its axis's
     tilt, which equal the misalignment of the two APDS frames at t = 0
-    (`drake_dock.docking.outcome.misalignment`): the box corner's offset lies along x and its
+    (`drake_dock.docking.model.outcome.misalignment`): the box corner's offset lies along x and its
     tilt in the x-z plane, so the view along y shows both and the view along x shows none."""
     out, _ = runs["box"]
     ts = out.timeseries
@@ -177,7 +177,7 @@ def test_interface_loads_balance_the_chaser(runs, which):
     start = max(ts["impact_t"].max(), PUSH_AFTER_S if which == "pushed" else 0.0)
     k = ts["t"] > start
     t = ts["t"][k]
-    loads = interface_loads(ts, apds_pairs(scenario.geometry))
+    loads = interface_loads(ts, DockingScene(scenario.geometry, "paper").pairs)
     R, c = ts["R_WA"][k, 0], ts["p_WA"][k, 0]
     F = np.einsum("nij,nj->ni", R, loads["F_A"][k])
     M = np.einsum("nij,nj->ni", R, loads["M_A"][k])

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from drake_dock.core.patches import Circle, Cone, PlaneRect, Reparametrized, Segment, posed
-from drake_dock.docking.apds import apds_patches, guide_side, guide_surface, ring_circle
-from drake_dock.docking.scene import rot_x, rot_z
+from drake_dock.docking.geometry.apds import apds_patches, guide_side, guide_surface, ring_circle
+from drake_dock.docking.geometry.rotations import rot_x, rot_z
 
 RNG = np.random.default_rng(7)
 

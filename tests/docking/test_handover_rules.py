@@ -9,11 +9,12 @@ import math
 
 import pytest
 
-from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.pairs import apds_pairs, pair_handovers
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.scene import contact_approach, initial_state
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import contact_approach, place
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.errors import NumericalError
 from drake_dock.systems import handovers
 
 COMPLETE = "contact: {pairs: complete}"
@@ -22,12 +23,12 @@ COMPLETE = "contact: {pairs: complete}"
 @pytest.fixture(scope="module")
 def scenario():
     s = load_scenario(data=COMPLETE)
-    return s, initial_state(s)
+    return s, place(s)
 
 
 def _run(scenario, handovers):
     s, state = scenario
-    return simulate(s, state=state, dd=build_docking_diagram(s, handovers=handovers))
+    return simulate(s, state, dd=build_docking_diagram(DiagramSpec.of(s, handovers=handovers)))
 
 
 def test_refused_handovers_leave_the_run_unchanged(scenario, monkeypatch):
@@ -49,11 +50,10 @@ def test_refused_handovers_leave_the_run_unchanged(scenario, monkeypatch):
 
 def test_without_the_rules_the_couples_go_to_and_fro(scenario, monkeypatch):
     """Every hand-over that falls due taken: more are taken than twice the declared hand-overs
-    (each could go once each way), so couples go to and fro. The run still ends captured (the
-    tracked couples that drift on the way are sought again), but not the physical run: a
-    couple handed where the rules refuse it (singular, or not the same pair of points) can
-    meet a patch the run without hand-overs never touches, so it captures later, after more
-    impacts."""
+    (each could go once each way), so couples go to and fro. That run is not the physical run:
+    a couple handed where the rules refuse it (singular, or not the same pair of points) can
+    meet a patch the run without hand-overs never touches. It either captures later, after
+    more impacts, or stops on a typed numerical failure naming its time and couples."""
     taken = []
 
     def take(*args):
@@ -62,12 +62,18 @@ def test_without_the_rules_the_couples_go_to_and_fro(scenario, monkeypatch):
 
     monkeypatch.setattr(handovers, "accepts", take)
     s, _ = scenario
-    declared = pair_handovers(s.geometry, apds_pairs(s.geometry, s.contact.pairs))
-    r = _run(scenario, True)
+    declared = DockingScene.of(s).handovers
     ref = _run(scenario, False)
+    try:
+        r = _run(scenario, True)
+    except NumericalError as e:
+        assert e.time is not None and e.time > 0 and e.couples
+        r = None
     assert len(taken) > 2 * len(declared) > 0
-    assert r.outcome == ref.outcome == "captured"
-    assert r.capture_time >= ref.capture_time and len(r.impacts) >= len(ref.impacts)
+    assert ref.outcome == "captured"
+    if r is not None:
+        assert r.outcome == "captured"
+        assert r.capture_time >= ref.capture_time and len(r.impacts) >= len(ref.impacts)
 
 
 def test_the_complete_set_shifts_the_paper_example_by_its_first_contact(scenario):
@@ -85,7 +91,7 @@ def test_the_complete_set_shifts_the_paper_example_by_its_first_contact(scenario
     _, lam_paper, _ = contact_approach(paper)
     assert abs(lam_complete - g.H) <= 1e-9 and all("tip" in name for name in closing)
     shift = (lam_complete - lam_paper) / s.initial.chaser_speed
-    r, ref = simulate(s), simulate(paper)
+    r, ref = simulate(s, place(s)), simulate(paper, place(paper))
     assert r.outcome == ref.outcome == "captured" and len(r.impacts) == len(ref.impacts) > 0
     assert abs(r.capture_time - ref.capture_time - shift) <= 1e-6
     for a, b in zip(r.impacts, ref.impacts):

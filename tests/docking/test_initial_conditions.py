@@ -6,10 +6,12 @@ import numpy as np
 import pytest
 import yaml
 
-from drake_dock.docking.scene import (CHASER_APDS, TARGET_APDS, apds_pairs, contact_approach,
-                                      initial_state, pair_couples)
+from drake_dock.docking.geometry.pairs import CHASER_APDS, TARGET_APDS
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.placement.place import contact_approach, place
+from drake_dock.docking.placement.search import pair_couples
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.errors import InputError
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 
 OFF_AXIS = dict(lateral_offset=[0.02, -0.01], tilt_deg=[1.0, 0.5], lateral_velocity=[0.01, 0.0],
                 angular_velocity_deg_s=[0.1, -0.2, 0.3], chaser_speed=0.1)
@@ -35,7 +37,7 @@ def test_off_axis_placement():
     distance, with the ring centre at lateral_offset and the chaser tilted by tilt_deg."""
     sc = scenario_with(**OFF_AXIS)
     ic = sc.initial
-    st = initial_state(sc)
+    st = place(sc)
     R_WA, p_WA = st.X_WB["target_apds"]
     R_WC, p_WC = st.X_WB["chaser"]
     w_WC, v_WC = st.V_WB["chaser"]
@@ -50,7 +52,7 @@ def test_off_axis_placement():
     R_AC = R_WA.T @ R_WC
     tilt = math.degrees(math.acos(np.clip(-R_AC[2, 2], -1, 1)))
     assert tilt == pytest.approx(math.hypot(*ic.tilt_deg), abs=1e-9)
-    pairs = apds_pairs(sc.geometry)
+    pairs = DockingScene(sc.geometry, "paper").pairs
     at = {TARGET_APDS: (np.eye(3), np.zeros(3))}
     start = pair_couples(pairs, {**at, CHASER_APDS: (R_AC, p_A)})
     contact = pair_couples(pairs, {**at, CHASER_APDS: (R_AC, p_contact)})
@@ -64,4 +66,4 @@ def test_zero_misalignment_is_the_coaxial_search():
     sc = load_scenario(PAPER_EXAMPLE)
     approach, lam_c, closing = contact_approach(sc)
     assert approach.pose(lam_c)[1].tolist() == [0.0, 0.0, lam_c]
-    assert closing == initial_state(sc).closing_pairs
+    assert closing == place(sc).closing_pairs

@@ -1,9 +1,11 @@
 """Every documented bad input raises InputError naming the field (one test per case)."""
+import math
+
 import pytest
 
-from drake_dock.docking.apds import ApdsGeometry
+from drake_dock.docking.scenario.dimensions import ApdsGeometry
+from drake_dock.docking.scenario.loading import load_scenario
 from drake_dock.errors import InputError
-from drake_dock.docking.scenario import load_scenario
 
 
 def _fails(data, field):
@@ -109,10 +111,11 @@ def test_contact_static_friction_defaults_to_sliding_friction():
 def test_contact_pairs_names_the_contact_set(paper_scenario):
     """contact.pairs: ``paper`` (the paper's 12 pairs, which the paper's example states) or
     ``complete`` (134 pairs, the default); anything else is named by its field."""
-    from drake_dock.docking.pairs import scenario_pairs
-    assert paper_scenario.contact.pairs == "paper" and len(scenario_pairs(paper_scenario)) == 12
+    from drake_dock.docking.geometry.scene import DockingScene
+    assert paper_scenario.contact.pairs == "paper"
+    assert len(DockingScene.of(paper_scenario).pairs) == 12
     s = load_scenario(data="contact: {pairs: complete}")
-    assert len(scenario_pairs(s)) == 134
+    assert len(DockingScene.of(s).pairs) == 134
     assert load_scenario(data="contact: {mu: 0.1}").contact.pairs == "complete"
     _fails("contact: {pairs: all}", "contact.pairs")
     _fails("contact: {pairs: 12}", "contact.pairs")
@@ -158,8 +161,8 @@ def test_physically_inconsistent(case):
 
 def test_target_apds_near_its_mass_centre_builds():
     """p_TA z in (0, 1] m is valid (the target's display hull used to refuse it)."""
-    from drake_dock.docking.diagram import build_docking_diagram
-    build_docking_diagram(load_scenario(data="stewart: {p_TA: [0.0, 0.0, 0.5]}"))
+    from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+    build_docking_diagram(DiagramSpec.of(load_scenario(data="stewart: {p_TA: [0.0, 0.0, 0.5]}")))
 
 
 def test_binary_file(tmp_path):
@@ -175,16 +178,20 @@ def test_capture_distance_at_or_beyond_the_start(beyond):
     """The initial ring distance is the first-contact distance plus the approach travel; a
     capture distance at or beyond it is refused when the chaser is placed, before simulating,
     naming both fields."""
-    from drake_dock.docking.scene import first_contact_distance, initial_state
+    from drake_dock.docking.geometry.scene import DockingScene
+    from drake_dock.docking.placement.place import PlacementCache, place
+    from drake_dock.docking.placement.search import Approach
+    from drake_dock.docking.placement.search import first_contact
     s = load_scenario()
-    d_c, _ = first_contact_distance(s.geometry, s.initial.target_yaw_deg)
+    d_c = first_contact(PlacementCache(DockingScene.of(s)),
+                        Approach(math.radians(s.initial.target_yaw_deg))).lam
     s.simulation.capture_distance = d_c + s.initial.approach_travel + beyond
     with pytest.raises(InputError) as e:
-        initial_state(s)
+        place(s)
     assert e.value.field == "simulation.capture_distance"
     assert "initial.approach_travel" in str(e.value)
     s.simulation.capture_distance = 0.99 * (d_c + s.initial.approach_travel)
-    assert initial_state(s).d0 == d_c + s.initial.approach_travel
+    assert place(s).d0 == d_c + s.initial.approach_travel
 
 
 def test_a_scenario_pickles_and_compares_with_its_simulator_config(paper_scenario):

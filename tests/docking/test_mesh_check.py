@@ -1,10 +1,10 @@
-"""The triangle-mesh interpenetration check (`drake_dock.docking.mesh_check`) against the paper's
-equations and closed forms: its vertices on the cone, the guide sides (Eq. 14) and the tip arcs;
-its chords within the sagitta of the widest row; a point pushed through a petal lies at its
-distance to the cone or to the nearest free edge; a point passing round a guide side or over a
-tip does not cross; a ring pushed into the other ring's solid lies at its distance to the
-solid's nearest face; the depth error falls as the mesh is refined; and the analytic check
-(`drake_dock.docking.penetration`) agrees on the same motions and on a short recorded run."""
+"""The triangle-mesh interpenetration check (`drake_dock.docking.checks.mesh_check`) against the
+paper's equations and closed forms: its vertices on the cone, the guide sides (Eq. 14) and the tip
+arcs; its chords within the sagitta of the widest row; a point pushed through a petal lies at its
+distance to the cone or to the nearest free edge; a point passing round a guide side or over a tip
+does not cross; a ring pushed into the other ring's solid lies at its distance to the solid's
+nearest face; the depth error falls as the mesh is refined; and the analytic check
+(`drake_dock.docking.checks.penetration`) agrees on the same motions and on a short recorded run."""
 import collections
 import math
 from pathlib import Path
@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drake_dock.docking.mesh_check import (MeshResolution, closest_on_triangles,
-                                           deepest_penetration_mesh, grid_triangles,
-                                           mesh_features, petal_grid, ring_grids)
-from drake_dock.docking.penetration import deepest_penetration
-from drake_dock.docking.rotations import rot_x, rot_z
+from drake_dock.docking.checks.mesh_check import (MeshResolution, closest_on_triangles,
+                                                  deepest_penetration_mesh, grid_triangles,
+                                                  mesh_features, petal_grid, ring_grids)
+from drake_dock.docking.checks.penetration import deepest_penetration
+from drake_dock.docking.geometry.rotations import rot_x, rot_z
 from drake_dock.errors import InputError
 from petal_paths import cone_point, near_side, one_point_path
 
@@ -287,11 +287,12 @@ def test_a_facing_approach_with_a_roll_agrees_with_the_analytic_check(geom):
 def recorded():
     """0.25 s of an IDSS box corner (models/idss_box_corner.yaml): the approach and the first
     impacts, ring inside circles and guide sides in contact with the other's petals."""
-    from drake_dock.docking.results import timeseries
-    from drake_dock.docking.scenario import load_scenario
-    from drake_dock.docking.simulate import simulate
+    from drake_dock.docking.model.simulate import simulate
+    from drake_dock.docking.placement.place import place
+    from drake_dock.docking.report.results import timeseries
+    from drake_dock.docking.scenario.loading import load_scenario
     s = load_scenario(Path(__file__).resolve().parents[2] / "models" / "idss_box_corner.yaml")
-    r = simulate(s, duration=0.25)
+    r = simulate(s, place(s), duration=0.25)
     assert len(r.impacts) >= 3
     ts = timeseries(r)
     return s.geometry, ts["t"], ts["R_WA"], ts["p_WA"], ts["apds_names"].tolist()

@@ -5,9 +5,9 @@ from pathlib import Path
 
 import pytest
 
-from drake_dock.docking.pairs import scenario_pairs
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.scene import initial_state
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import load_scenario
 
 MODELS = sorted(p for p in (Path(__file__).resolve().parents[2] / "models").glob("*.yaml")
                 if not p.name.startswith("idss_envelope"))
@@ -21,7 +21,7 @@ def test_the_models_are_the_documented_ones():
 @pytest.mark.parametrize("path", MODELS, ids=lambda p: p.stem)
 def test_each_model_places_its_first_contact(path):
     s = load_scenario(path)
-    state = initial_state(s)
-    names = {p.name for p in scenario_pairs(s)}
+    state = place(s)
+    names = {p.name for p in DockingScene.of(s).pairs}
     assert state.closing_pairs and set(state.closing_pairs) <= names
     assert state.d0 == pytest.approx(state.d_contact + s.initial.approach_travel, abs=1e-12)

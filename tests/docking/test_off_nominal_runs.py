@@ -7,8 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import load_scenario
 
 MODELS = Path(__file__).resolve().parents[2] / "models"
 
@@ -37,7 +38,8 @@ def _box_corner_paper_pairs():
     ids=["misaligned", "idss_box_corner"])
 def test_runs_past_the_former_seek_crash(make, crashed_at):
     duration = crashed_at + 0.02
-    result = simulate(make(), duration=duration)
+    s = make()
+    result = simulate(s, place(s), duration=duration)
     assert result.outcome == "timeout" and result.end_time == pytest.approx(duration)
 
 
@@ -50,17 +52,17 @@ def test_idss_sample_139_lifts_off_and_runs_to_a_named_outcome():
     6 s and its impacts the energy ledger closes to 1e-6 with the default integration scheme
     (RK5; docs/model.md, "Integration")."""
     import numpy as np
-    from drake_dock.docking.outcome import OUTCOMES
-    from drake_dock.docking.results import IN_CONTACT, summary, timeseries
     from drake_dock.campaign.plan import load_plan
     from drake_dock.campaign.sample import sample_scenario
     from drake_dock.campaign.sampling import sample_specs
+    from drake_dock.docking.model.outcome import OUTCOMES
+    from drake_dock.docking.report.results import IN_CONTACT, summary, timeseries
     plan, base, fields = load_plan(MODELS / "idss_envelope.yaml")
     (_, _, values), = sample_specs(plan, fields, [139])
     scenario = sample_scenario(base, values)
     scenario = dataclasses.replace(scenario, thrust=None, contact=dataclasses.replace(
         scenario.contact, pairs="paper"))
-    result = simulate(scenario)
+    result = simulate(scenario, place(scenario))
     ts = timeseries(result)
     contact = ts["status"] >= IN_CONTACT
     active = contact[:, list(ts["couple_names"]).index("cc_T3_C3")]

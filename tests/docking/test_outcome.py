@@ -9,9 +9,9 @@ import pytest
 import yaml
 
 from drake_dock.cli import main
-from drake_dock.docking.outcome import (JAM_DISTANCE, CaptureRule, OutcomeWatch, misalignment,
-                                        progress_fraction)
-from drake_dock.docking.scenario import PAPER_EXAMPLE
+from drake_dock.docking.model.outcome import (JAM_DISTANCE, CaptureRule, OutcomeWatch,
+                                              misalignment, progress_fraction)
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE
 
 
 def feed(watch, ts, ds, driven=None, lateral=None):
@@ -183,12 +183,13 @@ def test_the_paper_example_is_captured_where_the_axial_distance_alone_captures_i
     """The paper's rings meet coaxially: with the latches' lateral and tilt tolerances left out
     (null), the capture witness is the axial distance alone, and the default tolerances do not
     bind, so both runs end at the same capture time, bit for bit."""
-    from drake_dock.docking.scenario import load_scenario
-    from drake_dock.docking.simulate import simulate
+    from drake_dock.docking.model.simulate import simulate
+    from drake_dock.docking.placement.place import place
+    from drake_dock.docking.scenario.loading import load_scenario
     s = load_scenario()
     axial_only = load_scenario()
     axial_only.simulation.capture_lateral = axial_only.simulation.capture_tilt_deg = None
-    a, b = simulate(s), simulate(axial_only)
+    a, b = simulate(s, place(s)), simulate(axial_only, place(axial_only))
     assert a.outcome == b.outcome == "captured"
     assert a.capture_time == b.capture_time
     assert "lateral offset <= 0.01 m" in a.reason and "lateral" not in b.reason

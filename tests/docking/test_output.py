@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from drake_dock.cli import main
+from drake_dock.docking.report.out_dir import MARKER, atomic_directory, check_destination
 from drake_dock.errors import InputError, NumericalError
-from drake_dock.docking.output import MARKER, atomic_directory, check_destination
 
 BOOM = "simulated although the destination is refused"
 
@@ -253,7 +253,7 @@ def test_contact_system_refusal_at_t0_is_exit_2(tmp_path, capsys, monkeypatch):
         raise InputError("initial state of pair cc_T1_C5", "signed gap -0.001 m",
                          "signed gap >= -impact_gap_tol = -1e-08 m",
                          "the bodies start interpenetrating")
-    monkeypatch.setattr("drake_dock.docking.simulate._Recorder.sample", refuse)
+    monkeypatch.setattr("drake_dock.docking.model.simulate._Recorder.sample", refuse)
     out = tmp_path / "results"
     rc = main(["run", "--out", str(out), "--no-progress"])
     err = " ".join(capsys.readouterr().err.split())

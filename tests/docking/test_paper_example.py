@@ -12,9 +12,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from drake_dock.core.patches import posed
-from drake_dock.docking.penetration import deepest_penetration
-from drake_dock.docking.scene import apds_pairs
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.checks.penetration import deepest_penetration
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 
 EXE = [sys.executable, "-m", "drake_dock.cli", "run", "--no-progress"]
 
@@ -185,7 +185,7 @@ def test_gaps_and_points_on_patches(runs):
     assert act.any()
     assert ts["gap"][act].min() >= -1e-8
     g = runs["scenario"].geometry
-    pairs = {p.name: p for p in apds_pairs(g)}
+    pairs = {p.name: p for p in DockingScene(g, "paper").pairs}
     apds = ts["apds_names"].tolist()
     for j, name in enumerate(ts["couple_names"].tolist()):
         pr = pairs[name]
@@ -323,8 +323,8 @@ def test_replay_time_readout_and_force_arrows(runs):
 
 
 def test_no_feature_enters_a_solid_of_the_other_apds(runs):
-    """The independent interpenetration check (`drake_dock.docking.penetration`) over the whole
-    run: the couples keep every ring edge, guide side and tip arc out of the other APDS."""
+    """The independent interpenetration check (`drake_dock.docking.checks.penetration`) over the
+    whole run: the couples keep every ring edge, guide side and tip arc out of the other APDS."""
     ts, g = runs["ts"], runs["scenario"].geometry
     pen = deepest_penetration(g, ts["t"], ts["R_WA"], ts["p_WA"], ts["apds_names"].tolist())
     assert pen.depth < 1e-6, pen.describe()

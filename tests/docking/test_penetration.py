@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from drake_dock.docking.penetration import (deepest_penetration, feature_points,
-                                            petal_coordinates, ring_depth_of)
+from drake_dock.docking.checks.penetration import (deepest_penetration, feature_points,
+                                                   petal_coordinates, ring_depth_of)
 from petal_paths import cone_point as _cone_point
 from petal_paths import near_side as _near_side
 from petal_paths import one_point_path as _path

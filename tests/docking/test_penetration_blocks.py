@@ -14,9 +14,10 @@ import math
 import numpy as np
 import pytest
 
-from drake_dock.docking import cone_reach, penetration as pen
-from drake_dock.docking.rotations import rot_vec
-from drake_dock.docking.scene import Approach
+from drake_dock.docking.checks import cone_reach
+from drake_dock.docking.checks import penetration as pen
+from drake_dock.docking.geometry.rotations import rot_vec
+from drake_dock.docking.placement.search import Approach
 
 NAMES = ("target_apds", "chaser_apds")
 

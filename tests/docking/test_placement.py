@@ -1,30 +1,36 @@
 """The first-contact search (`first_contact`) against a full scan: every pair's signed gap
 (`signed_gaps`) at every point of the travel grid, the pairs' sides continued from point to
 point, and brentq on the first step where a positive gap turns <= 0 (or the march
-between). The
-search seeks a pair only in the steps its covers can touch; the travel, the closing pairs and
-the typed error are the scan's, bit for bit. Independently, the path down to the first
-contact is clear by the interpenetration check (`drake_dock.docking.penetration`)."""
-import dataclasses
+between). The search seeks a pair only in the steps its covers can touch; the travel and the
+closing pairs are the scan's, bit for bit, and where the scan finds none the search finds
+none. Independently, the path down to the first contact is clear by the interpenetration check
+(`drake_dock.docking.checks.penetration`)."""
 import math
 
 import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from drake_dock.docking import search
-from drake_dock.docking.apds import ApdsGeometry
-from drake_dock.docking.scene import (MARCH_SUBSTEPS, Approach, apds_pairs, first_contact,
-                                      first_contact_seeks, march_root, seek_gaps, signed_gaps,
-                                      travel_grid)
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.placement import search
+from drake_dock.docking.placement.place import PlacementCache, contact_approach, place
+from drake_dock.docking.placement.search import Approach
+from drake_dock.docking.placement.search import (MARCH_SUBSTEPS, TOUCH_GAP, first_contact,
+                                                 march_root, seek_gaps, signed_gaps, travel_grid)
+from drake_dock.docking.scenario.dimensions import ApdsGeometry
 from drake_dock.errors import NumericalError
+
+
+def _first(g, approach, which="paper", **kw):
+    """`first_contact` on a fresh cache of the scene (g, which)."""
+    return first_contact(PlacementCache(DockingScene(g, which)), approach, **kw)
 
 
 def full_scan(g, approach, xtol=1e-13, which="paper"):
     """(lam, names, seeks) of the scan of every pair at every grid point: a pair closes on the
     first step where its gap turns from above `TOUCH_GAP` to <= 0, or, failing that on a step
     it comes within the step's travel of, where `march_root` closes it."""
-    pairs = apds_pairs(g, which)
+    pairs = DockingScene(g, which).pairs
     grid = travel_grid(g, approach)
     gaps, refs, dist = seek_gaps(pairs, approach, grid[0], [None] * len(pairs))
     seeks = len(pairs)
@@ -33,7 +39,7 @@ def full_scan(g, approach, xtol=1e-13, which="paper"):
         seeks += len(pairs)
         roots = {}
         for j in range(len(pairs)):
-            if search.TOUCH_GAP < gaps[j] < np.inf and gaps_lo[j] <= 0:
+            if TOUCH_GAP < gaps[j] < np.inf and gaps_lo[j] <= 0:
                 roots[pairs[j].name] = brentq(
                     lambda x, j=j: signed_gaps([pairs[j]], approach, x, [refs[j]])[0][0],
                     d_lo, d, xtol=xtol, rtol=1e-15)
@@ -65,15 +71,14 @@ APPROACHES = {
 def test_search_equals_the_full_scan(name):
     g = ApdsGeometry()
     approach = APPROACHES[name]
+    found = _first(g, approach)
     try:
         expected = full_scan(g, approach)
     except NumericalError:
-        with pytest.raises(NumericalError, match="no pair closes"):
-            first_contact(g, approach)
+        assert found.lam is None and found.closing == ()
         return
-    lam, names = first_contact(g, approach)
-    assert (lam, names) == expected[:2]
-    assert first_contact_seeks(g, approach) < expected[2]
+    assert (found.lam, list(found.closing)) == expected[:2]
+    assert found.seeks < expected[2]
 
 
 def _random_approach(rng):
@@ -93,19 +98,19 @@ def test_search_equals_the_full_scan_on_random_approaches(which, seed):
     seek) closes the full scan's pairs at its travel, bit for bit, in fewer seeks."""
     g = ApdsGeometry()
     approach = _random_approach(np.random.default_rng(seed))
+    found = _first(g, approach, which)
     try:
         expected = full_scan(g, approach, which=which)
     except NumericalError:
-        with pytest.raises(NumericalError, match="no pair closes"):
-            first_contact(g, approach, which=which)
+        assert found.lam is None and found.closing == ()
         return
-    assert first_contact(g, approach, which=which) == expected[:2]
-    assert first_contact_seeks(g, approach, which=which) < expected[2]
+    assert (found.lam, list(found.closing)) == expected[:2]
+    assert found.seeks < expected[2]
 
 
 # Where no pair closes, and the placement's fixed point -----------------------------------------
 def _scenario(**initial):
-    from drake_dock.docking.scenario import load_scenario
+    from drake_dock.docking.scenario.loading import load_scenario
     s = load_scenario()
     for k, v in initial.items():
         setattr(s.initial, k, v)
@@ -117,12 +122,11 @@ def test_a_roll_of_zero_approaches_freely_and_is_captured_without_contact():
     independent interpenetration check finds the way clear (the ring's inside circle grazes the
     petal tips, Rs = R - H cot(alpha1)), the chaser starts approach_travel before the ring faces
     meet and coasts: captured at (approach_travel - capture_distance) / chaser_speed, no impact."""
-    from drake_dock.docking.scene import initial_state
-    from drake_dock.docking.simulate import simulate
+    from drake_dock.docking.model.simulate import simulate
     s = _scenario(target_yaw_deg=0.0)
-    st = initial_state(s)
+    st = place(s)
     assert st.d_contact == 0.0 and st.closing_pairs == [] and st.d0 == s.initial.approach_travel
-    r = simulate(s)
+    r = simulate(s, st)
     t_free = (s.initial.approach_travel - s.simulation.capture_distance) / s.initial.chaser_speed
     assert r.outcome == "captured" and not r.impacts
     assert r.capture_time == pytest.approx(t_free, abs=1e-7)
@@ -131,17 +135,16 @@ def test_a_roll_of_zero_approaches_freely_and_is_captured_without_contact():
 def test_a_large_roll_that_meets_unmodelled_features_is_a_typed_error():
     """At 40 deg roll no paper pair closes, but the guide sides cut through the petals that are
     not their partners: NoPairCloses names the feature and the petal, before any simulation."""
-    from drake_dock.docking.scene import NoPairCloses, initial_state
+    from drake_dock.docking.placement.path_check import NoPairCloses
     with pytest.raises(NoPairCloses, match=r"guide side \d passes through the \w+ petal \d"):
-        initial_state(_scenario(target_yaw_deg=40.0))
+        place(_scenario(target_yaw_deg=40.0))
 
 
 def test_a_tilted_tip_on_tip_approach_is_placed_on_a_point_contact():
     """Coaxial and level at 40 deg roll the tips meet along an arc (tests/docking/
     test_tip_on_tip.py); tilted by 2 deg the same approach is placed on a point contact, and
     the independent check finds its path clear."""
-    from drake_dock.docking.penetration import deepest_penetration
-    from drake_dock.docking.scene import contact_approach
+    from drake_dock.docking.checks.penetration import deepest_penetration
     s = _scenario(target_yaw_deg=40.0)
     s.contact.pairs = "complete"
     g = s.geometry
@@ -162,15 +165,15 @@ def test_a_large_roll_with_tilt_is_placed_on_the_new_pairs(yaw, tilt, offset, pa
     """Near the roll range's ends, tilted and offset: the first contact is a tip arc on a tip
     arc, or a chaser corner on a target guide surface, and the independent check finds the
     straight path down to it clear (within 1 nm)."""
-    from drake_dock.docking.penetration import deepest_penetration
-    from drake_dock.docking.scene import contact_approach
+    from drake_dock.docking.checks.penetration import deepest_penetration
     s = _scenario(target_yaw_deg=yaw, tilt_deg=tilt, lateral_offset=offset)
     s.contact.pairs = "complete"
     a, lam_c, names = contact_approach(s)
     assert names == [pair]
     # The pair's couple touches there (its seek's distance, from the geometry afresh).
-    from drake_dock.docking.scene import CHASER_APDS, TARGET_APDS, pair_couples
-    spec, = [p for p in apds_pairs(s.geometry, "complete") if p.name == pair]
+    from drake_dock.docking.geometry.pairs import CHASER_APDS, TARGET_APDS
+    from drake_dock.docking.placement.search import pair_couples
+    spec, = [p for p in DockingScene(s.geometry, "complete").pairs if p.name == pair]
     c, = pair_couples([spec], {TARGET_APDS: (np.eye(3), np.zeros(3)),
                                 CHASER_APDS: a.pose(lam_c)})
     assert c.interior and abs(c.distance) < 1e-9
@@ -183,13 +186,21 @@ def test_a_large_roll_with_tilt_is_placed_on_the_new_pairs(yaw, tilt, offset, pa
 
 
 def test_a_crossing_before_the_first_contact_is_a_missed_contact():
-    """`check_path_to_contact` asked to verify a first contact 1 cm below the tips' meeting of
-    a coaxial 40 deg approach (ring distance 2H - 1 cm): the petals crossed on the way, so
-    `MissedContact` names the crossing before it."""
-    from drake_dock.docking.path_check import MissedContact, check_path_to_contact
+    """`check_path` asked to verify a first contact of the complete set 1 cm below the tips'
+    meeting of a coaxial 40 deg approach (ring distance 2H - 1 cm): the petals crossed on the
+    way, so `MissedContact` names the crossing before it; the paper's set is not checked past
+    its closing pairs, and where no pair closes the same crossing is a `NoPairCloses`."""
+    from drake_dock.docking.placement.path_check import MissedContact, NoPairCloses, check_path
+    from drake_dock.docking.placement.search import FirstContact
     g = _scenario().geometry
+    approach = Approach(math.radians(40.0))
+    below = FirstContact(2 * g.H - 0.01, ("cc_T1_C5",), 0, 0.45)
     with pytest.raises(MissedContact, match=r"petal \d before its first contact"):
-        check_path_to_contact(g, Approach(math.radians(40.0)), 0.45, 2 * g.H - 0.01)
+        check_path(PlacementCache(DockingScene(g, "complete")), approach, below)
+    check_path(PlacementCache(DockingScene(g, "paper")), approach, below)
+    with pytest.raises(NoPairCloses, match=r"petal \d"):
+        check_path(PlacementCache(DockingScene(g, "paper")), approach,
+                   FirstContact(None, (), 0, 0.45))
 
 
 def _idss_sample(k):
@@ -208,7 +219,6 @@ def test_a_fast_sideways_approach_is_placed_at_its_consistent_first_contact():
     with the aim, so a bracket over the whole range closes on a jump; the placement finds the
     root instead. Checked afresh: the path passes the lateral offset at the height of its first
     contact, and that contact is the first on the path (a full scan of every pair agrees)."""
-    from drake_dock.docking.scene import contact_approach
     s = _idss_sample(34)
     a, lam, closing = contact_approach(s)
     ic = s.initial
@@ -227,8 +237,6 @@ def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there(monkey
     to the first contact of the search whose seek converges there. The placement is
     consistent (the path passes the offset at its first contact to 1e-8 m |slope|), and its
     first contact is the full scan's, which seeks every pair at every grid point."""
-    from drake_dock.docking import search
-    from drake_dock.docking.scene import contact_approach
     from drake_dock.errors import SeekingError
     s = _idss_sample(694)
     ic = s.initial
@@ -239,13 +247,13 @@ def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there(monkey
                                atol=1e-8 * np.linalg.norm(slope))
     lam_scan, names, _ = full_scan(s.geometry, a, which=s.contact.pairs)
     assert lam == lam_scan and closing == names
-    pair, = [pr for pr in apds_pairs(s.geometry, s.contact.pairs) if pr.name == "cs_Cring_T1"]
+    pair = DockingScene.of(s).pair("cs_Cring_T1")
     failing = Approach(a.yaw, a.tilt, (-0.052305884320687224, -0.09989067043207144),
                        a.direction)
     lam_fail = 0.23063723414045384
     gap, _, dist = seek_gaps([pair], failing, lam_fail, [None])
     assert gap[0] == np.inf and 0 < dist[0] < 1e-4
-    converged = search.first_contact_or_faces(s.geometry, failing, s.contact.pairs)
+    converged = _first(s.geometry, failing, s.contact.pairs)
     original, failed = search._seek, []
 
     def seek(pr, approach, x, ref):
@@ -255,12 +263,8 @@ def test_a_seek_that_fails_outside_its_domain_is_marched_as_a_touch_there(monkey
         return original(pr, approach, x, ref)
 
     monkeypatch.setattr(search, "_seek", seek)
-    search._first_contact.cache_clear()
-    try:
-        assert (search.first_contact_or_faces(s.geometry, failing, s.contact.pairs)
-                == converged and failed)
-    finally:
-        search._first_contact.cache_clear()
+    again = _first(s.geometry, failing, s.contact.pairs)
+    assert (again.lam, again.closing) == (converged.lam, converged.closing) and failed
 
 
 def test_the_fixed_point_is_a_root_or_the_jump_the_bracket_closes_on():
@@ -268,7 +272,7 @@ def test_the_fixed_point_is_a_root_or_the_jump_the_bracket_closes_on():
     jump where the function jumps across zero (its side with the smaller miss, within that
     miss / `JUMP_SLOPE`), the largest sign change of the grid where the whole range has none,
     and None where nothing changes sign."""
-    from drake_dock.docking.scene import JUMP_SLOPE, _consistent_height
+    from drake_dock.docking.placement.aim import JUMP_SLOPE, _consistent_height
     assert _consistent_height(lambda s: 0.3 - 2.0 * s, 0.45) == pytest.approx(0.15, abs=1e-9)
     s_jump = 0.2 + 1e-3 / math.pi
     jump = _consistent_height(lambda s: 0.1 if s < s_jump else -0.05, 0.45)
@@ -296,7 +300,7 @@ def test_the_grid_fallback_evaluates_from_the_top_and_stops_at_the_first_sign_ch
     """mismatch(s) = (s - a)(s - b), positive at both ends of [0, 0.46] (no sign change for the
     whole-range brentq): the fallback returns the upper root b (to xtol), the same bits as the
     eager scan, and with b in the top grid interval it evaluates fewer than cells + 1 times."""
-    from drake_dock.docking.scene import _consistent_height
+    from drake_dock.docking.placement.aim import _consistent_height
     calls = []
 
     def mismatch(s):
@@ -320,9 +324,8 @@ def test_a_jump_of_the_first_contact_is_placed_and_its_offset_reported():
     contact (`contact_offset`, in summary.json) is reported, about a millimetre away. Checked
     afresh: the chosen path's first contact is the full scan's, and the offset is the path's
     lateral position at that contact's height."""
-    from drake_dock.docking.scenario import load_scenario
-    from drake_dock.docking.scene import (JUMP_SLOPE, contact_approach, first_contact_or_faces,
-                                          initial_state)
+    from drake_dock.docking.placement.aim import JUMP_SLOPE
+    from drake_dock.docking.scenario.loading import load_scenario
     from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
     base = load_scenario()
     base.contact.pairs = "complete"
@@ -334,7 +337,7 @@ def test_a_jump_of_the_first_contact_is_placed_and_its_offset_reported():
     ic = s.initial
     slope = np.array(ic.lateral_velocity) / ic.chaser_speed
     centre = np.array(a.aim) - a.height(lam) * slope
-    st = initial_state(s)
+    st = place(s)
     np.testing.assert_allclose(st.contact_offset, centre, atol=1e-15)
     assert np.linalg.norm(centre - np.array(ic.lateral_offset)) > 1e-4
     aimed = (np.array(a.aim) - np.array(ic.lateral_offset)) @ slope / (slope @ slope)
@@ -344,14 +347,14 @@ def test_a_jump_of_the_first_contact_is_placed_and_its_offset_reported():
     for x in (aimed - reach, aimed + reach):
         near = Approach(a.yaw, a.tilt, tuple((np.array(ic.lateral_offset) + x * slope).tolist()),
                         a.direction)
-        sides.append(near.height(first_contact_or_faces(g, near, "complete")[0]) - x)
+        sides.append(near.height(_first(g, near, "complete").travel()) - x)
     assert min(sides) < -1e-4 and max(sides) > 1e-4
 
 
 def _path_depth(g, approach, lam_c):
     """The deepest crossing (`deepest_penetration`, 1 um grazing) on the straight path from the
     search's start down to the first contact."""
-    from drake_dock.docking.penetration import deepest_penetration
+    from drake_dock.docking.checks.penetration import deepest_penetration
     (R0, p0), (R1, p1) = approach.pose(travel_grid(g, approach)[0]), approach.pose(lam_c)
     eye, zero = np.eye(3), np.zeros(3)
     return deepest_penetration(g, np.array([0.0, 1.0]), np.array([[eye, R0], [eye, R1]]),
@@ -369,8 +372,7 @@ def test_the_path_to_the_first_contact_is_clear_where_a_pair_closes_inside_a_ste
     (random 26's circle cuts the surface next to a near-tangent touch, where the couple is
     degenerate and its Newton slow). The steps' ends alone miss these contacts: the pair that
     closes is apart (+inf) at one end of its step or the other."""
-    from drake_dock.docking.scenario import load_scenario
-    from drake_dock.docking.scene import contact_approach
+    from drake_dock.docking.scenario.loading import load_scenario
     from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
     base = load_scenario()
     base.contact.pairs = "complete"
@@ -385,21 +387,21 @@ def test_the_path_to_a_random_first_contact_is_clear(seed):
     crosses nothing (independent interpenetration check)."""
     g = ApdsGeometry()
     approach = _random_approach(np.random.default_rng(seed))
-    assert _path_depth(g, approach, first_contact(g, approach, which="complete")[0]) < 1e-6
+    assert _path_depth(g, approach, _first(g, approach, "complete").lam) < 1e-6
 
 
 @pytest.mark.parametrize("seed", [0, 14, 32])
 def test_lockstep_marches_find_the_full_marches_closings(seed):
     """On the first contact's step of approaches where marches close, the lockstep marches
-    (`_Gaps.marches`, stopped once a march's next sub-step starts 1e-9 below the best closing)
+    (`search._Gaps.marches`, stopped once a march's next sub-step starts 1e-9 below the best closing)
     against each march run over the whole step alone (`march_root`): with no closing known,
     with the best given at the first contact or 5e-10 above it, and with one given below
     every march's closing, the closings within 1e-9 of the first contact are found, each
     equal, in no more seeks."""
     g = ApdsGeometry()
     approach = _random_approach(np.random.default_rng(seed))
-    lam_c = first_contact(g, approach, which="complete")[0]
-    pairs = search.search_pairs(dataclasses.astuple(g), "complete")
+    lam_c = _first(g, approach, "complete").lam
+    pairs = DockingScene(g, "complete").pairs
     grid = travel_grid(g, approach)
     k = max(i for i in range(len(grid) - 1) if grid[i] >= lam_c)
     touch = search.touch_steps(pairs, approach, grid)
@@ -442,22 +444,20 @@ def test_a_march_through_a_cut_finds_the_floor_steps_first_contact_in_fewer_seek
     g = ApdsGeometry()
     found = {}
     for floors in (search.CUT_FLOORS, 1):
-        search._first_contact.cache_clear()
         with mock.patch.object(search, "CUT_FLOORS", floors):
-            found[floors] = (first_contact(g, approach), first_contact_seeks(g, approach))
-    search._first_contact.cache_clear()
-    assert found[search.CUT_FLOORS][0] == found[1][0]
-    assert 2 * found[search.CUT_FLOORS][1] < found[1][1]
+            found[floors] = _first(g, approach)
+    cut = found[search.CUT_FLOORS]
+    assert (cut.lam, cut.closing) == (found[1].lam, found[1].closing)
+    assert 2 * cut.seeks < found[1].seeks
 
 
 def test_a_seek_that_fails_next_to_a_touch_is_taken_as_touching(monkeypatch):
     """Random 26 of the conditions sweep closes by touch: the target ring's circle meets a
-    chaser guide surface (`cs_Tring_C1`) and then cuts it (`_touch`). Made to fail wherever that
-    pair's couple is interior and nearer than 1e-5 m, its seek is taken as touching there: the
+    chaser guide surface (`cs_Tring_C1`) and then cuts it (`search.march_root`). Made to fail
+    wherever that pair's couple is interior and nearer than 1e-5 m, its seek is taken as touching there: the
     closing pair is the same, and the first contact moves up to the first point of the travel
     at which the distance falls to 1e-5 m (brentq on the distance less 1e-5 m, to 1e-11 m)."""
-    from drake_dock.docking.scenario import load_scenario
-    from drake_dock.docking.scene import contact_approach
+    from drake_dock.docking.scenario.loading import load_scenario
     from drake_dock.errors import SeekingError
     from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
     base = load_scenario()
@@ -465,7 +465,7 @@ def test_a_seek_that_fails_next_to_a_touch_is_taken_as_touching(monkeypatch):
     s = with_condition(base, dict(conditions(ConditionsPlan(random=60, corners=16)))["random 26"])
     a, lam, closing = contact_approach(s)
     assert closing == ["cs_Tring_C1"]
-    pair, = [pr for pr in apds_pairs(s.geometry, "complete") if pr.name == closing[0]]
+    pair, = [pr for pr in DockingScene(s.geometry, "complete").pairs if pr.name == closing[0]]
     original, failed, near = search._seek, [], 1e-5
 
     def seek(pr, approach, x, ref):
@@ -476,11 +476,8 @@ def test_a_seek_that_fails_next_to_a_touch_is_taken_as_touching(monkeypatch):
         return hit
 
     monkeypatch.setattr(search, "_seek", seek)
-    search._first_contact.cache_clear()
-    try:
-        lam_f, names = search.first_contact(s.geometry, a, which="complete")
-    finally:
-        search._first_contact.cache_clear()
+    found = _first(s.geometry, a, "complete")
+    lam_f, names = found.lam, list(found.closing)
     assert names == closing and failed and lam_f > lam
     want = brentq(lambda x: original(pair, a, x, None)[2] - near, lam, lam + 1e-2, xtol=1e-13)
     assert lam_f == pytest.approx(want, abs=1e-11)

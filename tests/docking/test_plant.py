@@ -10,13 +10,13 @@ from pydrake.multibody.math import SpatialVelocity
 from pydrake.systems.analysis import SimulatorConfig
 from pydrake.systems.framework import DiagramBuilder
 
-from drake_dock.docking.plant import add_docking_plant, body_momenta
+from drake_dock.docking.model.plant import PlantSpec, add_docking_plant, body_momenta
 from drake_dock.systems.simulator import make_simulator
 
 
 def _build(scenario):
     builder = DiagramBuilder()
-    dp = add_docking_plant(builder, scenario)
+    dp = add_docking_plant(builder, PlantSpec.of(scenario))
     diagram = builder.Build()
     return diagram, dp
 

@@ -9,8 +9,8 @@ import zipfile
 import numpy as np
 import pytest
 
-from drake_dock.docking.replay import MIN_SCREEN_SECONDS, playback_slowdown
-from drake_dock.docking.results import first_contact_sample
+from drake_dock.docking.report.replay import MIN_SCREEN_SECONDS, playback_slowdown
+from drake_dock.docking.report.results import first_contact_sample
 
 MB = 1e6
 NICE = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000)

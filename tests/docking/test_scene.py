@@ -10,16 +10,18 @@ from scipy.optimize import brentq
 from closest_reference import brute_force_closest, random_starts, scipy_closest
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import seek_couple
-from drake_dock.docking.plant import add_docking_plant, set_initial_state
-from drake_dock.docking.scene import apds_pairs, initial_state, rot_z, rot_x
+from drake_dock.docking.geometry.rotations import rot_x, rot_z
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.model.plant import PlantSpec, add_docking_plant, set_initial_state
+from drake_dock.docking.placement.place import place
 from pydrake.systems.framework import DiagramBuilder
 
 
 @pytest.fixture(scope="module")
 def paper_setup(paper_scenario):
-    state = initial_state(paper_scenario)
+    state = place(paper_scenario)
     builder = DiagramBuilder()
-    dp = add_docking_plant(builder, paper_scenario)
+    dp = add_docking_plant(builder, PlantSpec.of(paper_scenario))
     diagram = builder.Build()
     ctx = diagram.CreateDefaultContext()
     pc = dp.plant.GetMyContextFromRoot(ctx)
@@ -34,7 +36,7 @@ def paper_setup(paper_scenario):
 def test_first_contact_after_declared_travel(paper_scenario, paper_setup):
     state, poses = paper_setup
     travel = paper_scenario.initial.approach_travel
-    pairs = {p.name: p for p in apds_pairs(paper_scenario.geometry)}
+    pairs = {p.name: p for p in DockingScene(paper_scenario.geometry, "paper").pairs}
     axis = poses["target_apds"][0][:, 2]
 
     def placed(pair, s):
@@ -86,7 +88,7 @@ def test_first_contact_distance_matches_coarse_check(paper_setup):
 def test_seeking_matches_scipy_on_random_poses(geom, seed):
     """Hierarchical grid + Newton finds the same couple as multi-start scipy."""
     rng = np.random.default_rng(seed)
-    pairs = apds_pairs(geom)
+    pairs = DockingScene(geom, "paper").pairs
     yaw, tilt = rng.uniform(-0.5, 0.5), rng.uniform(-0.2, 0.2)
     R = rot_z(yaw) @ rot_x(math.pi + tilt)
     p = np.array([*rng.uniform(-0.1, 0.1, 2), rng.uniform(0.05, 0.35)])
@@ -106,7 +108,7 @@ def test_seeking_matches_brute_force_on_random_poses(geom, seed):
     R = rot_z(rng.uniform(-0.6, 0.6)) @ rot_x(math.pi + rng.uniform(-0.3, 0.3))
     p = np.array([*rng.uniform(-0.15, 0.15, 2), rng.uniform(0.05, 0.3)])
     poses = {"target_apds": (np.eye(3), np.zeros(3)), "chaser_apds": (R, p)}
-    for pair in apds_pairs(geom):
+    for pair in DockingScene(geom, "paper").pairs:
         P1, P2 = posed(pair.patch1, *poses[pair.body1]), posed(pair.patch2, *poses[pair.body2])
         cp = seek_couple(P1, P2)
         _, _, d = brute_force_closest(P1, P2)
@@ -138,7 +140,7 @@ def test_far_pair_distance_mode_matches_brute_force(geom, seed):
     p = np.array([*rng.uniform(-0.15, 0.15, 2), rng.uniform(0.01, 0.3)])
     poses = {"target_apds": (np.eye(3), np.zeros(3)), "chaser_apds": (R, p)}
     beyond = 0.02
-    for pair in apds_pairs(geom):
+    for pair in DockingScene(geom, "paper").pairs:
         P1, P2 = posed(pair.patch1, *poses[pair.body1]), posed(pair.patch2, *poses[pair.body2])
         cp = seek_couple(P1, P2, distance_rtol=1e-7, rtol_beyond=beyond)
         d = np.linalg.norm(brute_force_closest(P1, P2)[2])

@@ -3,15 +3,17 @@
 sought again, impacts and sliding is bitwise the same."""
 import numpy as np
 
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import load_scenario
 from drake_dock.systems.contact_types import ContactModes, ModesIndex
 
 SCENE = "contact: {pairs: complete}\ninitial: {target_yaw_deg: -8.0}\nsimulation: {duration: 0.5}"
 
 
 def _run():
-    r = simulate(load_scenario(data=SCENE))
+    s = load_scenario(data=SCENE)
+    r = simulate(s, place(s))
     return r, (r.end_time, r.evaluations, r.mode_changes, len(r.impacts), np.array(r.record.x),
                np.array(r.record.couples))
 

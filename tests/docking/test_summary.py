@@ -10,10 +10,12 @@ import math
 import numpy as np
 import pytest
 
-from drake_dock.docking.apds import ApdsGeometry, apds_patches
-from drake_dock.docking.pairs import apds_pairs, feature_words
-from drake_dock.docking.results import near_couples, rigid_chaser_force
-from drake_dock.docking.scenario import load_scenario
+from drake_dock.docking.geometry.apds import apds_patches
+from drake_dock.docking.geometry.pairs import feature_words
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.report.results import near_couples, rigid_chaser_force
+from drake_dock.docking.scenario.dimensions import ApdsGeometry
+from drake_dock.docking.scenario.loading import load_scenario
 from drake_dock.run import format_summary, run
 
 COST_KEYS = {"wall_time_s", "derivative_evaluations", "time_shares", "cost_by_pair_type",
@@ -150,7 +152,7 @@ def test_feature_words_follow_the_geometry():
         half = abs(((b - a + math.pi) % (2 * math.pi) - math.pi) / 2)
         centre = a + ((b - a + math.pi) % (2 * math.pi) - math.pi) / 2
         assert abs((az - centre + math.pi) % (2 * math.pi) - math.pi) <= half + 1e-9, (i, k)
-    described = [p.description for p in apds_pairs(g, "complete")]
+    described = [p.description for p in DockingScene(g, "complete").pairs]
     assert len(set(described)) == len(described) and all(" / " in d for d in described)
 
 

@@ -6,10 +6,12 @@ import numpy as np
 import pytest
 import yaml
 
-from drake_dock.docking.results import summary, timeseries
-from drake_dock.docking.scenario import PAPER_EXAMPLE, ThrustParams, load_scenario
-from drake_dock.docking.simulate import simulate
-from drake_dock.docking.thrust import ThrustSchedule
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.model.thrust import ThrustSchedule
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.report.results import summary, timeseries
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.schema import ThrustParams
 from drake_dock.errors import InputError
 
 
@@ -62,7 +64,7 @@ def coaxial_run():
     does not turn its axis and the thrust's direction stays e3."""
     s = _scenario({"force": 300.0, "delay": 0.05, "duration": 0.1}, chaser_speed=0.1)
     s.simulation.duration = 0.35
-    r = simulate(s)
+    r = simulate(s, place(s))
     ts = timeseries(r)
     return s, r, ts, summary(r, ts)
 

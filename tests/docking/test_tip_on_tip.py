@@ -11,14 +11,16 @@ import math
 import numpy as np
 import pytest
 
-from drake_dock.docking.apds import tip_arc
-from drake_dock.docking.mesh_check import deepest_penetration_mesh
-from drake_dock.docking.penetration import deepest_penetration
-from drake_dock.docking.results import summary, timeseries
-from drake_dock.docking.scenario import load_scenario
-from drake_dock.docking.scene import (CHASER_APDS, TARGET_APDS, apds_pairs, contact_approach,
-                                      initial_state, pair_couples)
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.checks.mesh_check import deepest_penetration_mesh
+from drake_dock.docking.checks.penetration import deepest_penetration
+from drake_dock.docking.geometry.apds import tip_arc
+from drake_dock.docking.geometry.pairs import CHASER_APDS, TARGET_APDS
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import contact_approach, place
+from drake_dock.docking.placement.search import pair_couples
+from drake_dock.docking.report.results import summary, timeseries
+from drake_dock.docking.scenario.loading import load_scenario
 
 
 def _coaxial(yaw, **simulation):
@@ -60,7 +62,7 @@ def test_the_overlap_ends_close_on_the_tip_lands_at_2H(yaw):
                     assert math.hypot(q[0], q[1]) == pytest.approx(r_tip, abs=1e-9)
                     expected.add(f"ps_{x}corner{i}_{'T' if x == 'C' else 'C'}tip{k}")
     assert len(expected) == 6 and set(lands) == expected
-    specs = [p for p in apds_pairs(g, "complete") if p.name in expected]
+    specs = [p for p in DockingScene(g, "complete").pairs if p.name in expected]
     for c in pair_couples(specs, pose):
         assert c.interior and abs(c.distance) < 1e-9
 
@@ -70,7 +72,7 @@ def test_the_lands_close_only_beyond_a_roll_of_2_theta_end():
     edge = math.degrees(2 * s.geometry.theta_end)
     for yaw, lands in ((edge - 0.05, 0), (edge + 0.05, 6), (-edge - 0.05, 6)):
         s.initial.target_yaw_deg = yaw
-        closing = initial_state(s).closing_pairs
+        closing = place(s).closing_pairs
         assert sum(n.startswith("ps_") and "tip" in n for n in closing) == lands
 
 
@@ -79,7 +81,7 @@ def test_the_first_impact_is_the_two_body_closed_form():
     gives no impulse) with restitution e: v_c' = v (m_c - e m_a) / (m_c + m_a) towards the
     target, v_a' = v_c' + e v; the six land pairs share the impulse m_a v_a' equally, axially."""
     s = _coaxial(40.0, duration=0.02)
-    r = simulate(s)
+    r = simulate(s, place(s))
     ts = timeseries(r)
     m_c, m_a = s.bodies.chaser.mass, s.bodies.target_apds.mass
     v, e = s.initial.chaser_speed, s.contact.restitution
@@ -109,7 +111,7 @@ def test_a_coaxial_tip_on_tip_run_ends_in_a_named_outcome(yaw):
     window), neither independent check finds interpenetration, momentum and the energy ledger
     close."""
     s = _coaxial(yaw, duration=3.0, jam_time=0.5)
-    r = simulate(s)
+    r = simulate(s, place(s))
     ts = timeseries(r)
     sm = summary(r, ts)
     assert sm["outcome"] == "jammed"

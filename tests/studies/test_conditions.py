@@ -104,7 +104,7 @@ def test_a_row_keeps_both_checks_and_the_deeper_one(monkeypatch, analytic, mesh,
     """The row's penetration_m and its text are the deeper check's (the analytic one on a tie);
     each check's depth has a column of its own, in the CSV and in the summary."""
     import drake_dock.studies.conditions as study
-    from drake_dock.docking.penetration import Penetration
+    from drake_dock.docking.checks.penetration import Penetration
     found = {"analytic": Penetration(analytic, 1.5, "chaser_apds guide side 1",
                                      "target_apds petal 2"),
              "mesh": Penetration(mesh, 2.5, "target_apds tip arc 1", "chaser_apds petal 3")}

@@ -13,16 +13,17 @@ import numpy as np
 import pytest
 from pydrake.systems.analysis import Simulator
 
-from drake_dock.docking.plant import set_initial_state
-from drake_dock.docking.scenario import MODELS_DIR, PAPER_EXAMPLE, load_scenario, validate
-from drake_dock.docking.scene import initial_state
+from drake_dock.docking.model.plant import set_initial_state
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.validation import validate
 from drake_dock.errors import InputError
 from drake_dock.studies.compliant import (CompliantConfig, apds_pieces, build_compliant_diagram,
                                           run_compliant)
+from drake_dock.studies.conditions import ConditionsPlan, conditions
 from drake_dock.studies.crosscheck import (CrosscheckPlan, agreement, capture_time_differences,
                                            counts_as_converged, peak_mean_force,
                                            plan_conditions, summary_lines)
-from drake_dock.studies.conditions import ConditionsPlan, conditions
 
 FUNNEL = MODELS_DIR / "apds_funnel.yaml"
 
@@ -43,7 +44,7 @@ def free_flight():
     validate(sc)
     cd = build_compliant_diagram(sc, CompliantConfig("point", 1e7, 1e-3, dissipation=1.0,
                                                      approximation="similar"))
-    return sc, initial_state(sc), cd
+    return sc, place(sc), cd
 
 
 @pytest.mark.parametrize("since", [None, 0.0, -4.9505])
@@ -79,7 +80,7 @@ def test_the_thrust_starts_at_the_first_step_with_a_contact_force():
     sc = copy.deepcopy(load_scenario(PAPER_EXAMPLE))
     sc.thrust = copy.deepcopy(load_scenario(FUNNEL).thrust)
     validate(sc)
-    state = initial_state(sc)
+    state = place(sc)
     cfg = CompliantConfig("point", 1e7, 5e-4, dissipation=1.0, approximation="similar")
     cd = build_compliant_diagram(sc, cfg)
     run = run_compliant(sc, state, cfg, t_max=0.03, cd=cd)

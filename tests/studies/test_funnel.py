@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from drake_dock.docking.scenario import MODELS_DIR, load_scenario
+from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
 from drake_dock.studies.funnel import (FunnelPlan, capture_range, clearance, geometries,
                                        probe)
 

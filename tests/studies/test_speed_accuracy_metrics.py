@@ -6,10 +6,12 @@ import math
 import numpy as np
 import pytest
 
-from drake_dock.docking.results import rigid_chaser_force, timeseries
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
-from drake_dock.docking.scene import CHASER_APDS, apds_pairs, initial_state
-from drake_dock.docking.simulate import simulate
+from drake_dock.docking.geometry.pairs import CHASER_APDS
+from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.model.simulate import simulate
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.report.results import rigid_chaser_force, timeseries
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.docking_metrics import (METRICS, SceneStart, contact_effect, errors,
                                                 rigid_metrics, sampled_peak, scene_start)
 from drake_dock.studies.work_precision import Point, converged_points, converged_speedups
@@ -104,7 +106,7 @@ def test_sampled_peak_of_a_parabola_is_its_vertex():
 @pytest.fixture(scope="module")
 def paper_run():
     sc = load_scenario(PAPER_EXAMPLE)
-    state = initial_state(sc)
+    state = place(sc)
     r = simulate(sc, state=state)
     return sc, r, rigid_metrics(r, scene_start(sc, state)), timeseries(r)
 
@@ -117,7 +119,8 @@ def test_impulse_is_the_integral_of_the_contact_force(paper_run):
     t, F = rigid_chaser_force(r)
     step = np.diff(t) > 0
     J = (0.5 * np.diff(t)[step, None] * (F[:-1] + F[1:])[step]).sum(0)
-    sign = np.array([1.0 if p.body1 == CHASER_APDS else -1.0 for p in apds_pairs(sc.geometry)])
+    sign = np.array([1.0 if p.body1 == CHASER_APDS else -1.0
+                     for p in DockingScene(sc.geometry, "paper").pairs])
     assert len(ts["impact_t"]) >= 3
     for i, t_i in enumerate(ts["impact_t"]):
         k = np.flatnonzero((ts["t"] == t_i) & (ts["sample_kind"] == 1))[0]

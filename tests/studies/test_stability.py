@@ -8,9 +8,9 @@ import sys
 import numpy as np
 import pytest
 
-from drake_dock.studies import stability as S
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.errors import ZenoError
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
+from drake_dock.studies import stability as S
 from drake_dock.studies.small_scenes import G, painleve_rod, stool
 
 
@@ -88,8 +88,8 @@ def test_zeno_guard_counts_and_error_when_off():
 
 
 def test_zeno_error_is_typed():
-    from drake_dock.systems.contact_system import ContactOptions
     from drake_dock.studies.small_scenes import disk_on_incline
+    from drake_dock.systems.contact_system import ContactOptions
     sc = disk_on_incline(0.0, restitution=0.5,
                          options=ContactOptions(zeno_speed=0.0, max_impacts=3))
     r = sc.params["radius"]

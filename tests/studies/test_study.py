@@ -11,18 +11,18 @@ import pytest
 from pydrake.systems.analysis import Simulator
 from scipy.integrate import solve_ivp
 
+from drake_dock.docking.model.plant import set_initial_state
+from drake_dock.docking.placement.place import place
+from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.compliant import (CompliantConfig, build_compliant_diagram,
                                           hunt_crossley_dissipation)
-from drake_dock.docking.plant import set_initial_state
-from drake_dock.docking.scene import initial_state
-from drake_dock.docking.scenario import PAPER_EXAMPLE, load_scenario
 from drake_dock.studies.docking_metrics import METRICS
 
 
 @pytest.fixture(scope="module")
 def paper():
     sc = load_scenario(PAPER_EXAMPLE)
-    return sc, initial_state(sc)
+    return sc, place(sc)
 
 
 def test_hunt_crossley_dissipation_gives_the_restitution():

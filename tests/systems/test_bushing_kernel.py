@@ -24,7 +24,7 @@ from pydrake.multibody.math import SpatialVelocity
 from pydrake.multibody.tree import MultibodyForces
 
 from drake_dock.core.kernels.bushing import GIMBAL_LOCK, OK, bushing_wrenches
-from drake_dock.docking.plant import StewartDamperPower, make_docking_plant
+from drake_dock.docking.model.plant import PlantSpec, StewartDamperPower, make_docking_plant
 
 RNG = np.random.default_rng(2024)
 N_STATES = 200
@@ -33,7 +33,7 @@ RTOL = 1e-12
 
 @pytest.fixture(scope="module")
 def dp(paper_scenario):
-    return make_docking_plant(paper_scenario)
+    return make_docking_plant(PlantSpec.of(paper_scenario))
 
 
 def _unit_quaternion():

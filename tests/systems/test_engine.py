@@ -16,8 +16,8 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorC
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.couple_row import CoupleRow
-from drake_dock.docking.diagram import build_docking_diagram
-from drake_dock.docking.plant import StewartDamperPower, stewart_potential
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.model.plant import StewartDamperPower, stewart_potential
 from drake_dock.studies.small_scenes import disk_on_incline, rod_on_edge, stool
 from drake_dock.systems.contact_types import ContactOptions
 
@@ -27,7 +27,7 @@ KV = JacobianWrtVariable.kV
 
 @pytest.fixture(scope="module")
 def docking(paper_scenario):
-    dd = build_docking_diagram(paper_scenario)
+    dd = build_docking_diagram(DiagramSpec.of(paper_scenario))
     return dd.contact, dd.dp
 
 

@@ -3,7 +3,7 @@ tip while it slides, its LZB impact made frictionless (`frictionless_lzb`; with 
 impact itself stops the slip), so that it stops the approach only and the sliding that
 follows has no consistent mode, resolved by an impact without collision at the same instant. Each
 impulse's logged states against the momentum balance of the rod written out (linear and
-angular momentum about the mass centre), and the recorder of `drake_dock.docking.simulate`
+angular momentum about the mass centre), and the recorder of `drake_dock.docking.model.simulate`
 replaying them; `max_impacts` counting both kinds."""
 import math
 import types
@@ -70,7 +70,7 @@ def test_two_impulses_in_one_event_carry_their_states(frictionless_lzb):
     impulse P = P_n z + P_ta x + P_tb y at the tip (the plane's frame): m dv = P and
     I dw = r x P; the kinetic energy drops by its energy_lost; the second starts where the
     first ends, and ends with the tip at rest (sticking). The recorder replays both."""
-    from drake_dock.docking.simulate import POST_IMPACT, STEP, _Recorder
+    from drake_dock.docking.model.simulate import POST_IMPACT, STEP, _Recorder
     sc, diagram, sim, r, I_W = initialized()
     root = sim.get_context()
     imp = sc.system.get_modes(sc.system.GetMyContextFromRoot(root)).impacts

@@ -28,8 +28,8 @@ def test_config_applied_and_context_accuracy_set(witness_accuracy):
 @pytest.mark.parametrize("accuracy", [1e-4, 1e-8])
 def test_docking_lzb_accuracy_follows_the_simulator_config(paper_scenario, accuracy):
     import copy
-    from drake_dock.docking.diagram import build_docking_diagram
+    from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
     scenario = copy.deepcopy(paper_scenario)
     scenario.simulator_config.accuracy = accuracy
-    dd = build_docking_diagram(scenario)
+    dd = build_docking_diagram(DiagramSpec.of(scenario))
     assert dd.contact.options.impact_rtol == tolerances(scenario.simulator_config).impact_rtol

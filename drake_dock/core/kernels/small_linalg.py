@@ -132,7 +132,13 @@ def lstsq(A, b, rcond):
     """The least-squares solution of A x = b of least norm, the singular values below rcond
     times the largest cut off (numpy's ``lstsq``)."""
     U, s, V = svd(A)
-    n = A.shape[0]
+    return svd_solve(U, s, V, b, rcond)
+
+
+@njit(cache=True)
+def svd_solve(U, s, V, b, rcond):
+    """`lstsq` from A's `svd` (U, s, V)."""
+    n = U.shape[0]
     cut = rcond * s[0]
     x = np.zeros(n)
     for j in range(n):

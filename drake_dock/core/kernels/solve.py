@@ -8,8 +8,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit, types
-from numba.extending import intrinsic
+from numba import njit
 
 from drake_dock.core import constraints as ref
 from drake_dock.core.kernels import small_linalg as L
@@ -21,14 +20,6 @@ NAME = (ref.STICK, ref.SLIDE, ref.DETACH)
 OK, SINGULAR, NONFINITE, NONE_CONSISTENT, INDETERMINATE = 0, 1, 2, 3, 4
 SLIDE_START_ITER = ref.SLIDE_START_ITER
 
-
-
-@intrinsic
-def _fma(typingctx, a, b, c):
-    """a b + c rounded once (LLVM's fma)."""
-    def codegen(context, builder, signature, args):
-        return builder.fma(*args)
-    return types.float64(types.float64, types.float64, types.float64), codegen
 
 
 @njit(cache=True)
@@ -74,8 +65,7 @@ def solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, 
         elif modes[i] == SLIDE:
             s0, s1 = dirs[i, 0], dirs[i, 1]
             for a in range(nv):
-                # Wt s as numpy's product of the (nv, 2) by the 2-vector rounds it
-                Ct[j, a] = W[i, a, 0] - mu[i] * _fma(W[i, a, 1], s0, W[i, a, 2] * s1)
+                Ct[j, a] = W[i, a, 0] - mu[i] * (W[i, a, 1] * s0 + W[i, a, 2] * s1)
                 Dt[j, a] = W[i, a, 0]
             rhs[j] = stabilised(bias[i, 0], vn[i], gap[i], omega)
             j += 1
@@ -118,7 +108,7 @@ def solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, 
     else:
         U, sv, V = L.svd(A)
         cond = sv[0] / sv[-1] if sv[-1] > 0.0 else math.inf
-        lam = L.lstsq(A, b, 1e-10)
+        lam = L.svd_solve(U, sv, V, b, 1e-10)
         if L.norm(L.matvec(A, lam) - b) > (1e-8 * (1.0 + L.norm(b)) + math.sqrt(soft)):
             return SINGULAR, cond
         ns = 0

@@ -1,0 +1,328 @@
+"""Runs the docking Diagram with Drake's Simulator and records its outputs.
+
+The record holds one sample at the end of every integration step (so the step that ends at an
+impact's witness gives the state just before it) and, for each impact, one sample of the state
+just after it at the same time (from the impact log; no step end sees that state). An event
+with two impulses (an LZB impact, then an impact without collision) gives two samples after
+it, the first also the state just before the second. The simulation ends at
+``simulation.duration`` or at capture (`CaptureMonitor`'s witness).
+
+Integration: the scenario's ``simulator_config`` (Drake's `SimulatorConfig`), applied by
+`drake_dock.systems.simulator.make_simulator`; the witness isolation window and LZB's accuracy
+follow from it (`drake_dock.systems.simulator.tolerances`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import time as _time
+
+import numpy as np
+
+from pydrake.systems.analysis import Simulator, SimulatorStatus
+
+from drake_dock.core.hybrid import Mode
+from drake_dock.docking.model.diagram import DiagramSpec, DockingDiagram, build_docking_diagram
+from drake_dock.docking.model.initial_state import InitialState
+from drake_dock.docking.model.outcome import OutcomeWatch, progress_fraction
+from drake_dock.docking.model.plant import relative_kinetic_energy, set_initial_state
+from drake_dock.errors import numerical_failure
+from drake_dock.systems.contact_system import COUPLE_OUTPUT_SIZE, COUPLE_SLICES, ContactModes
+from drake_dock.systems.contact_types import copied_states
+from drake_dock.systems.simulator import make_simulator, make_witness_approach
+
+STEP, PRE_IMPACT, POST_IMPACT = 0, 1, 2
+
+
+class Record:
+    """Samples of a run (row k = sample k): its time, the contact system's continuous state,
+    the sample's kind (STEP / PRE_IMPACT / POST_IMPACT), the contact modes and the inputs'
+    generalized force then. Everything else of a sample (the couple outputs, the energy, the
+    Stewart element's coordinates and force, the ring distance) is what one evaluation of the
+    contact system at it gives, made for every sample when first asked (`derive`): a run
+    records five references per step."""
+
+    def __init__(self, dd=None):
+        self.dd = dd
+        self.t, self.states, self.kind, self.modes, self.tau = [], [], [], [], []
+        self._derived = None
+
+    def append(self, t, state, kind, modes, tau):
+        self.t.append(t)
+        self.states.append(state)
+        self.kind.append(kind)
+        self.modes.append(modes)
+        self.tau.append(tau)
+        self._derived = None
+
+    @property
+    def x(self) -> np.ndarray:
+        """The plant's [q, v] per sample (N, nq + nv)."""
+        n = self.dd.contact.nq + self.dd.contact.nv
+        return np.array([x[:n] for x in self.states]).reshape(len(self.t), n)
+
+    def derive(self, couples: bool = True) -> dict:
+        """Per sample, by one evaluation of the contact system: ``couples`` (N, pairs,
+        COUPLE_OUTPUT_SIZE) its couple outputs (left out with ``couples`` False: the largest
+        part), ``lambda_n_max`` (N,) the largest normal force, ``energy`` (N, energy names),
+        ``bushings`` (N, bushings, 12: deflection, roll-pitch-yaw, force on the APDS frame,
+        world), ``ring_distance`` (N,)."""
+        if self._derived is None or (couples and "couples" not in self._derived):
+            contact, capture = self.dd.contact, self.dd.capture
+            n = len(self.t)
+            C = np.zeros((n, len(contact.pairs), COUPLE_OUTPUT_SIZE)) if couples else None
+            lam = np.zeros(n)
+            energy = np.zeros((n, len(contact.energy_names)))
+            bush = np.zeros((n, contact.engine.nbush, 12))
+            ring = np.zeros(n)
+            for k in range(n):
+                E = contact.engine.evaluate(self.t[k], self.states[k], self.modes[k],
+                                            self.tau[k])
+                if couples:
+                    C[k] = contact.couple_table_of(E)
+                lam[k] = E.lam_n.max(initial=0.0)
+                energy[k] = contact.energy(E, self.modes[k])
+                bush[k] = E.bushings
+                ring[k] = capture.misalignment_of(self.states[k][:contact.nq])[0]
+            self._derived = dict(lambda_n_max=lam, energy=energy, bushings=bush,
+                                 ring_distance=ring)
+            if couples:
+                self._derived["couples"] = C
+        return self._derived
+
+    @property
+    def couples(self) -> np.ndarray:
+        return self.derive()["couples"]
+
+    @property
+    def energy(self) -> np.ndarray:
+        return self.derive(False)["energy"]
+
+    @property
+    def ring_distance(self) -> np.ndarray:
+        return self.derive(False)["ring_distance"]
+
+    @property
+    def bushings(self) -> np.ndarray:
+        return self.derive(False)["bushings"]
+
+
+@dataclasses.dataclass
+class RunResult:
+    scenario: object
+    dd: DockingDiagram
+    initial: InitialState
+    record: Record
+    impacts: list              # the contact system's impact log
+    mode_changes: int
+    captured: bool
+    capture_time: float | None
+    end_time: float
+    wall_time: float           # seconds in Simulator.Initialize + AdvanceTo (build excluded)
+    evaluations: int
+    timing: dict | None = None  # `Timing.shares`: seeking / contact dynamics / impacts / other
+    outcome: str = "timeout"   # `drake_dock.docking.model.outcome.OUTCOMES`
+    reason: str = ""
+    # At the end of a run that is not captured: the couples in contact (`Holding`), and the
+    # kinetic energy left in the centre-of-mass frame (J).
+    holding: list = dataclasses.field(default_factory=list)
+    relative_kinetic_energy: float = math.nan
+
+    @property
+    def scene(self):
+        """The run's `DockingScene` (its Diagram's): the pairs its couples are named after."""
+        return self.dd.scene
+
+
+@dataclasses.dataclass(frozen=True)
+class Holding:
+    """A couple in contact at the end of a run: its name, the angle of its normal to the
+    docking axis (deg; 0: the couple pushes the rings apart along the axis, 90: sideways) and
+    its normal force (N)."""
+
+    couple: str
+    normal_angle_deg: float
+    force_N: float
+
+    def describe(self) -> str:
+        return f"{self.couple} ({self.normal_angle_deg:.3g} deg from the axis, {self.force_N:.4g} N)"
+
+
+def docking_simulator(dd: DockingDiagram, state: InitialState, config,
+                      witness_accuracy: float | None = None) -> Simulator:
+    """The Simulator of a docking diagram (`make_simulator` with ``config``, a
+    `SimulatorConfig`): ``state`` placed (`set_initial_state`) and copied into the contact
+    system, which owns the state."""
+    def set_state(root):
+        pc = dd.dp.plant.CreateDefaultContext()
+        set_initial_state(dd.dp, pc, state)
+        dd.contact.set_from_plant_context(dd.contact.GetMyMutableContextFromRoot(root), pc)
+    return make_simulator(dd.diagram, config, set_state, witness_accuracy=witness_accuracy)
+
+
+class _Recorder:
+    def __init__(self, dd: DockingDiagram):
+        self.dd = dd
+        self.record = Record(dd)
+        self.n_impacts = 0
+        self._scratch = dd.diagram.CreateDefaultContext()
+
+    def _append(self, root, kind):
+        contact = self.dd.contact
+        cc = contact.GetMyContextFromRoot(root)
+        self.record.append(root.get_time(), cc.get_continuous_state_vector().CopyToVector(),
+                           kind, contact.get_modes(cc), contact.input_force(cc))
+
+    def sample(self, root):
+        """A step end. Impacts logged since the last sample happened at that sample's time:
+        it becomes the pre-impact sample and the logged post-impact state follows it."""
+        contact = self.dd.contact
+        modes = contact.get_modes(contact.GetMyContextFromRoot(root))
+        new = modes.impacts[self.n_impacts:]
+        r = self.record
+        for imp in new:
+            if r.t and r.t[-1] == imp["t"] and r.kind[-1] == STEP:
+                r.kind[-1] = PRE_IMPACT
+            self._post_impact(root, imp, modes)
+        self.n_impacts = len(modes.impacts)
+        if not r.t or root.get_time() > r.t[-1] or new:
+            self._append(root, STEP)
+
+    def _post_impact(self, root, imp, modes):
+        s = self._scratch
+        s.SetTimeStateAndParametersFrom(root)
+        s.SetTime(imp["t"])
+        contact = self.dd.contact
+        cc = contact.GetMyMutableContextFromRoot(s)
+        cc.SetContinuousState(imp["x_plus"])
+        after = ContactModes(copied_states(imp["pairs_plus"]), [], imp["impact_loss_plus"],
+                             modes.mode_changes)
+        contact.set_modes(cc, after.seal())
+        self._append(s, POST_IMPACT)
+
+
+def _couples_in_play(dd: DockingDiagram, root) -> list:
+    """The pairs tracked or in contact (not far) in the root context's state."""
+    try:
+        modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
+        return [p.name for p, st in zip(dd.contact.pairs, modes.pairs) if st.mode != Mode.FAR]
+    except Exception:  # noqa: BLE001 - only a detail of an error report
+        return []
+
+
+def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
+             progress=None, duration: float | None = None,
+             witness_approach: bool = True) -> RunResult:
+    """Runs the scenario from ``state`` (`drake_dock.docking.placement.place.place` finds the
+    scenario's own) on ``dd`` (built when not given) until a named outcome
+    (`drake_dock.docking.model.outcome`), ``simulation.duration`` (or ``duration``) being the
+    timeout; ``progress(t, t_end, fraction)`` is called after each step. Raises the contact
+    system's typed errors (`NumericalError`), and any other failure of the integration as a
+    `NumericalError` with the time and the couples in play. ``witness_approach`` shortens the
+    steps before predicted witness zeros (`drake_dock.systems.stepping.WitnessApproach`); off,
+    Drake's plain isolation is used."""
+    with numerical_failure("the Diagram's set-up", lambda: (0.0, ())):
+        dd = dd or build_docking_diagram(DiagramSpec.of(scenario))
+        rec = _Recorder(dd)
+        sim = docking_simulator(dd, state, scenario.simulator_config)
+    t_end = scenario.simulation.duration if duration is None else duration
+
+    sp = scenario.simulation
+    approach = make_witness_approach(sim, [dd.contact, dd.capture], scenario.simulator_config) \
+        if witness_approach else None
+
+    watch = None
+    ended = []
+
+    def driven(root) -> bool:
+        """Whether post-contact thrust acts now or later."""
+        if dd.thrust is None:
+            return False
+        tc = float(dd.contact.GetOutputPort("first_contact_time").Eval(
+            dd.contact.GetMyContextFromRoot(root))[0])
+        return dd.thrust.schedule.still_to_act(root.get_time() - tc if math.isfinite(tc)
+                                               else -math.inf)
+
+    def monitor(root):
+        from pydrake.systems.framework import EventStatus
+        rec.sample(root)
+        if approach is not None:
+            approach(root)
+        t = root.get_time()
+        cap = dd.capture.GetMyContextFromRoot(root)
+        pose = dd.capture.misalignment(cap)
+        d, to_go = pose[0], dd.capture.rule.to_go(*pose)
+        if progress is not None:
+            progress(t, t_end, progress_fraction(t, t_end, to_go, watch.d_start,
+                                                 sp.capture_distance))
+        end = watch.update(t, d, pose[1], to_go, driven(root))
+        if end is not None:
+            ended.append(end)
+            return EventStatus.ReachedTermination(dd.capture, end[0])
+        return EventStatus.Succeeded()
+
+    evals0 = dd.contact.evaluations
+    dd.contact.timing.reset()
+    wall0 = _time.perf_counter()
+    root = sim.get_context()
+    with numerical_failure("the simulation",
+                            lambda: (root.get_time(), _couples_in_play(dd, root))):
+        sim.Initialize()
+        rec.sample(root)
+        g = scenario.geometry
+        watch = OutcomeWatch(dd.capture.distance(dd.capture.GetMyContextFromRoot(root)),
+                             sp.jam_time, beside=2.0 * g.R, beyond=g.H)
+        sim.set_monitor(monitor)
+        try:
+            status = sim.AdvanceTo(t_end)
+        finally:
+            # The monitor refers to the simulator (the step control): a cycle through Drake's
+            # C++ that Python's collector cannot see would keep the run's record alive.
+            sim.clear_monitor()
+    wall = _time.perf_counter() - wall0
+    rec.sample(root)
+    terminated = status.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition
+    if ended:
+        outcome, reason = ended[0]
+    elif terminated:
+        outcome, reason = "captured", dd.capture.rule.describe()
+    else:
+        outcome, reason = "timeout", f"simulation.duration {t_end:g} s reached"
+    captured = outcome == "captured"
+    modes = dd.contact.get_modes(dd.contact.GetMyContextFromRoot(root))
+    holding, ke_rel = [], math.nan
+    if not captured:
+        holding, ke_rel = _holding(dd, root)
+        if outcome in ("jammed", "timeout"):
+            reason += (f"; held by {', '.join(h.describe() for h in holding) or 'no couple'}"
+                       f"; relative kinetic energy {ke_rel:.4g} J")
+    return RunResult(scenario, dd, state, rec.record, list(modes.impacts), modes.mode_changes,
+                     captured, root.get_time() if captured else None, root.get_time(), wall,
+                     dd.contact.evaluations - evals0, dd.contact.timing.shares(wall),
+                     outcome, reason, holding, ke_rel)
+
+
+def _holding(dd: DockingDiagram, root) -> tuple[list, float]:
+    """The couples in contact in the root context, largest normal force first (`Holding`), and
+    the relative kinetic energy (`relative_kinetic_energy`)."""
+    contact = dd.contact
+    cc = contact.GetMyContextFromRoot(root)
+    table = contact.couple_table(cc)
+    pc = dd.dp.plant.CreateDefaultContext()
+    x = contact.GetOutputPort("state").Eval(cc)
+    dd.dp.plant.SetPositionsAndVelocities(pc, x)
+    axis = dd.dp.apds_frames["target_apds"].CalcPoseInWorld(pc).rotation().col(2)
+    S = COUPLE_SLICES
+    out = []
+    for p, st, row in zip(contact.pairs, contact.get_modes(cc).pairs, table):
+        if st.mode.in_contact:
+            n = row[S["frame"]].reshape(3, 3)[:, 2]
+            cos = min(abs(float(np.dot(n, axis))) / max(float(np.linalg.norm(n)), 1e-300), 1.0)
+            out.append(Holding(p.name, math.degrees(math.acos(cos)),
+                               float(row[S["lambda_n"]][0])))
+    out.sort(key=lambda h: -h.force_N)
+    return out, relative_kinetic_energy(dd.dp, pc)
+
+
+__all__ = ["simulate", "docking_simulator", "RunResult", "Record", "STEP", "PRE_IMPACT",
+           "POST_IMPACT", "COUPLE_OUTPUT_SIZE"]

@@ -1,0 +1,3 @@
+"""A run's report: its numbers (`results`, `loads`, `cost`), the out directory (`out_dir`), the
+figures (`run_figures`, `ledger_figures`, `initial_figure`, `figure_kit`) and the replay
+(`replay`, `replay_marks`). Imports the `scenario`, `geometry` and `model` wings."""
