@@ -45,6 +45,9 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/time_shares.py
 	$(BIN)/python bench/target_floor.py
 	$(BIN)/python bench/offnominal.py
+	$(BIN)/python bench/evaluation.py
+	$(BIN)/python bench/campaign.py
+	$(BIN)/python bench/cold_start.py
 
 clean:
 	rm -rf $(VENV) .venv-core out

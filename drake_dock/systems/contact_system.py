@@ -123,19 +123,21 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     joules of a run with kJ of kinetic energy, not its motion, would set the step (the docking
     diagram passes the chaser's kinetic energy; the ``energy`` output is in joules).
     ``handovers`` are the declared `Handover`s between edge pairs and surface pairs
-    (`drake_dock.core.handover`)."""
+    (`drake_dock.core.handover`). ``followers`` are `FollowerForce`s added to the inputs'
+    generalized force from the state (their work is part of ``input_work``)."""
 
     #: evaluations kept for reuse (`Memo`)
     eval_memo_size = 4
 
     def __init__(self, plant, pairs, law: ContactLaw = ContactLaw(),
                  options: ContactOptions = ContactOptions(), wrench_bodies=(), dampers=(),
-                 energy_scale: float = 1.0, handovers=()):
+                 energy_scale: float = 1.0, handovers=(), followers=()):
         super().__init__()
         check_pairs(plant, pairs, energy_scale)
         law.validate("law")
         self.plant, self.pairs, self.law, self.options = plant, list(pairs), law, options
         self.energy_scale = float(energy_scale)
+        self.followers = tuple(followers)
         self.frames, self.fidx = frame_list(self.pairs)
         self.spans = [np.concatenate([p.patch1.span, p.patch2.span]) for p in self.pairs]
         self.far = FarPairs(self.pairs, self.fidx)
@@ -226,13 +228,24 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     def input_force(self, context) -> np.ndarray:
         """The inputs' generalized force: the ``generalized_force`` input plus each body
         wrench [torque, force] (world frame, at the body's origin), which is a free body's
-        generalized force."""
+        generalized force, plus the follower forces where they act."""
         tau = (self._gf_port.Eval(context).copy() if self._gf_port.HasValue(context)
                else np.zeros(self.nv))
         for j, port in self._wrench_ports.values():
             if port.HasValue(context):
                 tau[j:j + 6] += port.Eval(context)
+        if self.followers:
+            tc = self.first_contact_time(self.get_modes(context))
+            since = context.get_time() - tc if math.isfinite(tc) else -math.inf
+            q = context.get_continuous_state_vector().CopyToVector()
+            for f in self.followers:
+                f.add_to(tau, q, since)
         return tau
+
+    @staticmethod
+    def first_contact_time(modes) -> float:
+        """The time of the first impact (s; every contact starts with one), +inf before it."""
+        return modes.impacts[0]["t"] if modes.impacts else math.inf
 
     def _calc_eval(self, context, value):
         t, modes = context.get_time(), self.get_modes(context)
@@ -273,8 +286,7 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
 
     def _out_first_contact(self, context, out):
         """The time of the first impact (s; every contact starts with one), +inf before it."""
-        impacts = self.get_modes(context).impacts
-        out.SetFromVector([impacts[0]["t"] if impacts else math.inf])
+        out.SetFromVector([self.first_contact_time(self.get_modes(context))])
 
     def _out_couple(self, context, out, i):
         out.SetFromVector(self.couple_table(context)[i])

@@ -2,6 +2,7 @@
 against conservation laws, symmetry, the geometry and a second run."""
 import contextlib
 import json
+import pathlib
 import re
 import subprocess
 import sys
@@ -14,8 +15,10 @@ from scipy.spatial.transform import Rotation
 from drake_dock.core.patches import posed
 from drake_dock.docking.checks.penetration import deepest_penetration
 from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.report.headline import headline_table
 from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
 
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 EXE = [sys.executable, "-m", "drake_dock.cli", "run", "--no-progress"]
 
 
@@ -328,3 +331,12 @@ def test_no_feature_enters_a_solid_of_the_other_apds(runs):
     ts, g = runs["ts"], runs["scenario"].geometry
     pen = deepest_penetration(g, ts["t"], ts["R_WA"], ts["p_WA"], ts["apds_names"].tolist())
     assert pen.depth < 1e-6, pen.describe()
+
+
+def test_the_docs_headline_table_is_the_runs(runs):
+    """docs/results.md's headline table of the example is the one its run gives (to the
+    digits it quotes)."""
+    table = headline_table(runs["summary"], runs["ts"]["impact_normal_impulse"],
+                           runs["ts"]["impact_restitution"])
+    docs = (ROOT / "docs" / "results.md").read_text()
+    assert table in docs, table

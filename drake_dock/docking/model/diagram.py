@@ -22,7 +22,7 @@ from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.model.capture import CaptureMonitor
 from drake_dock.docking.model.outcome import CaptureRule
 from drake_dock.docking.model.plant import DockingPlant, PlantSpec, make_docking_plant
-from drake_dock.docking.model.thrust import ThrustSchedule, ThrustSystem
+from drake_dock.docking.model.thrust import ThrustSchedule, ThrustSystem, follower_of
 from drake_dock.errors import InputError
 from drake_dock.systems.contact_system import (ContactOptions, ContactPair, Handover,
                                                 RigidContactSystem)
@@ -120,10 +120,11 @@ def build_docking_diagram(spec: DiagramSpec, meshcat=None) -> DockingDiagram:
                          p.sigma) for p in scene.pairs]
     contact = builder.AddSystem(RigidContactSystem(
         dp.plant, pairs, law, options,
-        wrench_bodies=("chaser",) + ((("chaser_thrust", "chaser"),) if schedule else ()),
+        wrench_bodies=("chaser",),
         dampers=[("stewart_damper_work", dp.bushing)], energy_scale=spec.energy_scale,
         handovers=[Handover(h.edge_pair.name, h.surface_pair.name, h.edge)
-                   for h in scene.handovers] if spec.handovers else []))
+                   for h in scene.handovers] if spec.handovers else [],
+        followers=[follower_of(dp, schedule)] if schedule else []))
     contact.set_name("rigid_contact")
     to_pose = builder.AddSystem(MultibodyPositionToGeometryPose(dp.plant,
                                                                 input_multibody_state=True))
@@ -137,7 +138,6 @@ def build_docking_diagram(spec: DiagramSpec, meshcat=None) -> DockingDiagram:
         builder.Connect(contact.GetOutputPort("state"), thrust.GetInputPort("state"))
         builder.Connect(contact.GetOutputPort("first_contact_time"),
                         thrust.GetInputPort("first_contact_time"))
-        builder.Connect(thrust.get_output_port(), contact.GetInputPort("chaser_thrust"))
     capture = builder.AddSystem(CaptureMonitor(dp, spec.capture))
     capture.set_name("capture")
     builder.Connect(contact.GetOutputPort("state"), capture.get_input_port())

@@ -4,10 +4,11 @@ theirs at the contact signal to guarantee capture.
 
 The scenario's ``thrust`` section gives the force (N) and when it acts, in seconds after the
 first contact: from ``delay`` for ``duration`` (open: until the run ends), or the listed
-``pulses`` [start, end]. `ThrustSystem` drives the contact system's ``chaser_thrust`` input:
-the force F e3 on the chaser at its mass centre (e3 its APDS frame's docking axis, towards the
-target; no torque), switched by the contact system's ``first_contact_time`` output. A witness
-at each switch ends an integration step there, so the step does not straddle the jump.
+``pulses`` [start, end]. The contact system applies it (`follower_of`: a
+`drake_dock.systems.follower.FollowerForce`): the force F e3 on the chaser at its origin, its
+mass centre (e3 its APDS frame's docking axis, towards the target; no torque), counted from
+the first contact. `ThrustSystem` holds a witness at each switch, which ends an integration
+step there so that the step does not straddle the jump.
 """
 from __future__ import annotations
 
@@ -17,6 +18,8 @@ import math
 import numpy as np
 from pydrake.systems.framework import (BasicVector, EventStatus, LeafSystem, PublishEvent,
                                        WitnessFunctionDirection)
+
+from drake_dock.systems.follower import FollowerForce
 
 
 WRENCH_SIZE = 6
@@ -58,20 +61,17 @@ class ThrustSchedule:
 
 
 class ThrustSystem(LeafSystem):
-    """Input ``state`` (the plant's [q, v]) and ``first_contact_time`` (s, +inf before it);
-    output ``chaser_thrust``, the wrench [torque, force] (world frame) on the chaser at its
-    mass centre: F times the chaser APDS's docking axis while the `ThrustSchedule` acts."""
+    """The thrust's switching times as witnesses (a step ends at each), and its wrench as the
+    output ``chaser_thrust`` ([torque, force], world frame, on the chaser at its origin) for
+    a viewer. Input ``state`` (the plant's [q, v]) and ``first_contact_time`` (s, +inf before
+    it). The contact system applies the thrust itself, as the `FollowerForce` ``follower``
+    (F along the chaser APDS's docking axis while the `ThrustSchedule` acts)."""
 
     def __init__(self, dp, schedule: ThrustSchedule):
         super().__init__()
         self.dp, self.schedule = dp, schedule
-        self._nq = dp.plant.num_positions()
-        # The chaser APDS frame's docking axis e3 from the chaser's quaternion: R_WB R_BF e3.
-        frame = dp.apds_frames["chaser_apds"]
-        self._q0 = int(frame.body().floating_positions_start())
-        self._e3_B = tuple(float(c) for c in frame.GetFixedPoseInBodyFrame().rotation().col(2))
-        self._zero = np.zeros(WRENCH_SIZE)
-        n = self._nq + dp.plant.num_velocities()
+        self.follower = follower_of(dp, schedule)
+        n = dp.plant.num_positions() + dp.plant.num_velocities()
         self._state = self.DeclareVectorInputPort("state", n)
         self._contact = self.DeclareVectorInputPort("first_contact_time", 1)
         self.DeclareVectorOutputPort("chaser_thrust", BasicVector(WRENCH_SIZE), self._out)
@@ -88,28 +88,22 @@ class ThrustSystem(LeafSystem):
         tc = float(self._contact.Eval(context)[0])
         return context.get_time() - tc if math.isfinite(tc) else -1.0
 
-    def acting(self, context) -> bool:
-        tc = float(self._contact.Eval(context)[0])
-        return math.isfinite(tc) and self.schedule.on(context.get_time() - tc)
-
-    def axis(self, q) -> tuple:
-        """The chaser APDS frame's docking axis (world) at the positions q: the chaser's
-        rotation (its quaternion, normalised as Drake does) applied to the frame's e3 in the
-        body (plain float arithmetic: it runs at every evaluation while the thrust acts)."""
-        w, x, y, z = (float(c) for c in q[self._q0:self._q0 + 4])
-        s = 2.0 / (w * w + x * x + y * y + z * z)
-        a, b, c = self._e3_B
-        return ((1.0 - s * (y * y + z * z)) * a + s * (x * y - w * z) * b + s * (x * z + w * y) * c,
-                s * (x * y + w * z) * a + (1.0 - s * (x * x + z * z)) * b + s * (y * z - w * x) * c,
-                s * (x * z - w * y) * a + s * (y * z + w * x) * b + (1.0 - s * (x * x + y * y)) * c)
-
     def _out(self, context, out):
-        if not self.acting(context):
-            out.SetFromVector(self._zero)
-            return
-        f = self.schedule.force
-        e0, e1, e2 = self.axis(self._state.Eval(context))
-        out.SetFromVector([0.0, 0.0, 0.0, f * e0, f * e1, f * e2])
+        tc = float(self._contact.Eval(context)[0])
+        w = self.follower.wrench(self._state.Eval(context),
+                                 context.get_time() - tc if math.isfinite(tc) else -math.inf)
+        out.SetFromVector(np.zeros(WRENCH_SIZE) if w is None else w)
 
     def DoGetWitnessFunctions(self, context):
         return self._witnesses
+
+
+def follower_of(dp, schedule: ThrustSchedule) -> FollowerForce:
+    """The thrust as a `FollowerForce` on the chaser: along the chaser APDS frame's docking
+    axis e3 (R_BF e3 in the chaser's body frame)."""
+    frame = dp.apds_frames["chaser_apds"]
+    body = frame.body()
+    return FollowerForce(schedule.force,
+                         tuple(float(c) for c in frame.GetFixedPoseInBodyFrame().rotation().col(2)),
+                         int(body.floating_positions_start()),
+                         int(body.floating_velocities_start_in_v()), schedule.windows)
