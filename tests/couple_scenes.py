@@ -3,8 +3,20 @@ scene tests (tests/docking): a ring outside a guide surface (C-S) and two facing
 (C-C)."""
 import numpy as np
 
+from drake_dock.core.couple import closest_point_conditions
 from drake_dock.docking.geometry.apds import apds_patches
 from motions import Motion
+
+
+def settle(kind, c1, X1, c2, X2, u, iters=20):
+    """The couple u finished by Newton on the contact form (Eq. 37-38) at the poses X_i."""
+    u = np.asarray(u, dtype=float)
+    for _ in range(iters):
+        F, Fu = closest_point_conditions(kind, c1, X1, c2, X2, u)
+        u = u - np.linalg.solve(Fu, F)
+        if np.abs(F).max() < 1e-15:
+            break
+    return u
 
 
 def cs_scene(geom, gap=0.02):

@@ -65,3 +65,21 @@ def check_rates_by_finite_differences(ev_at, m1, m2, times=(0.2, 0.55, 0.9), h=1
         np.testing.assert_allclose(np.array([e0.ta @ acc, e0.tb @ acc]) + e0.bias_t, vt_dot,
                                    atol=1e-6)
         np.testing.assert_allclose(e0.vt, [e0.ta @ e0.v_rel, e0.tb @ e0.v_rel], atol=1e-15)
+
+
+class PosedMotion:
+    """A rigid motion given by its pose function ``pose(t)`` -> (R, p), with the accelerations
+    of its material points by second central differences (for `check_rates_by_finite_differences`
+    where no closed form is at hand)."""
+
+    def __init__(self, pose, h=1e-4):
+        self.pose, self.h = pose, h
+
+    def acceleration(self, t, P):
+        R, p = self.pose(t)
+        body = R.T @ (np.asarray(P) - p)          # the material point in the body frame
+
+        def x(s):
+            Rs, ps = self.pose(s)
+            return ps + Rs @ body
+        return (x(t + self.h) - 2 * x(t) + x(t - self.h)) / self.h ** 2

@@ -27,7 +27,7 @@ from drake_dock.core.kernels.engine import evaluate as evaluate_kernel
 from drake_dock.core.kernels.jets import N_PARAMS, patch_spec
 from drake_dock.core.kernels import records
 from drake_dock.core.kernels.records import pack
-from drake_dock.core.kernels.tracked import CoupleRow
+from drake_dock.core.kernels.couple_row import CoupleRow
 from drake_dock.systems.evaluation import Evaluation, Kinematics
 
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels import model as E
-from drake_dock.core.kernels.tracked import CoupleRow
+from drake_dock.core.kernels.couple_row import CoupleRow
 from drake_dock.core.kernels.witness_values import far_witness
 
 

@@ -8,7 +8,6 @@ from drake_dock.core import handover, hybrid
 from drake_dock.core.couple import point_curve_side
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import constraints as compiled_constraints
-from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import (DriftError, InputError, PainleveInconsistency, SeekingError,
@@ -197,9 +196,7 @@ class Transitions:
         a, b = ev.fidx[i]
         try:
             P1, P2 = posed(p.patch1, *poses[a]), posed(p.patch2, *poses[b])
-            seek = (compiled_seek.seek_couple if compiled_seek.supported(P1, P2)
-                    else seek_couple)
-            c = seek(P1, P2, distance_rtol=opt.seek_rtol, rtol_beyond=opt.track_distance)
+            c = seek_couple(P1, P2, distance_rtol=opt.seek_rtol, rtol_beyond=opt.track_distance)
         except SeekingError as e:
             raise SeekingError(str(e), time=time, couples=[p.name]) from None
         st.ref_X21 = ev.far.reference(i, poses)

@@ -80,7 +80,7 @@ def test_an_edit_of_the_real_tree_changes_the_keys_of_the_modules_that_import_it
 
 def test_the_kernels_are_cached_in_their_module_directory_under_its_key():
     from drake_dock.core.kernels import couples, lzb
-    for module, fn in [("couples", couples.evaluate_couples), ("lzb", lzb.lzb_impact)]:
+    for module, fn in [("couples", couples.evaluate_one), ("lzb", lzb.lzb_impact)]:
         key = cc.module_key(K + module)
         assert fn._cache.cache_path == str(cc.cache_dir() / f"{module}-{key}")
         assert fn._cache._impl.locator.get_source_stamp() == key

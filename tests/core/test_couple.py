@@ -8,7 +8,7 @@ from drake_dock.core.couple import closest_point_conditions, evaluate_couple
 from drake_dock.core.patches import Circle, PlaneRect, Segment, posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.docking.geometry.rotations import rot_x, rot_z
-from couple_scenes import cc_scene, cs_scene
+from couple_scenes import cc_scene, cs_scene, settle
 
 
 def _frame_on(P, T):
@@ -17,15 +17,6 @@ def _frame_on(P, T):
     t = T - (T @ n) * n
     t /= np.linalg.norm(t)
     return n, t
-
-
-def settle(kind, c1, X1, c2, X2, u, iters=20):
-    for _ in range(iters):
-        F, Fu = closest_point_conditions(kind, c1, X1, c2, X2, u)
-        u = u - np.linalg.solve(Fu, F)
-        if np.abs(F).max() < 1e-15:
-            break
-    return u
 
 
 def scene_at(scene, t, u):

@@ -13,7 +13,6 @@ import pytest
 
 from drake_dock.core import covers
 from drake_dock.core.kernels import cover as compiled
-from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.docking.geometry.pairs import CHASER_APDS
@@ -123,7 +122,7 @@ def test_touch_steps_equal_a_brute_force(name):
 def test_bound_lies_below_the_seek_distance():
     """At every grid point of the paper's approach: the covers' least distance (min over cell
     pairs of the larger of |c1 - c2| - r1 - r2 and each slab's |n . (c1 - c2)| - r - kappa)
-    <= the compiled seek's distance of every pair, and > 0 at both ends of every step that is
+    <= the seek's distance of every pair, and > 0 at both ends of every step that is
     not touched."""
     g = ApdsGeometry()
     approach = APPROACHES[0]
@@ -136,8 +135,8 @@ def test_bound_lies_below_the_seek_distance():
             bound = _least_bound(moving, fixed, -lam * e)
             R, p = approach.pose(lam)
             poses = {CHASER_APDS: (R, p), "target_apds": (np.eye(3), np.zeros(3))}
-            cp = compiled_seek.seek_couple(posed(pr.patch1, *poses[pr.body1]),
-                                           posed(pr.patch2, *poses[pr.body2]))
+            cp = seek_couple(posed(pr.patch1, *poses[pr.body1]),
+                             posed(pr.patch2, *poses[pr.body2]))
             assert bound <= cp.distance + 1e-12, (pr.name, lam)
             near = touched[j, max(k - 1, 0):k + 1]
             if not near.any():
@@ -146,7 +145,7 @@ def test_bound_lies_below_the_seek_distance():
 
 def test_cover_gap_compiled_equals_reference_and_lies_below_the_seek():
     """`cover_gap` (block-pruned, compiled) equals the reference over every sphere pair to
-    1e-12, and lies below the compiled seek's distance, for the complete set's pairs at random
+    1e-12, and lies below the seek's distance, for the complete set's pairs at random
     relative poses of the two APDS (tilt up to 10 deg, offset up to 0.15 m, ring distance -0.2
     to 0.5 m)."""
     from drake_dock.docking.geometry.pairs import R_MATCHED
@@ -165,6 +164,5 @@ def test_cover_gap_compiled_equals_reference_and_lies_below_the_seek():
             got, ref = compiled.cover_gap(a, b), covers.cover_gap(a, b)
             assert got == pytest.approx(ref, rel=0, abs=1e-12), pr.name
             P1, P2 = posed(pr.patch1, *X[pr.body1]), posed(pr.patch2, *X[pr.body2])
-            cp = (compiled_seek.seek_couple if compiled_seek.supported(P1, P2)
-                  else seek_couple)(P1, P2)
+            cp = seek_couple(P1, P2)
             assert got <= cp.distance + 1e-12, pr.name

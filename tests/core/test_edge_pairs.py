@@ -1,9 +1,10 @@
 """The edge and face pairs (`contact.pairs: complete`) in closed form (tests/edge_scenes.py): a
 ring's circle over a straight edge and over a tip arc, a straight edge over a skew straight edge
 and over an arc (C-C: a guide side against another side or a tip arc), a tilted rim over a ring
-face (C-S),
-a tip arc over a guide-surface cone (C-S) and the hand-over at a petal-like tip, tracked by Eq. (47) through prescribed motions to 1e-8;
-the compiled kernels against the Python reference to 1e-12."""
+face (C-S), a tip arc over a guide-surface cone (C-S) and the hand-over at a petal-like tip,
+tracked by Eq. (47) through prescribed motions to 1e-8; the couple's projection, frame, both
+orientations, relative velocity and Eq. (52) terms against the closed form and its differences
+along the motion."""
 import math
 
 import numpy as np
@@ -11,16 +12,13 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from drake_dock.core.couple import evaluate_couple
-from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.kernels.jets import jet, patch_spec
-from drake_dock.core.kernels.tracked import TrackedCouples
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.docking.geometry.apds import apds_patches, corner_point
-from drake_dock.docking.geometry.pairs import R_MATCHED
-from drake_dock.docking.geometry.rotations import rot_vec
 from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.scenario.dimensions import ApdsGeometry
+from motions import PosedMotion, check_rates_by_finite_differences
 from edge_scenes import (CORNER, arc_over_cone, rim_over_face, ring_over_arc, ring_over_segment,
                          segment_over_arc, segment_over_segment, tip_handover)
 
@@ -56,19 +54,18 @@ def _track(scene, t_span, u0, events=None):
 
 @pytest.mark.parametrize("name", SCENES)
 def test_seek_finds_the_closed_form_couple(name):
-    """At t = 0 the seek (Python and compiled) finds the closed-form couple, interior, and the
+    """At t = 0 the seek finds the closed-form couple, interior, and the
     contact-form finish keeps it (a ring over a straight edge crosses it twice at the same
     distance: either couple)."""
     s = SCENES[name]()
     exact = [s.exact(0.0, b) for b in s.branches]
     X1, _, X2, _ = s.poses(0.0)
     P1, P2 = posed(s.patch1, *X1), posed(s.patch2, *X2)
-    for seek in (seek_couple, compiled_seek.seek_couple):
-        c = seek(P1, P2)
-        assert c.interior
-        u, gap = min(exact, key=lambda e: np.abs(_wrap(c.u - e[0], s)).max())[:2]
-        assert c.distance == pytest.approx(gap, abs=1e-12)
-        np.testing.assert_allclose(_wrap(c.u - u, s), 0.0, atol=1e-8)
+    c = seek_couple(P1, P2)
+    assert c.interior
+    u, gap = min(exact, key=lambda e: np.abs(_wrap(c.u - e[0], s)).max())[:2]
+    assert c.distance == pytest.approx(gap, abs=1e-12)
+    np.testing.assert_allclose(_wrap(c.u - u, s), 0.0, atol=1e-8)
     cc = contact_couple(s.kind, s.patch1, X1, s.patch2, X2, c, conditioning_min=1e-10)
     assert cc.usable
     np.testing.assert_allclose(_wrap(cc.u - u, s), 0.0, atol=1e-12)
@@ -134,36 +131,41 @@ def test_handover_at_the_tip_corner():
 
 
 @pytest.mark.parametrize("name", SCENES)
-def test_kernels_equal_the_python_path(name):
-    """The compiled jets (the arc as a CIRCLE, the face as ANNULUS) and couple evaluation equal
-    the Python reference to 1e-12, at the couple and perturbed off it, both sigmas."""
+def test_projection_frame_and_rates_against_the_closed_form(name):
+    """From the closed-form couple 1e-3 off, one projection lands within 5e-5 of it and a second
+    within 1e-8 (Newton: quadratic), drift = u - u_state; at the couple both orientations give the closed-form gap
+    and normal (negated with sigma), an orthonormal right-handed frame with ta along patch 2's
+    tangent, the material points' relative velocity (the twists at the points), and u'
+    (Eq. 47), g' = v_n, g'' and (t . v_rel)' (Eq. 52; the points' accelerations by differences
+    of the poses) equal the differences along the motion of the closed-form couples."""
     s = SCENES[name]()
     rng = np.random.default_rng(3)
-    for patch in (s.patch1, s.patch2):
-        kind, prm = patch_spec(patch)
-        for _ in range(10):
-            u = patch.lower + rng.random(patch.dim) * patch.span
-            r, T, K = patch.jet(u)
-            got = jet(kind, prm, u[0], u[1] if patch.dim == 2 else 0.0)
-            want = [r, T[0], K[0][0]] if patch.dim == 1 else [r, *T, K[0][0], K[0][1], K[1][1]]
-            got = [got[0], got[1], got[3]] if patch.dim == 1 else [got[0], *got[1:]]
-            np.testing.assert_allclose(np.array(got), np.array(want), rtol=0, atol=1e-15)
-    tc = TrackedCouples([(s.kind, s.patch1, s.patch2, (0, 1))])
-    assert tc.supported
+    sigma0 = float(np.sign(_evaluate(s, 0.0, s.exact(0.0)[0]).gap))
     for t in (0.1, 0.6):
         X1, V1, X2, V2 = s.poses(t)
-        R, o = np.array([X1[0], X2[0]]), np.array([X1[1], X2[1]])
-        w, v = np.array([V1[0], V2[0]]), np.array([V1[1], V2[1]])
-        u0 = s.exact(t)[0]
-        for u, sigma in ((u0, 1.0), (u0 + 1e-3 * rng.normal(size=len(u0)), -1.0)):
-            out, _ = tc.evaluate(R, o, w, v, u, np.array([sigma]), np.ones(1, dtype=np.bool_))
-            ref = _evaluate(s, t, u, sigma)
-            got = tc.couple_eval(out, 0)
-            for f in ("u", "udot", "p1", "p2", "n", "ta", "tb", "gap", "vn", "vt", "bias_n",
-                      "bias_t"):
-                want = np.asarray(getattr(ref, f), dtype=float)
-                np.testing.assert_allclose(getattr(got, f), want, rtol=0,
-                                           atol=1e-12 * (1.0 + np.abs(want).max()), err_msg=f)
+        u0, gap, p1, p2, n = s.exact(t)
+        du = 1e-3 * rng.normal(size=len(u0))
+        ev = _evaluate(s, t, u0 + du, -sigma0)
+        np.testing.assert_allclose(_wrap(ev.u - u0, s), 0.0, atol=5e-5)
+        np.testing.assert_allclose(ev.drift, ev.u - (u0 + du), atol=1e-15)
+        again = _evaluate(s, t, ev.u, -sigma0)
+        np.testing.assert_allclose(_wrap(again.u - u0, s), 0.0, atol=1e-8)
+        for sigma in (sigma0, -sigma0):
+            ev = _evaluate(s, t, u0, sigma)
+            assert ev.gap == pytest.approx(sigma * sigma0 * gap, abs=1e-10)
+            np.testing.assert_allclose(ev.n, sigma * sigma0 * n, atol=1e-10)
+            Rf = ev.frame
+            np.testing.assert_allclose(Rf.T @ Rf, np.eye(3), atol=1e-12)
+            assert np.linalg.det(Rf) > 0
+            T2 = X2[0] @ s.patch2.first(ev.u[s.patch1.dim:])[:, 0]
+            np.testing.assert_allclose(ev.ta, T2 / np.linalg.norm(T2), atol=1e-12)
+            v_rel = (V1[1] + np.cross(V1[0], ev.p1 - X1[1])
+                     - V2[1] - np.cross(V2[0], ev.p2 - X2[1]))
+            np.testing.assert_allclose(ev.v_rel, v_rel, atol=1e-12)
+    m1 = PosedMotion(lambda t: s.poses(t)[0])
+    m2 = PosedMotion(lambda t: s.poses(t)[2])
+    check_rates_by_finite_differences(lambda t: _evaluate(s, t, s.exact(t)[0], sigma0), m1, m2,
+                                      times=(0.1, 0.6))
 
 
 def test_complete_set_names_and_patches(geom):
@@ -240,26 +242,6 @@ def test_complete_set_names_and_patches(geom):
                                    atol=1e-15)
     with pytest.raises(ValueError, match="contact.pairs"):
         DockingScene(geom, "all").pairs
-
-
-@pytest.mark.parametrize("g", [ApdsGeometry(), ApdsGeometry(R=0.9, Rs=0.55, H=0.3,
-                                                            alpha1_deg=50.0, alpha2_deg=25.0)])
-@pytest.mark.parametrize("d", [0.12, 0.02, -0.05])
-def test_complete_pairs_compiled_seek_equals_python(g, d):
-    """The 20 new C-C and C-S pairs, the chaser tilted, offset and at ring distance d: the compiled seek
-    gives the Python seek's distance to 1e-12 and the same interior flag."""
-    poses = {"target_apds": (np.eye(3), np.zeros(3)),
-             "chaser_apds": (rot_vec((0.03, -0.02, 0.01)) @ R_MATCHED,
-                             np.array([0.03, -0.02, d]))}
-    for pr in DockingScene(g, "complete").pairs[12:]:
-        P1, P2 = posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2])
-        if pr.kind in ("PC", "PS"):     # a point: sought in Python, not compiled
-            assert not compiled_seek.supported(P1, P2)
-            continue
-        assert compiled_seek.supported(P1, P2)
-        ref, got = seek_couple(P1, P2), compiled_seek.seek_couple(P1, P2)
-        assert got.distance == pytest.approx(ref.distance, rel=0, abs=1e-12), pr.name
-        assert got.interior == ref.interior, pr.name
 
 
 def test_tip_arcs_face_the_surfaces_their_pairs_name(geom):
@@ -427,8 +409,8 @@ def _tip_tip_exact(geom, tips, j, k, R, p):
 
 def test_tip_tip_pairs_follow_the_closed_form(geom):
     """Each tip-tip pair (C-C, `tip_tip_pairs`) with the chaser level, rolled and offset so
-    that its tip arc crosses the target's over both arcs (seeded search): the seek (Python and
-    compiled) finds the closed-form couple and distance to 1e-12, the normal is along the
+    that its tip arc crosses the target's over both arcs (seeded search): the seek finds the
+    closed-form couple and distance to 1e-12, the normal is along the
     axis, and u* integrated by Eq. (47) along a motion (the chaser closing at 0.05 m/s and
     drifting sideways at 0.02 m/s) equals the closed form to 1e-8."""
     from drake_dock.docking.placement.search import relative_pose
@@ -449,10 +431,9 @@ def test_tip_tip_pairs_follow_the_closed_form(geom):
         target = (np.eye(3), np.zeros(3))
         (u0, dist), = _tip_tip_exact(geom, P.tips, j, k, *pose(0.0))
         P1, P2 = posed(pr.patch1, *pose(0.0)), posed(pr.patch2, *target)
-        for seek in (seek_couple, compiled_seek.seek_couple):
-            c = seek(P1, P2)
-            assert c.interior and c.distance == pytest.approx(dist, abs=1e-12), pr.name
-            np.testing.assert_allclose(c.u, u0, atol=1e-8)
+        c = seek_couple(P1, P2)
+        assert c.interior and c.distance == pytest.approx(dist, abs=1e-12), pr.name
+        np.testing.assert_allclose(c.u, u0, atol=1e-8)
         twist1 = (np.zeros(3), np.array([0.02, 0.0, -0.05]))
         still = (np.zeros(3), np.zeros(3))
         ev = evaluate_couple("CC", pr.patch1, pose(0.0), twist1, pr.patch2, target, still, u0,

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from drake_dock.core.couple import closest_point_conditions, evaluate_couple
-from drake_dock.core.kernels import seek as compiled_seek
+from drake_dock.core.kernels.jets import jet, patch_spec, position
 from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.core.couple_rate import couple_rate
@@ -227,7 +227,7 @@ def test_ring_nearly_coaxial_over_tip_arcs(gap):
     """A ring's inside circle over the other APDS's tip arcs, of the same radius (Rs = R -
     H cot(alpha1)), coaxial to 0-1e-6 rad: a valley of couples at nearly one distance, whose
     bottom is at an arc end (a tilt of 2e-10 rad at 19.6 mm made the Newton creep along it,
-    50 iterations short of the end). Both seeks converge to the closed-form distance, against
+    50 iterations short of the end). The seek converges to the closed-form distance, against
     the tip arc and against the guide surface it bounds (nearest at its tip arc: the cone
     falls away below it)."""
     rng = np.random.default_rng(int(gap * 1e6))
@@ -242,8 +242,7 @@ def test_ring_nearly_coaxial_over_tip_arcs(gap):
                 X1, X2 = _scene_poses(pair, X_chaser)
                 want = _circle_to_arc(pair.patch1, X1, arc)
                 P1, P2 = posed(pair.patch1, *X1), posed(pair.patch2, *X2)
-                for seek in (seek_couple, compiled_seek.seek_couple):
-                    assert seek(P1, P2).distance == pytest.approx(want, abs=1e-12)
+                assert seek_couple(P1, P2).distance == pytest.approx(want, abs=1e-12)
 
 
 def _plane_normal(curve):
@@ -336,21 +335,18 @@ CREEPING_X2 = ([[0.9994844617295722, 0.028793339321968578, 0.014204026606468355]
 def test_seek_creeping_to_a_near_tangent_crossing():
     """The ring's circle cuts the guide surface next to its edge while nearly osculating it
     (J's smallest singular value 3e-6 of its largest): every Newton start creeps along the
-    valley for about 90 iterations before it converges (more than a limit of 50). Both
-    seeks find a crossing: distance below 1e-12, the circle's points on either side of the
-    couple on opposite sides of the surface's tangent plane; and they agree."""
+    valley for about 90 iterations before it converges (more than a limit of 50). The seek
+    finds a crossing: distance below 1e-12, the circle's points on either side of the couple
+    on opposite sides of the surface's tangent plane."""
     pair = next(p for p in PAIRS if p.name == "cs_Cring_T1")
     X1, X2 = ((np.array(R), np.array(p)) for R, p in (CREEPING_X1, CREEPING_X2))
     P1, P2 = posed(pair.patch1, *X1), posed(pair.patch2, *X2)
-    found = [seek(P1, P2, distance_rtol=1e-7, rtol_beyond=0.02)
-             for seek in (seek_couple, compiled_seek.seek_couple)]
-    for c in found:
-        assert c.distance < 1e-12
-        T = P2.first(c.u2)
-        nrm = np.cross(T[:, 0], T[:, 1])
-        sides = [nrm @ (P1.position(c.u1 + e) - P2.position(c.u2)) for e in (-1e-6, 1e-6)]
-        assert sides[0] * sides[1] < 0
-    assert np.linalg.norm(found[0].p1 - found[1].p1) < 1e-6
+    c = seek_couple(P1, P2, distance_rtol=1e-7, rtol_beyond=0.02)
+    assert c.distance < 1e-12
+    T = P2.first(c.u2)
+    nrm = np.cross(T[:, 0], T[:, 1])
+    sides = [nrm @ (P1.position(c.u1 + e) - P2.position(c.u2)) for e in (-1e-6, 1e-6)]
+    assert sides[0] * sides[1] < 0
 
 
 # ------------------------------------------------------------------- small scenes' patch types
@@ -413,27 +409,47 @@ def test_finish_at_round_off_far_from_the_origin():
         np.testing.assert_allclose(f.u[1:] - 50.0, X1[1][:2], atol=1e-9)
 
 
-def test_patch_continuation_beyond_the_domain():
-    """Beyond their reach the guide surface holds theta_1 and the guide side holds rho: values
-    continuous across the reach, finite everywhere, and the derivatives there those of the held
-    curve (central differences)."""
+def _kernel_jet(patch, u):
+    """(r, T, K) of the compiled jet (`drake_dock.core.kernels.jets`) in the form of
+    `Patch.jet`."""
+    kind, prm = patch_spec(patch)
+    r, t0, t1, k00, k01, k11 = jet(kind, prm, u[0], u[1] if patch.dim == 2 else 0.0)
+    if patch.dim == 1:
+        return r, (t0,), ((k00,),)
+    return r, (t0, t1), ((k00, k01), (k01, k11))
+
+
+def _kernel_position(patch, u):
+    kind, prm = patch_spec(patch)
+    return np.array(position(kind, prm, u[0], u[1] if patch.dim == 2 else 0.0))
+
+
+@pytest.mark.parametrize("compiled", [False, True], ids=["patch", "kernel"])
+def test_patch_continuation_beyond_the_domain(compiled):
+    """Beyond their reach the guide surface holds theta_1 and the guide side holds rho, in the
+    patches and in the compiled jets alike: values continuous across the reach, finite
+    everywhere, and the derivatives there those of the held curve (central differences)."""
     P = apds_patches(G)
     surf, side = P.surfaces[1], P.sides[2]
+    jet_of = _kernel_jet if compiled else (lambda patch, u: patch.jet(u))
+    pos = _kernel_position if compiled else (lambda patch, u: patch.position(u))
     lo, hi = surf.phi.z_reach
     for z in (lo, hi):
-        a, b = surf.position([0.3, z - 1e-9]), surf.position([0.3, z + 1e-9])
+        a, b = pos(surf, [0.3, z - 1e-9]), pos(surf, [0.3, z + 1e-9])
         assert np.linalg.norm(a - b) < 1e-8
     for s in ([0.3, hi + 0.05], [0.7, lo - 0.3], [-2.0, 0.3], [0.5, 0.6], [3.0, 50.0]):
-        r, T, K = surf.jet(s)
+        r, T, K = jet_of(surf, s)
         assert np.all(np.isfinite(r)) and np.all(np.isfinite(T)) and np.all(np.isfinite(K))
+        np.testing.assert_allclose(r, surf.position(s), atol=1e-15)
         h = 1e-6
         for k in range(2):
             e = np.eye(2)[k] * h
-            fd = (surf.position(np.add(s, e)) - surf.position(np.subtract(s, e))) / (2 * h)
+            fd = (pos(surf, np.add(s, e)) - pos(surf, np.subtract(s, e))) / (2 * h)
             np.testing.assert_allclose(T[k], fd, atol=1e-6)
     # Side 2 (sigma = -1): w = alpha2 - (theta - pi/3) reaches 0 at theta = pi/3 + alpha2.
     for th in (math.pi / 3 + G.alpha2, math.pi / 3 + G.alpha2 + 0.1, math.pi / 3 - 2.0, -40.0):
-        r, T, K = side.jet([th])
+        r, T, K = jet_of(side, [th])
         assert np.all(np.isfinite(r)) and np.all(np.isfinite(T)) and np.all(np.isfinite(K))
-        fd = (side.position([th + 1e-6]) - side.position([th - 1e-6])) / 2e-6
+        np.testing.assert_allclose(r, side.position([th]), atol=1e-15)
+        fd = (pos(side, [th + 1e-6]) - pos(side, [th - 1e-6])) / 2e-6
         np.testing.assert_allclose(T[0], fd, atol=1e-6)

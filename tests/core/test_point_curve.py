@@ -140,42 +140,28 @@ def test_arc_seek_bounded(q):
 
 
 @pytest.mark.parametrize("r_pt", [0.0, 0.002])
-def test_compiled_kernel_equals_python(r_pt):
-    """The compiled point-curve couple (`TrackedCouples`, beside a C-C pair) gives the Python
-    evaluation's fields to 1e-12, on and off the couple (projection) and for both sigma; a
-    point on the curve is a NaN gap there (the caller's `SingularCoupleError`)."""
-    from drake_dock.core.kernels.tracked import TrackedCouples
-    from drake_dock.core.patches import Segment
+@pytest.mark.parametrize("m1", MOVING)
+def test_both_orientations_and_the_projection(m1, r_pt):
+    """From the closed-form s 1e-3 off, one projection lands within 1e-5 of it and a second
+    within 1e-10 (Newton on F = t2 . d: quadratic), drift = s - s_state; with sigma = -1 the
+    normal is -d/|d| and the gap -|d| - r (closed form), the rate s' the same as with +1."""
     point, ring = Point((0.03, -0.02, 0.04), r_pt), Circle(R_C)
-    seg = Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1))
-    tc = TrackedCouples([("CC", seg, Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0)), (1, 0)),
-                         ("PC", point, ring, (0, 1))])
-    assert tc.supported and tc.python == []
     rng = np.random.default_rng(3)
-    for m1 in MOVING:
-        for t in (0.1, 0.45, 0.8):
-            X1, X2, V1, V2 = m1.pose(t), RING.pose(t), m1.twist(t), RING.twist(t)
-            s = closed_form(X1[1] + X1[0] @ point.p, *X2)[0]
-            for s0, sigma in ((s, 1.0), (s + 1e-3 * rng.normal(), -1.0)):
-                out, rate = tc.evaluate(np.array([X1[0], X2[0]]), np.array([X1[1], X2[1]]),
-                                        np.array([V1[0], V2[0]]), np.array([V1[1], V2[1]]),
-                                        np.array([0.5, 0.5, s0]), np.array([1.0, sigma]),
-                                        np.array([False, True]), drift_feedback=50.0)
-                ref = evaluate_couple("PC", point, X1, V1, ring, X2, V2, [s0], sigma)
-                got = tc.couple_eval(out, 1)
-                for f in ("u", "drift", "udot", "conditioning", "p1", "p2", "n", "ta", "tb",
-                          "gap", "vn", "vt", "bias_n", "bias_t"):
-                    want = np.asarray(getattr(ref, f), dtype=float)
-                    np.testing.assert_allclose(getattr(got, f), want, rtol=0,
-                                               atol=1e-12 * (1.0 + np.abs(want).max()),
-                                               err_msg=f)
-                assert rate[2] == pytest.approx(ref.udot[0] + 50.0 * ref.drift[0], abs=1e-12)
-                assert rate[:2].tolist() == [0.0, 0.0]
-    X = np.array([np.eye(3), np.eye(3)])
-    on = TrackedCouples([("PC", Point((R_C, 0.0, 0.0)), ring, (0, 1))])
-    out, _ = on.evaluate(X, np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)),
-                         np.array([0.0]), np.ones(1), np.ones(1, dtype=np.bool_))
-    assert math.isnan(on.couple_eval(out, 0).gap)
+    for t in (0.1, 0.45, 0.8):
+        X1, X2, V1, V2 = m1.pose(t), RING.pose(t), m1.twist(t), RING.twist(t)
+        s, dist, n = closed_form(X1[1] + X1[0] @ point.p, *X2)
+        s0 = s + 1e-3 * rng.normal()
+        ev = evaluate_couple("PC", point, X1, V1, ring, X2, V2, [s0], -1.0)
+        assert abs(ev.u[0] - s) < 1e-5 and ev.drift[0] == pytest.approx(ev.u[0] - s0, abs=1e-15)
+        again = evaluate_couple("PC", point, X1, V1, ring, X2, V2, ev.u, -1.0)
+        assert abs(again.u[0] - s) < 1e-10
+        plus = evaluate_couple("PC", point, X1, V1, ring, X2, V2, [s], 1.0)
+        minus = evaluate_couple("PC", point, X1, V1, ring, X2, V2, [s], -1.0)
+        np.testing.assert_allclose(minus.n, -n, atol=1e-12)
+        assert minus.gap == pytest.approx(-dist - r_pt, abs=1e-12)
+        assert plus.gap == pytest.approx(dist - r_pt, abs=1e-12)
+        assert minus.udot[0] == pytest.approx(plus.udot[0], abs=1e-12)
+        assert minus.vn == pytest.approx(-plus.vn, abs=1e-12)
 
 
 def test_scene_corner_pairs_random_poses_raise_only_typed_errors():

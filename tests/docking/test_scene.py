@@ -5,8 +5,9 @@ import math
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq, minimize
+from scipy.optimize import brentq
 
+from closest_reference import brute_force_closest, random_starts, scipy_closest
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.docking.geometry.rotations import rot_x, rot_z
@@ -14,34 +15,6 @@ from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.model.plant import PlantSpec, add_docking_plant, set_initial_state
 from drake_dock.docking.placement.place import place
 from pydrake.systems.framework import DiagramBuilder
-
-
-def _scipy_closest(P1, P2, starts):
-    """Closest couple by bounded L-BFGS from many starts (an independent reference)."""
-    lo = np.concatenate([P1.patch.lower, P2.patch.lower])
-    hi = np.concatenate([P1.patch.upper, P2.patch.upper])
-    n1 = P1.patch.dim
-
-    def f(u):
-        d = P1.position(u[:n1]) - P2.position(u[n1:])
-        J = np.concatenate([P1.first(u[:n1]), -P2.first(u[n1:])], axis=1)
-        return 0.5 * d @ d, J.T @ d
-
-    best = None
-    for u0 in starts:
-        r = minimize(f, u0, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi)),
-                     options={"ftol": 1e-30, "gtol": 1e-16, "maxiter": 2000})
-        if best is None or r.fun < best.fun:
-            best = r
-    u = best.x
-    return u[:n1], u[n1:], P1.position(u[:n1]) - P2.position(u[n1:])
-
-
-def _starts(P1, P2, n=5, seed=0):
-    rng = np.random.default_rng(seed)
-    lo = np.concatenate([P1.patch.lower, P2.patch.lower])
-    hi = np.concatenate([P1.patch.upper, P2.patch.upper])
-    return [lo + (hi - lo) * rng.random(lo.size) for _ in range(n)]
 
 
 @pytest.fixture(scope="module")
@@ -77,17 +50,17 @@ def test_first_contact_after_declared_travel(paper_scenario, paper_setup):
     roots, points = [], []
     for name in state.closing_pairs:
         P1, P2 = placed(pairs[name], 0.0)
-        _, _, d0 = _scipy_closest(P1, P2, _starts(P1, P2))
+        _, _, d0 = scipy_closest(P1, P2, random_starts(P1, P2))
         ref = d0 / np.linalg.norm(d0)
 
         def gap(s):
             Q1, Q2 = placed(pairs[name], s)
-            _, _, d = _scipy_closest(Q1, Q2, _starts(Q1, Q2))
+            _, _, d = scipy_closest(Q1, Q2, random_starts(Q1, Q2))
             return np.linalg.norm(d) * (1 if d @ ref >= 0 else -1)
 
         roots.append(brentq(gap, 0.5 * travel, 1.5 * travel, xtol=1e-10))
         Q1, Q2 = placed(pairs[name], travel)
-        u1, _, _ = _scipy_closest(Q1, Q2, _starts(Q1, Q2))
+        u1, _, _ = scipy_closest(Q1, Q2, random_starts(Q1, Q2))
         points.append(Q1.position(u1))
     np.testing.assert_allclose(roots, travel, atol=1e-6)
     # The three couples are images of each other under turns of 120 deg about the axis
@@ -101,7 +74,7 @@ def test_first_contact_after_declared_travel(paper_scenario, paper_setup):
     # No pair of the 12 is closed before: at s = travel - 1e-6 every interior distance > 0.
     for name, pair in pairs.items():
         P1, P2 = placed(pair, travel - 1e-6)
-        _, _, d = _scipy_closest(P1, P2, _starts(P1, P2, n=8))
+        _, _, d = scipy_closest(P1, P2, random_starts(P1, P2, n=8))
         assert np.linalg.norm(d) > 0.0, name
 
 
@@ -123,21 +96,8 @@ def test_seeking_matches_scipy_on_random_poses(geom, seed):
     for pair in pairs:
         P1, P2 = posed(pair.patch1, *poses[pair.body1]), posed(pair.patch2, *poses[pair.body2])
         cp = seek_couple(P1, P2)
-        _, _, d = _scipy_closest(P1, P2, _starts(P1, P2, n=12, seed=seed) + [cp.u])
+        _, _, d = scipy_closest(P1, P2, random_starts(P1, P2, n=12, seed=seed) + [cp.u])
         assert cp.distance <= np.linalg.norm(d) + 1e-9, pair.name
-
-
-def _brute_force_closest(P1, P2, n_curve=400, n_surf=90):
-    """Dense sampling of both patches, then scipy L-BFGS from the 4 best samples: a reference
-    that shares nothing with the hierarchical grid + Newton."""
-    def samples(P):
-        return P.patch.grid(n_curve if P.patch.dim == 1 else n_surf)
-    U1, U2 = samples(P1), samples(P2)
-    X1, X2 = P1.position(U1), P2.position(U2)
-    d2 = (X1 ** 2).sum(1)[:, None] + (X2 ** 2).sum(1)[None, :] - 2 * X1 @ X2.T
-    best = np.argsort(d2, axis=None)[:4]
-    starts = [np.concatenate([U1[i], U2[j]]) for i, j in zip(*np.unravel_index(best, d2.shape))]
-    return _scipy_closest(P1, P2, starts)
 
 
 @pytest.mark.parametrize("seed", range(4))
@@ -151,7 +111,7 @@ def test_seeking_matches_brute_force_on_random_poses(geom, seed):
     for pair in DockingScene(geom, "paper").pairs:
         P1, P2 = posed(pair.patch1, *poses[pair.body1]), posed(pair.patch2, *poses[pair.body2])
         cp = seek_couple(P1, P2)
-        _, _, d = _brute_force_closest(P1, P2)
+        _, _, d = brute_force_closest(P1, P2)
         assert abs(cp.distance - np.linalg.norm(d)) < 1e-9, pair.name
 
 
@@ -165,7 +125,7 @@ def test_seeking_matches_brute_force_points(geom, kind):
         P1, P2 = posed(c1, *m1.pose(t)), posed(c2, *m2.pose(t))
         cp = seek_couple(P1, P2)
         assert cp.interior and cp.distance > 1e-3
-        u1, u2, _ = _brute_force_closest(P1, P2)
+        u1, u2, _ = brute_force_closest(P1, P2)
         np.testing.assert_allclose(cp.p1, P1.position(u1), atol=1e-9)
         np.testing.assert_allclose(cp.p2, P2.position(u2), atol=1e-9)
 
@@ -183,7 +143,7 @@ def test_far_pair_distance_mode_matches_brute_force(geom, seed):
     for pair in DockingScene(geom, "paper").pairs:
         P1, P2 = posed(pair.patch1, *poses[pair.body1]), posed(pair.patch2, *poses[pair.body2])
         cp = seek_couple(P1, P2, distance_rtol=1e-7, rtol_beyond=beyond)
-        d = np.linalg.norm(_brute_force_closest(P1, P2)[2])
+        d = np.linalg.norm(brute_force_closest(P1, P2)[2])
         assert cp.distance >= d - 1e-9, pair.name
         assert cp.distance <= d * (1 + 1e-4) + 1e-9, pair.name
         if d < beyond:

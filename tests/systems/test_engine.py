@@ -15,7 +15,7 @@ from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorC
 
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import couples as K
-from drake_dock.core.kernels.tracked import CoupleRow
+from drake_dock.core.kernels.couple_row import CoupleRow
 from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
 from drake_dock.docking.model.plant import StewartDamperPower, stewart_potential
 from drake_dock.studies.small_scenes import disk_on_incline, rod_on_edge, stool

@@ -7,10 +7,11 @@ of sliding in `slide_start`). `compile_cache` keys the compiled code's cache per
 chooses its directory (importing this package applies it before any kernel is defined);
 `prepare` compiles the kernels before a run needs them, in parallel, with a line per module.
 
-The pure-Python modules (`drake_dock.core.patches`, `drake_dock.core.couple`,
-`drake_dock.core.seeking`, `drake_dock.core.constraints`) stay the reference the kernels are
-tested against (tests/core/test_kernels.py, tests/core/test_kernels_seek.py,
-tests/core/test_kernels_constraints.py) and the path for patches that no kernel describes."""
+`drake_dock.core.couple` is the couple kernels' Python interface (it packs a pair's patches
+and poses and raises the typed errors); the pure-Python modules `drake_dock.core.seeking` and
+`drake_dock.core.constraints` stay the reference the compiled seek and constraints are tested
+against (tests/core/test_kernels_seek.py, tests/core/test_kernels_constraints.py).
+``NUMBA_DISABLE_JIT=1`` runs the kernels as Python, for debugging."""
 from drake_dock.core.kernels import compile_cache
 
 compile_cache.configure()

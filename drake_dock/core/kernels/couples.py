@@ -1,17 +1,14 @@
-"""Every tracked couple of a contact system in one compiled call (Sect. 7 of the paper).
+"""The kinematics of one couple of two moving patches (Sect. 5 and 7 of the paper), compiled,
+by pair kind: curve-curve ("CC") and curve-surface ("CS", `evaluate_one`), point-curve ("PC",
+`evaluate_pc_one`) and point-surface ("PS", `evaluate_ps_one`), the model of each in
+`drake_dock.core.couple`. Each evaluates the closest-point conditions in contact form (Eq. 37-38),
+one Newton projection of the integrated couple, Eq. (47) for u*', the contact frame
+(Definition 2), the gap, the relative velocity (Eq. 23-25) and the velocity-product terms of
+Eq. (52) into one row, its fields at the offsets below (`ROW`). `conditions` gives F, its
+Jacobian Fu (Eq. 40) and their conditioning at a couple without projecting it.
 
-`evaluate_couples` is `drake_dock.core.couple.evaluate_couple` for a whole set of pairs over
-plain arrays: per pair, the closest-point conditions in contact form (Eq. 37-38), one Newton
-projection of the integrated couple, Eq. (47) for u*', the contact frame (Definition 2), the
-gap, the relative velocity (Eq. 23-25) and the velocity-product terms of Eq. (52). The
-operations are those of `evaluate_couple`, in the same order, except for the conditioning's row
-norms (a plain square root of the sum of squares instead of `math.hypot`, which only moves the
-conditioning, a threshold test, in its last bits).
-
-Patch 1 of every pair is a curve; patch 2 a curve (CC) or a surface (CS). The point-curve
-couples (kind "PC", a point against a curve) have their own loop, `evaluate_point_curves`. The output has one
-row per pair, its fields at the offsets below (`ROW`); the rows of pairs not asked for are
-left zero.
+The patches are kernel descriptions (`drake_dock.core.kernels.jets`), a point by its frame's
+coordinates and radius; the frames' rotations are arrays, points and twists 3-tuples.
 """
 from __future__ import annotations
 
@@ -30,6 +27,8 @@ from drake_dock.core.kernels.jets import jet
 U, DRIFT, UDOT, RESIDUAL, COND, P1, P2, N, TA, TB, GAP, VREL, VN, VT, BIAS_N, BIAS_T, \
     DRIFT_REL, RATE = 0, 3, 6, 9, 10, 11, 14, 17, 20, 23, 26, 27, 30, 31, 33, 34, 36, 37
 ROW = 40
+# Pair kinds.
+CC, CS, PC, PS = 0, 1, 2, 3
 _Z = (0.0, 0.0, 0.0)
 
 
@@ -74,7 +73,8 @@ def _det(n, A0, A1, A2):
 
 @njit(cache=True)
 def _solve(n, A0, A1, A2, b):
-    """A x = b by Cramer's rule, n = 2 or 3 (`drake_dock.core.couple._solve`)."""
+    """A x = b by Cramer's rule, n = 2 or 3 (the callers have checked the conditioning of A,
+    `_conditioning`: no pivoting is needed at these sizes)."""
     if n == 2:
         a, c = A0[0], A0[1]
         d, e = A1[0], A1[1]
@@ -120,7 +120,11 @@ def _put(out, at, a):
 @njit(cache=True)
 def evaluate_one(cc, kind1, prm1, kind2, prm2, R1, o1, w1, v1, R2, o2, w2, v2, u_state,
                  sigma, project, out):
-    """One couple (`evaluate_couple`) into the row ``out``."""
+    """One curve-curve (``cc``) or curve-surface couple at ``u_state`` (u1, u2[, u2b]) into
+    the row ``out``: patch 1 the curve (kind1, prm1) of the frame (R1, o1) with twist
+    (w1, v1), patch 2 (kind2, prm2) of (R2, o2), (w2, v2); sigma = +-1 orients n
+    (Definition 2). With ``project`` one Newton step on F(u) = 0 (Eq. 37-38) corrects the
+    couple first; a correction below 1e-9 of u moves the points along their tangents."""
     n = 2 if cc else 3
     u = (u_state[0], u_state[1], u_state[2] if n == 3 else 0.0)
     r1, T1, _, K1, _, _ = _geometry(kind1, prm1, R1, u[0], 0.0)
@@ -204,41 +208,13 @@ def evaluate_one(cc, kind1, prm1, kind2, prm2, R1, o1, w1, v1, R2, o2, w2, v2, u
 
 
 @njit(cache=True)
-def evaluate_couples(cc, kind1, prm1, kind2, prm2, fidx, uoff, spans, R, o, w, v, u, sigma,
-                     active, project, drift_feedback, out, rate):
-    """Pairs i with ``active[i]``: their couples u[uoff[i]:uoff[i + 1]] evaluated into
-    ``out[i]`` (see the module docstring), with the frames' world rotations R (F, 3, 3),
-    origins o (F, 3) and twists w, v (F, 3); pair i's bodies are frames fidx[i]. Also the
-    largest drift relative to the domain spans (pair i's spans[i]), and the integrated rate,
-    also into ``rate`` (the layout of u)."""
-    for i in range(len(cc)):
-        if not active[i]:
-            continue
-        a, b = fidx[i, 0], fidx[i, 1]
-        ui = u[uoff[i]:uoff[i + 1]]
-        us = (ui[0], ui[1], ui[2] if len(ui) == 3 else 0.0)
-        row = out[i]
-        evaluate_one(cc[i], kind1[i], prm1[i], kind2[i], prm2[i],
-                     R[a], (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]),
-                     (v[a, 0], v[a, 1], v[a, 2]),
-                     R[b], (o[b, 0], o[b, 1], o[b, 2]), (w[b, 0], w[b, 1], w[b, 2]),
-                     (v[b, 0], v[b, 1], v[b, 2]), us, sigma[i], project, row)
-        m = len(ui)
-        rel = 0.0
-        for j in range(m):
-            rel = max(rel, abs(row[DRIFT + j]) / spans[i, j])
-            row[RATE + j] = row[UDOT + j] + drift_feedback * row[DRIFT + j]
-            rate[uoff[i] + j] = row[RATE + j]
-        row[DRIFT_REL] = rel
-
-
-@njit(cache=True)
 def evaluate_pc_one(kind2, prm2, p, radius, R1, o1, w1, v1, R2, o2, w2, v2, s, sigma,
                     project, out):
-    """One point-curve couple (kind "PC", `drake_dock.core.couple._evaluate_point_curve`):
-    the point p (its frame's coordinates; a sphere of ``radius``) against the curve
-    (kind2, prm2), u = (s,), into the row ``out``. A point on the curve (|d| = 0, no normal)
-    leaves the gap NaN for the caller to report."""
+    """One point-curve couple (kind "PC"): the point p (its frame's coordinates; a sphere of
+    ``radius``) against the curve (kind2, prm2), u = (s,), into the row ``out``. F = t2 . d,
+    Fu = k2 . d - t2 . t2; s' = -Ft / Fu (Eq. 47); the frame from d' = v_rel - t2 s' and
+    t2' = w2 x t2 + k2 s' (`frame_rates_pc`). A point on the curve (|d| = 0, no normal) leaves
+    the gap NaN for the caller to report."""
     r1 = _rot(R1, p)
     x1 = _add(r1, o1)
     r2, T2, _, K2, _, _ = _geometry(kind2, prm2, R2, s, 0.0)
@@ -294,34 +270,13 @@ def evaluate_pc_one(kind2, prm2, p, radius, R1, o1, w1, v1, R2, o2, w2, v2, s, s
 
 
 @njit(cache=True)
-def evaluate_point_curves(pc, kind2, prm1, prm2, fidx, uoff, spans, R, o, w, v, u, sigma,
-                          active, project, drift_feedback, out, rate):
-    """`evaluate_couples` for the point-curve pairs i listed in ``pc`` that are ``active``:
-    prm1[i] holds the point (3) and its radius."""
-    for i in pc:
-        if not active[i]:
-            continue
-        a, b = fidx[i, 0], fidx[i, 1]
-        row = out[i]
-        evaluate_pc_one(kind2[i], prm2[i], (prm1[i, 0], prm1[i, 1], prm1[i, 2]), prm1[i, 3],
-                        R[a], (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]),
-                        (v[a, 0], v[a, 1], v[a, 2]),
-                        R[b], (o[b, 0], o[b, 1], o[b, 2]), (w[b, 0], w[b, 1], w[b, 2]),
-                        (v[b, 0], v[b, 1], v[b, 2]), u[uoff[i]], sigma[i], project, row)
-        row[DRIFT_REL] = abs(row[DRIFT]) / spans[i, 0]
-        row[RATE] = row[UDOT] + drift_feedback * row[DRIFT]
-        rate[uoff[i]] = row[RATE]
-
-
-@njit(cache=True)
 def evaluate_ps_one(kind2, prm2, p, radius, R1, o1, w1, v1, R2, o2, w2, v2, u_state, sigma,
                     project, out):
-    """One point-surface couple (kind "PS", `drake_dock.core.couple._evaluate_point_surface`):
-    the point p (its frame's coordinates; a sphere of ``radius``) against the surface
-    (kind2, prm2), u = (u, v), into the row ``out`` (its u, drift and udot in the row's first
-    two places of each). F = [s_u . d, s_v . d] (Eq. 38 without its tangency row); the frame as
-    for C-S with no curve on Body 1; the contact point is the sphere's point towards the
-    surface, q = -radius n from its centre."""
+    """One point-surface couple (kind "PS"): the point p (its frame's coordinates; a sphere of
+    ``radius``) against the surface (kind2, prm2), u = (u, v), into the row ``out`` (its u,
+    drift and udot in the row's first two places of each). F = [s_u . d, s_v . d] (Eq. 38
+    without its tangency row); the frame as for C-S with no curve on Body 1; the contact point
+    is the sphere's point towards the surface, q = -radius n from its centre."""
     r1 = _rot(R1, p)
     x1 = _add(r1, o1)
     a0, a1 = u_state[0], u_state[1]
@@ -385,14 +340,52 @@ def evaluate_ps_one(kind2, prm2, p, radius, R1, o1, w1, v1, R2, o2, w2, v2, u_st
 
 @njit(cache=True)
 def _ps_conditioning(A0, A1, su, sv):
-    """`drake_dock.core.couple._conditioning` of a point-surface Fu: its columns scaled by
-    |s_u|, |s_v|, |det| over the product of the row norms."""
+    """`_conditioning` of a point-surface Fu: its columns scaled by |s_u|, |s_v|, |det| over
+    the product of the row norms."""
     c0, c1 = math.sqrt(_dot(su, su)), math.sqrt(_dot(sv, sv))
     if min(c0, c1) > 0.0:
         A0 = (A0[0] / c0, A0[1] / c1, 0.0)
         A1 = (A1[0] / c0, A1[1] / c1, 0.0)
     den = math.hypot(A0[0], A0[1]) * math.hypot(A1[0], A1[1])
     return abs(A0[0] * A1[1] - A0[1] * A1[0]) / den if den > 0 else 0.0
+
+
+@njit(cache=True)
+def conditions(pair, kind1, prm1, kind2, prm2, p, R1, o1, R2, o2, u_state, out):
+    """The contact form's F (Eq. 37-38) into out[0:3], its Jacobian Fu = dF/du (Eq. 40) by
+    rows into out[3:12] and its conditioning into out[12], at the couple ``u_state`` (a
+    3-tuple, zero-padded) of a pair of kind ``pair`` (`CC` ... `PS`), unprojected: patch 1 the
+    curve (kind1, prm1) of the frame (R1, o1), or for PC and PS the point p (its frame's
+    coordinates); patch 2 (kind2, prm2) of (R2, o2). Entries beyond the couple's dimension are
+    zero. The conditioning is the one the evaluations test (`_conditioning`; PC: |Fu| /
+    (t2 . t2 + |k2| |d|), 0 with the point on a circle's axis)."""
+    out[:13] = 0.0
+    if pair == PC or pair == PS:
+        x1 = _add(_rot(R1, p), o1)
+        r2, su, sv, suu, suv, svv = _geometry(kind2, prm2, R2, u_state[0], u_state[1])
+        d = _sub(x1, _add(r2, o2))
+        if pair == PC:
+            out[0], out[3] = _dot(su, d), _dot(suu, d) - _dot(su, su)
+            den = _dot(su, su) + math.sqrt(_dot(suu, suu) * _dot(d, d))
+            out[12] = abs(out[3]) / den if den > 0 else 0.0
+            return
+        susv = _dot(su, sv)
+        A0 = (_dot(suu, d) - _dot(su, su), _dot(suv, d) - susv, 0.0)
+        A1 = (_dot(suv, d) - susv, _dot(svv, d) - _dot(sv, sv), 0.0)
+        out[0], out[1] = _dot(su, d), _dot(sv, d)
+        out[3], out[4], out[6], out[7] = A0[0], A0[1], A1[0], A1[1]
+        out[12] = _ps_conditioning(A0, A1, su, sv)
+        return
+    cc = pair == CC
+    n = 2 if cc else 3
+    r1, T1, _, K1, _, _ = _geometry(kind1, prm1, R1, u_state[0], 0.0)
+    r2, T2, T2b, K2, K2ab, K2bb = _geometry(kind2, prm2, R2, u_state[1],
+                                            u_state[2] if n == 3 else 0.0)
+    d = _sub(_add(r1, o1), _add(r2, o2))
+    F, A0, A1, A2 = _residual(cc, d, T1, K1, T2, T2b, K2, K2ab, K2bb)
+    for c in range(n):
+        out[c], out[3 + c], out[6 + c], out[9 + c] = F[c], A0[c], A1[c], A2[c]
+    out[12] = _conditioning(n, A0, A1, A2, T1, T2, T2b)
 
 
 def warm():
@@ -418,3 +411,6 @@ def warm():
                     project, out[2])
     evaluate_ps_one(kp, pplane, (0.1, 0.2, 0.3), 0.01, R[0], z, z, z, R[1], z, z, z,
                     (0.5, 0.5), 1.0, project, out[2])
+    for pair, (ka, pa), (kb, pb) in ((CC, (k1, p1), (k2, p2)), (CS, (kc, pcirc), (kp, pplane)),
+                                     (PC, (0, p1), (kc, pcirc)), (PS, (0, p1), (kp, pplane))):
+        conditions(pair, ka, pa, kb, pb, z, R[0], z, R[1], z, (0.5, 0.5, 0.5), out[0])

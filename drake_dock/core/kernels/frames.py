@@ -1,7 +1,6 @@
-"""The contact frame and its rates along a couple (Definition 2; the Eq. 52 bias terms), in
-compiled code shared by the compiled couple kernel (`couples.py`) and the Python couple
-evaluation (`drake_dock.core.couple`): one implementation of the frame, whichever path computed
-the couple. 3-vectors are tuples of floats."""
+"""The contact frame and its rates along a couple (Definition 2; the Eq. 52 bias terms) for the
+couple kernels (`couples`), and the 3-vector arithmetic they share; 3-vectors are tuples of
+floats."""
 from __future__ import annotations
 
 import math

@@ -1,22 +1,25 @@
 """Patch jets (r, T, K) of Definition 1 by kind code and parameter array, compiled.
 
 A patch is described to the kernels by an integer kind and a float64 parameter array
-(`patch_spec`); `jet` evaluates it at one parameter point with the same floating-point
-operations, in the same order, as the patch's own `jet` (drake_dock.core.patches), so that
-both give the same bits. The kinds:
+(`patch_spec`); `jet` evaluates it at one parameter point with the floating-point operations,
+in their order, of the patch's own `jet` (drake_dock.core.patches). The kinds:
 
 - CIRCLE  [radius, height]: `Circle`.
 - SEGMENT [a (3), b (3)]: `Segment`.
 - PLANE   [o (3), e0 (3), e1 (3)]: `PlaneRect`.
 - CONE    [R0, cot alpha]: `Cone`.
-- SINE_POLAR [A, sigma, phi, tan alpha1, R, alpha2]: a `PolarCurve` in the sine form of Eq. (14),
-  rho = A / sin(alpha2 + sigma (theta - phi)), z = (R - rho) tan alpha1 (a guide side).
+- SINE_POLAR [A, sigma, phi, tan alpha1, R, alpha2, w_lo, w_hi]: a `PolarCurve` in the sine
+  form of Eq. (14), rho = A / sin(w), w = alpha2 + sigma (theta - phi), z = (R - rho) tan alpha1
+  (a guide side); beyond its reach w_lo <= w <= w_hi (w modulo 2 pi) rho is held.
 - ANNULUS [height]: `Annulus`, u = (rho, theta). An `Arc` is a CIRCLE (its domain is the
   patch's, not the kernel's).
-- PETAL [R0, cot alpha, phi0, cot alpha1, A, alpha2, R, w0]: a `Cone` reparametrized across
-  the petal between two guide sides, theta = phi0 + theta_1(z) + s (w0 - 2 theta_1(z)) with
-  theta_1 of Eq. (13) and w0 the petal's angle at its root (pi/3 in the paper; a guide
-  surface).
+- PETAL [R0, cot alpha, phi0, cot alpha1, A, alpha2, R, w0, z_lo, z_hi]: a `Cone`
+  reparametrized across the petal between two guide sides, theta = phi0 + theta_1(z) +
+  s (w0 - 2 theta_1(z)) with theta_1 of Eq. (13) and w0 the petal's angle at its root (pi/3 in
+  the paper; a guide surface); beyond its reach z_lo <= z <= z_hi theta_1 is held.
+
+The holds continue a guide side and a guide surface beyond their domains so that every
+evaluation is finite (docs/model.md, "Patches beyond their domains").
 
 Each jet is returned as six 3-tuples (r, T0, T1, K00, K01, K11); a curve's T1, K01, K11 are
 zero. `position` is r alone, with the same operations as `jet` (the same bits) and none of the
@@ -33,7 +36,7 @@ from drake_dock.core.patches import Annulus, Circle, Cone, PlaneRect, PolarCurve
     Reparametrized, Segment
 
 CIRCLE, SEGMENT, PLANE, CONE, SINE_POLAR, PETAL, ANNULUS = range(7)
-N_PARAMS = 9
+N_PARAMS = 10
 _Z = (0.0, 0.0, 0.0)
 
 
@@ -78,16 +81,27 @@ def _cone(R0, cot, th, z):
 
 
 @njit(cache=True)
+def _petal_z(prm, z):
+    """(z held in a PETAL's reach [z_lo, z_hi], whether z lies in it)."""
+    inside = prm[8] <= z <= prm[9]
+    return (z if inside else min(max(z, prm[8]), prm[9])), inside
+
+
+@njit(cache=True)
 def _petal(prm, a, z):
-    """`_PetalMap.jet` composed with the cone's jet by `Reparametrized.jet`'s chain rule."""
+    """`_PetalMap.jet` composed with the cone's jet by `Reparametrized.jet`'s chain rule;
+    theta_1 held beyond the reach (its derivatives zero there)."""
     cot, phi0, A, alpha2, R = prm[3], prm[2], prm[4], prm[5], prm[6]
-    rho = R - z * cot
+    zh, inside = _petal_z(prm, z)
+    rho = R - zh * cot
     x = A / rho
     x1 = x * cot / rho
     x2 = 2.0 * x * math.pow(cot, 2.0) / math.pow(rho, 2.0)
     q = math.sqrt(1.0 - x * x)
     t1 = math.asin(x) - alpha2
-    d1, d2 = x1 / q, x2 / q + x * math.pow(x1, 2.0) / math.pow(q, 3.0)
+    d1, d2 = 0.0, 0.0
+    if inside:
+        d1, d2 = x1 / q, x2 / q + x * math.pow(x1, 2.0) / math.pow(q, 3.0)
     w = prm[7] - 2 * t1
     j00, j01, j10, j11 = w, d1 * (1 - 2 * a), 0.0, 1.0
     h001 = -2 * d1
@@ -110,6 +124,22 @@ def _second(B0, B1, B00, B01, B11, ua0, ua1, ub0, ub1, h0, h1):
 
 
 @njit(cache=True)
+def _sine_angle(prm, u0):
+    """A SINE_POLAR's angle w = alpha2 + sigma (theta - phi) and whether rho is held: w taken
+    modulo 2 pi (into [w_0, w_0 + 2 pi), w_0 = (w_lo + w_hi) / 2 - pi) when it lies outside
+    the reach [w_lo, w_hi], and held at the reach's nearer end beyond it."""
+    w = prm[5] + prm[1] * (u0 - prm[2])
+    lo, hi = prm[6], prm[7]
+    if lo <= w <= hi:
+        return w, False
+    w0 = 0.5 * (lo + hi) - math.pi
+    w = w0 + (w - w0) % (2.0 * math.pi)
+    if lo <= w <= hi:
+        return w, False
+    return min(max(w, lo), hi), True
+
+
+@njit(cache=True)
 def jet(kind, prm, u0, u1):
     """(r, T0, T1, K00, K01, K11) of the patch (kind, prm) at u = (u0[, u1])."""
     if kind == CIRCLE:
@@ -128,12 +158,14 @@ def jet(kind, prm, u0, u1):
     if kind == CONE:
         return _cone(prm[0], prm[1], u0, u1)
     if kind == SINE_POLAR:
-        A, sigma, phi, tan1, R, alpha2 = prm[0], prm[1], prm[2], prm[3], prm[4], prm[5]
-        w = alpha2 + sigma * (u0 - phi)
+        A, sigma, tan1, R = prm[0], prm[1], prm[3], prm[4]
+        w, held = _sine_angle(prm, u0)
         sw, cw = math.sin(w), math.cos(w)
         rho = A / sw
-        r1 = -sigma * A * cw / math.pow(sw, 2.0)
-        r2 = A * (1.0 + math.pow(cw, 2.0)) / math.pow(sw, 3.0)
+        r1, r2 = 0.0, 0.0
+        if not held:
+            r1 = -sigma * A * cw / math.pow(sw, 2.0)
+            r2 = A * (1.0 + math.pow(cw, 2.0)) / math.pow(sw, 3.0)
         return _polar(rho, r1, r2, (R - rho) * tan1, -r1 * tan1, -r2 * tan1, u0)
     if kind == ANNULUS:
         c, s = math.cos(u1), math.sin(u1)
@@ -158,7 +190,7 @@ def position(kind, prm, u0, u1):
         rho = prm[0] - u1 * prm[1]
         return rho * math.cos(u0), rho * math.sin(u0), u1
     if kind == SINE_POLAR:
-        rho = prm[0] / math.sin(prm[5] + prm[1] * (u0 - prm[2]))
+        rho = prm[0] / math.sin(_sine_angle(prm, u0)[0])
         return rho * math.cos(u0), rho * math.sin(u0), (prm[4] - rho) * prm[3]
     if kind == ANNULUS:
         return u0 * math.cos(u1), u0 * math.sin(u1), prm[0]
@@ -169,7 +201,7 @@ def position(kind, prm, u0, u1):
 def petal_row(prm, z):
     """What a PETAL's point at zeta = z shares with the others at that z (`_petal`): theta_1
     (Eq. 13), the petal's angle w0 - 2 theta_1 and the cone's radius (Eq. 12)."""
-    t1 = math.asin(prm[4] / (prm[6] - z * prm[3])) - prm[5]
+    t1 = math.asin(prm[4] / (prm[6] - _petal_z(prm, z)[0] * prm[3])) - prm[5]
     return t1, prm[7] - 2 * t1, prm[0] - z * prm[1]
 
 

@@ -12,8 +12,8 @@ from numba import njit
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.records import f1, f2, f3, i1, i2
 
-# Pair kinds.
-CC, CS, PC, PS = 0, 1, 2, 3
+# Pair kinds (`couples`).
+CC, CS, PC, PS = K.CC, K.CS, K.PC, K.PS
 KIND_CODE = {"CC": CC, "CS": CS, "PC": PC, "PS": PS}
 # Modes (`drake_dock.core.hybrid.Mode`).
 FAR, TRACKED, SLIDING, STICKING = 0, 1, 2, 3

@@ -1,10 +1,19 @@
-"""The seek of Sect. 5.1 compiled: the hierarchical grid and the bounded Newton finish of
-`drake_dock.core.seeking` (`hierarchical_seek`, `newton_closest`, `seek_couple`) over the
-kernels' patch descriptions (`jets.patch_spec`), with the same steps and tolerances.
+"""The seek of Sect. 5.1 compiled, over the kernels' patch descriptions (`jets.patch_spec`;
+`drake_dock.core.seeking.seek_couple` packs them and reads the result):
 
-The grid distances are computed as |x1 - x2|^2 directly (the reference expands them), so a grid
-tie may be broken differently; the Newton finish then converges to the same couple (tests
-compare the couples and distances with the reference)."""
+- a curve against a curve or a surface (`seek`): the paper's hierarchical grid (`hierarchical`:
+  a coarse grid over both patches' parameters, then grids an order finer around the best
+  cells), each start finished by a bounded Newton iteration on the closest-point conditions
+  (`newton`: the gradient of 0.5 |r1 - r2|^2 zero, or its projection on the active bounds);
+- a point against a surface (`point_surface`): the nearest point of a grid, then `newton`;
+- a point against a curve (`point_curve`): for a full circle in closed form (the polar angle
+  of the point in the circle's frame; 0 on the axis, where every parameter is closest), else
+  the nearest point of a grid finished by Newton on F = t2 . d (Eq. 37 for a point), clipped
+  to the domain; and the curve's side the point lies on.
+
+docs/model.md, "Degenerate couples", gives the rules for flat valleys, domain ends and
+creeping iterations that `newton` follows.
+"""
 from __future__ import annotations
 
 import math
@@ -12,179 +21,28 @@ import math
 import numpy as np
 from numba import njit
 
-from drake_dock.core.kernels.jets import PETAL, jet, patch_spec, petal_point, petal_row, position
-from drake_dock.core.seeking import CLOSEST_MAX_ITER, CREEP_TOUCH, FLAT, Couple
-from drake_dock.errors import SeekingError
+from drake_dock.core.kernels.grids import POINT, hierarchical, positions, within, world_point
+from drake_dock.core.kernels.jets import CIRCLE, jet, position
 
 EPS8 = 8 * np.finfo(float).eps
-
-
-@njit(cache=True)
-def _point(kind, prm, R, o, u0, u1):
-    r = position(kind, prm, u0, u1)
-    return (R[0, 0] * r[0] + R[0, 1] * r[1] + R[0, 2] * r[2] + o[0],
-            R[1, 0] * r[0] + R[1, 1] * r[1] + R[1, 2] * r[2] + o[1],
-            R[2, 0] * r[0] + R[2, 1] * r[1] + R[2, 2] * r[2] + o[2])
-
-
-@njit(cache=True)
-def _frame(R, o):
-    """R and o as twelve scalars, read once for a grid's loop."""
-    return (R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2], R[2, 0], R[2, 1], R[2, 2],
-            o[0], o[1], o[2])
-
-
-@njit(cache=True)
-def _place(F, r, X, a):
-    """X[a] = R r + o (Eq. 20) for the `_frame` F, as `_point` computes it."""
-    X[a, 0] = F[0] * r[0] + F[1] * r[1] + F[2] * r[2] + F[9]
-    X[a, 1] = F[3] * r[0] + F[4] * r[1] + F[5] * r[2] + F[10]
-    X[a, 2] = F[6] * r[0] + F[7] * r[1] + F[8] * r[2] + F[11]
-
-
-@njit(cache=True)
-def _positions(kind, prm, R, o, U):
-    """The points R r(u) + o (Eq. 20) at the rows u of U."""
-    X = np.empty((U.shape[0], 3))
-    F = _frame(R, o)
-    two = U.shape[1] == 2
-    for a in range(U.shape[0]):
-        _place(F, position(kind, prm, U[a, 0], U[a, 1] if two else 0.0), X, a)
-    return X
-
-
-@njit(cache=True)
-def _d2(X1, X2):
-    D = np.empty((X1.shape[0], X2.shape[0]))
-    for i in range(X1.shape[0]):
-        for j in range(X2.shape[0]):
-            a, b, c = X1[i, 0] - X2[j, 0], X1[i, 1] - X2[j, 1], X1[i, 2] - X2[j, 2]
-            D[i, j] = a * a + b * b + c * c
-    return D
-
-
-@njit(cache=True)
-def _argmin_d2(X1, X2):
-    """(i, j) of np.argmin(_d2(X1, X2)) without the matrix: the first least entry, or the
-    first NaN."""
-    best, bi, bj = np.inf, 0, 0
-    for i in range(X1.shape[0]):
-        for j in range(X2.shape[0]):
-            a, b, c = X1[i, 0] - X2[j, 0], X1[i, 1] - X2[j, 1], X1[i, 2] - X2[j, 2]
-            d = a * a + b * b + c * c
-            if d < best:
-                best, bi, bj = d, i, j
-            elif d != d:
-                return i, j
-    return bi, bj
-
-
-@njit(cache=True)
-def _local_axes(c, hw, lower, upper, periodic, n):
-    """`seeking._local_grids` for one centre c, as its axes (dim, n): the grid's row a is
-    (A[0, a // n], A[1, a % n]) (or A[0, a] for a curve)."""
-    dim = c.shape[0]
-    lo, hi = c - hw, c + hw
-    for k in range(dim):
-        if not periodic[k]:
-            lo[k], hi[k] = max(lo[k], lower[k]), min(hi[k], upper[k])
-    t = np.linspace(0.0, 1.0, n)
-    A = np.empty((dim, n))
-    for k in range(dim):
-        for j in range(n):
-            A[k, j] = lo[k] + (hi[k] - lo[k]) * t[j]
-            if periodic[k]:
-                span = upper[k] - lower[k]
-                A[k, j] = lower[k] + np.mod(A[k, j] - lower[k], span)
-    return A
-
-
-@njit(cache=True)
-def _axes_point(A, a):
-    """Row a of the grid of the axes A (`_local_axes`)."""
-    n = A.shape[1]
-    if A.shape[0] == 1:
-        return np.array([A[0, a]])
-    return np.array([A[0, a // n], A[1, a % n]])
-
-
-@njit(cache=True)
-def _axes_positions(kind, prm, R, o, A):
-    """`_positions` of the grid of the axes A; a petal's `petal_row` once per zeta."""
-    dim, n = A.shape
-    if kind != PETAL or dim == 1:
-        U = np.empty((n ** dim, dim))
-        for a in range(n ** dim):
-            U[a] = _axes_point(A, a)
-        return _positions(kind, prm, R, o, U)
-    X = np.empty((n * n, 3))
-    F = _frame(R, o)
-    for j in range(n):
-        row = petal_row(prm, A[1, j])
-        for i in range(n):
-            _place(F, petal_point(prm, A[0, i], A[1, j], row), X, i * n + j)
-    return X
-
-
-@njit(cache=True)
-def _within(u, c, w):
-    """All |u - c| <= w."""
-    for k in range(u.shape[0]):
-        if not abs(u[k] - c[k]) <= w[k]:
-            return False
-    return True
-
-
-@njit(cache=True)
-def hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
-                 levels, n_fine, candidates):
-    """`seeking.hierarchical_seek`: up to ``candidates`` start couples (C, dim1 + dim2), best
-    first, from the coarse grids U1, U2."""
-    n_coarse1 = round(U1.shape[0] ** (1.0 / U1.shape[1]))
-    n_coarse2 = round(U2.shape[0] ** (1.0 / U2.shape[1]))
-    h1 = (hi1 - lo1) / (n_coarse1 - 1)
-    h2 = (hi2 - lo2) / (n_coarse2 - 1)
-    d2 = _d2(_positions(k1, p1, R1, o1, U1), _positions(k2, p2, R2, o2, U2))
-    dim1, dim2 = U1.shape[1], U2.shape[1]
-    C1, C2 = np.empty((candidates, dim1)), np.empty((candidates, dim2))
-    C = 0
-    w1, w2 = 2 * h1, 2 * h2            # the candidates' exclusion half-widths
-    for _ in range(candidates):
-        best, bi, bj = np.inf, -1, -1
-        for i in range(d2.shape[0]):
-            for j in range(d2.shape[1]):
-                if d2[i, j] < best:
-                    best, bi, bj = d2[i, j], i, j
-        if bi < 0:
-            break
-        C1[C], C2[C] = U1[bi], U2[bj]
-        C += 1
-        near2 = np.empty(d2.shape[1], dtype=np.bool_)
-        for j in range(d2.shape[1]):
-            near2[j] = _within(U2[j], U2[bj], w2)
-        for i in range(d2.shape[0]):
-            if _within(U1[i], U1[bi], w1):
-                for j in range(d2.shape[1]):
-                    if near2[j]:
-                        d2[i, j] = np.inf
-    g1, g2 = h1, h2
-    for _ in range(levels):
-        for c in range(C):
-            A1 = _local_axes(C1[c].copy(), 2 * g1, lo1, hi1, per1, n_fine)
-            A2 = _local_axes(C2[c].copy(), 2 * g2, lo2, hi2, per2, n_fine)
-            i, j = _argmin_d2(_axes_positions(k1, p1, R1, o1, A1),
-                              _axes_positions(k2, p2, R2, o2, A2))
-            C1[c], C2[c] = _axes_point(A1, i), _axes_point(A2, j)
-        g1, g2 = 4 * g1 / (n_fine - 1), 4 * g2 / (n_fine - 1)
-    out = np.empty((C, dim1 + dim2))
-    out[:, :dim1], out[:, dim1:] = C1[:C], C2[:C]
-    return out
+# Eigenvalues of the descent step's Hessian below FLAT max(1, |w|max) are flat directions.
+FLAT = 1e-10
+# The closest-couple Newton's iteration limit (`newton`). A crossing next to a tangency (a
+# ring's circle cutting a guide surface it nearly osculates, next to the surface's edge) leaves
+# J nearly singular, and the iteration walks the valley for about 90 iterations before it
+# converges quadratically.
+CLOSEST_MAX_ITER = 200
+# m: a Newton finish that creeps this near touching is a touch (`newton`'s status).
+CREEP_TOUCH = 1e-6
 
 
 @njit(cache=True)
 def _descent_step(H, g):
-    """`seeking._descent_step`: -|H|^-1 g, eigenvalues made positive, as (Newton part, flat
-    part)."""
+    """The descent step -|H|^-1 g with the eigenvalues of H made positive, in two parts: along
+    the directions where |w| >= FLAT max(1, |w|max) (the Newton step where H is safely
+    positive definite), and along the flat ones, where -(v . g) / |w| (|w| floored at 1e-16)
+    is far too long and the caller caps it. A Cholesky solve where H is well conditioned
+    (det / tr^(n-1) above FLAT max(1, tr)), the eigen-decomposition otherwise."""
     n = g.shape[0]
     if n == 1:
         return np.array([-g[0] / max(abs(H[0, 0]), FLAT * max(1.0, abs(H[0, 0])))]), np.zeros(1)
@@ -234,46 +92,59 @@ def _descent_step(H, g):
 
 @njit(cache=True)
 def _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, n1):
-    x1 = _point(k1, p1, R1, o1, u[0], 0.0)
-    x2 = _point(k2, p2, R2, o2, u[n1], u[n1 + 1] if u.shape[0] == n1 + 2 else 0.0)
+    """(x1 - x2, x1, x2) at the couple u, patch 1 a curve (n1 = 1) or a `POINT` (n1 = 0)."""
+    x1 = world_point(k1, p1, R1, o1, u[0], 0.0)
+    x2 = world_point(k2, p2, R2, o2, u[n1], u[n1 + 1] if u.shape[0] == n1 + 2 else 0.0)
     return (x1[0] - x2[0], x1[1] - x2[1], x1[2] - x2[2]), x1, x2
 
 
 @njit(cache=True)
 def newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale, tol, max_iter,
            distance_rtol, rtol_beyond):
-    """`seeking.newton_closest` from u (patch 1 a curve): (u, iterations, status), status 0
-    converged, 1 not converged (the reference raises `SeekingError`). ``distance_rtol`` < 0
-    means none."""
-    n1 = 1
+    """Bounded Newton on f(u) = 0.5 |r1(u1) - r2(u2)|^2 from u, patch 1 a curve or a `POINT`:
+    (u, iterations, status), status 0 converged, 1 not converged with the projected gradient
+    above 1e-10 |J| |d| (the caller names the couple). Parameters at a domain end with the
+    gradient pushing outwards are held (an active set with a band, Bertsekas' projected
+    Newton), periodic ones wrapped; the step descends (the Hessian's eigenvalues made
+    positive), runs along a flat direction to a quarter of the domain or the first domain end
+    on its way, and is backtracked on f. With ``distance_rtol`` >= 0 (< 0: none) the iteration
+    also ends when a step shortens the distance by less than that fraction of it, while the
+    distance exceeds ``rtol_beyond``."""
+    n1 = 0 if k1 == POINT else 1
     n = u.shape[0]
+    n2 = n - n1
     u = u.copy()
     gfree = np.zeros(n)
     norm_J = norm_d = 0.0
     it = 0
     converged = False
     for it in range(1, max_iter + 1):
-        j1 = jet(k1, p1, u[0], 0.0)
-        j2 = jet(k2, p2, u[1], u[2] if n == 3 else 0.0)
+        j2 = jet(k2, p2, u[n1], u[n1 + 1] if n2 == 2 else 0.0)
         _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, n1)
         d = np.array([x1[0] - x2[0], x1[1] - x2[1], x1[2] - x2[2]])
+        # J = [T1, -T2] (world tangents); g = J^T d; H = J^T J + diag(d . K1, -d . K2).
         cols = np.empty((n, 3))
-        cols[0] = R1 @ np.array(j1[1])
-        cols[1] = -(R2 @ np.array(j2[1]))
-        if n == 3:
-            cols[2] = -(R2 @ np.array(j2[2]))
+        k1d = 0.0
+        if n1 == 1:
+            j1 = jet(k1, p1, u[0], 0.0)
+            cols[0] = R1 @ np.array(j1[1])
+            k1d = (R1.T @ d) @ np.array(j1[3])
+        cols[n1] = -(R2 @ np.array(j2[1]))
+        if n2 == 2:
+            cols[n1 + 1] = -(R2 @ np.array(j2[2]))
         g = cols @ d
         H = cols @ cols.T
-        d1, d2 = R1.T @ d, R2.T @ d
-        H[0, 0] += d1 @ np.array(j1[3])
+        d2 = R2.T @ d
+        if n1 == 1:
+            H[0, 0] += k1d
         K2 = (np.array(j2[3]), np.array(j2[4]), np.array(j2[5]))
-        if n == 2:
-            H[1, 1] -= d2 @ K2[0]
+        if n2 == 1:
+            H[n1, n1] -= d2 @ K2[0]
         else:
-            H[1, 1] -= d2 @ K2[0]
-            H[1, 2] -= d2 @ K2[1]
-            H[2, 1] -= d2 @ K2[1]
-            H[2, 2] -= d2 @ K2[2]
+            H[n1, n1] -= d2 @ K2[0]
+            H[n1, n1 + 1] -= d2 @ K2[1]
+            H[n1 + 1, n1] -= d2 @ K2[1]
+            H[n1 + 1, n1 + 1] -= d2 @ K2[2]
         norm_J = math.sqrt(np.sum(cols * cols))
         norm_d = math.sqrt(d @ d)
         d_roundoff = EPS8 * (max(abs(x1[0]), max(abs(x1[1]), abs(x1[2])))
@@ -383,7 +254,7 @@ def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
     for c in range(C):
         dup = False
         for s in range(c):
-            dup = dup or (started[s] and _within(starts[c], starts[s], tol))
+            dup = dup or (started[s] and within(starts[c], starts[s], tol))
         if dup:
             continue
         started[c] = True
@@ -395,77 +266,112 @@ def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
         X1[m, 0], X1[m, 1], X1[m, 2] = x1
         X2[m, 0], X2[m, 1], X2[m, 2] = x2
         interior[m] = True
-        for k in range(n):
-            # is_interior: min(u - lower, upper - u) > 1e-9 span unless periodic (NaN: not).
-            inside = u[k] - lower[k] > 1e-9 * span[k] and upper[k] - u[k] > 1e-9 * span[k]
-            if not (periodic[k] or inside):
-                interior[m] = False
+        interior[m] = _interior(u, lower, upper, periodic)
         m += 1
     return U[:m], its[:m], status[:m], X1[:m], X2[:m], interior[:m]
 
 
-def _spec(patch):
-    """(kind, parameters) of a patch, kept on it."""
-    hit = patch.__dict__.get("_kernel_spec")
-    if hit is None:
-        hit = patch.__dict__["_kernel_spec"] = patch_spec(patch)
-    return hit
+@njit(cache=True)
+def _interior(u, lower, upper, periodic):
+    """min(u - lower, upper - u) > 1e-9 span for every bounded parameter (NaN: not)."""
+    for k in range(u.shape[0]):
+        span = upper[k] - lower[k]
+        inside = u[k] - lower[k] > 1e-9 * span and upper[k] - u[k] > 1e-9 * span
+        if not (periodic[k] or inside):
+            return False
+    return True
 
 
-def _domain(patch, n_coarse):
-    """(lower, upper, periodic, coarse grid) of a patch as the kernels take them (writable,
-    C-ordered: one compiled signature), kept on it."""
-    cache = patch.__dict__.setdefault("_kernel_domain", {})
-    hit = cache.get(n_coarse)
-    if hit is None:
-        hit = cache[n_coarse] = (np.array(patch.lower, dtype=float),
-                                 np.array(patch.upper, dtype=float), np.array(patch.periodic),
-                                 np.array(patch.grid_points(n_coarse)[0]))
-    return hit
+@njit(cache=True)
+def point_surface(pt, R1, o1, k2, p2, R2, o2, lo2, hi2, per2, U2, distance_rtol, rtol_beyond):
+    """The couple of the point pt (its frame's coordinates, frame (R1, o1)) and a surface: the
+    nearest point of the grid U2, finished by `newton`. Returns (u (2,), iterations, status,
+    x1, x2 (3,), interior)."""
+    X2 = positions(k2, p2, R2, o2, U2)
+    x = world_point(POINT, pt, R1, o1, 0.0, 0.0)
+    best, a = np.inf, 0
+    for i in range(X2.shape[0]):
+        e0, e1, e2 = X2[i, 0] - x[0], X2[i, 1] - x[1], X2[i, 2] - x[2]
+        dd = e0 * e0 + e1 * e1 + e2 * e2
+        if dd < best:
+            best, a = dd, i
+    scale = np.maximum(hi2 - lo2, 1e-300)
+    u, it, status = newton(POINT, pt, R1, o1, k2, p2, R2, o2, U2[a].copy(), lo2, hi2, per2,
+                           scale, 1e-14, CLOSEST_MAX_ITER, distance_rtol, rtol_beyond)
+    _, x1, x2 = _gap(POINT, pt, R1, o1, k2, p2, R2, o2, u, 0)
+    return (u, it, status, np.array([x1[0], x1[1], x1[2]]), np.array([x2[0], x2[1], x2[2]]),
+            _interior(u, lo2, hi2, per2))
 
 
-def supported(P1, P2) -> bool:
-    """True when the compiled seek applies: patch 1 a curve, both patches with a kernel
-    description."""
-    return P1.patch.dim == 1 and _spec(P1.patch) is not None and _spec(P2.patch) is not None
-
-
-def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, levels=2,
-                n_fine=21, candidates=3) -> Couple:
-    """`drake_dock.core.seeking.seek_couple` compiled, for posed patches P1 (a curve) and P2
-    with kernel descriptions (`supported`): one call of `seek`, then the nearest finished
-    couple."""
-    pa, pb = P1.patch, P2.patch
-    (k1, q1), (k2, q2) = _spec(pa), _spec(pb)
-    # Writable C-ordered copies: one compiled signature whatever the caller's arrays.
-    R1, o1 = np.array(P1.R, dtype=float, order="C"), np.array(P1.p, dtype=float)
-    R2, o2 = np.array(P2.R, dtype=float, order="C"), np.array(P2.p, dtype=float)
-    U, its, status, X1, X2, interior = seek(k1, q1, R1, o1, *_domain(pa, n_coarse), k2, q2, R2, o2,
-                                  *_domain(pb, n_coarse), levels, n_fine, candidates,
-                                  -1.0 if distance_rtol is None else float(distance_rtol),
-                                  float(rtol_beyond))
-    # The nearest couple. A start whose Newton did not converge (it creeps: a nearly flat
-    # valley, e.g. a ring's circle almost parallel to the other ring's face, or a circle that
-    # touches or pierces a face, where the minima form a curve) counts where it is not the
-    # nearest, or where it ended within CREEP_TOUCH of touching (the contact-form finish and
-    # the modes then take it as a touch); else it is an error.
-    best, dist = -1, np.inf
-    for c in range(U.shape[0]):
-        d = float(np.linalg.norm(X1[c] - X2[c]))
-        if d < dist:
-            best, dist = c, d
-    if status[best] and dist > CREEP_TOUCH:
-        raise SeekingError(f"closest-couple Newton did not converge in {CLOSEST_MAX_ITER} "
-                           f"iterations (at distance {dist:.3g} m)")
-    return Couple(U[best, :1], U[best, 1:], X1[best], X2[best], dist, int(its[best]),
-                  bool(interior[best]))
+@njit(cache=True)
+def point_curve(x, k2, p2, R2, o2, lo, hi, periodic, U, max_iter):
+    """The couple of the world point x and a curve (frame (R2, o2)): the s of least
+    |x - c(s)|, for a full circle (a periodic CIRCLE) its polar angle in the curve's frame (0 on
+    the axis), else from the nearest point of the grid U by Newton on F = t2 . d, clipped to the
+    domain, for at most ``max_iter`` steps (stopping where F' >= 0, not a minimum). Returns (s,
+    iterations, x2 (3,), concave): ``concave`` where the point lies on the curve's concave side
+    (d along its curvature direction; true where the curve is straight)."""
+    e = (x[0] - o2[0], x[1] - o2[1], x[2] - o2[2])
+    q = (R2[0, 0] * e[0] + R2[1, 0] * e[1] + R2[2, 0] * e[2],
+         R2[0, 1] * e[0] + R2[1, 1] * e[1] + R2[2, 1] * e[2],
+         R2[0, 2] * e[0] + R2[1, 2] * e[1] + R2[2, 2] * e[2])
+    span = hi[0] - lo[0]
+    it = 0
+    if k2 == CIRCLE and periodic[0]:
+        s = math.atan2(q[1], q[0]) if math.hypot(q[0], q[1]) > 0.0 else 0.0
+    else:
+        best, s = np.inf, U[0, 0]
+        for a in range(U.shape[0]):
+            r = position(k2, p2, U[a, 0], 0.0)
+            dd = (r[0] - q[0]) ** 2 + (r[1] - q[1]) ** 2 + (r[2] - q[2]) ** 2
+            if dd < best:
+                best, s = dd, U[a, 0]
+        for it in range(1, max_iter + 1):
+            r, t, _, k, _, _ = jet(k2, p2, s, 0.0)
+            d = (q[0] - r[0], q[1] - r[1], q[2] - r[2])
+            Fu = (k[0] * d[0] + k[1] * d[1] + k[2] * d[2]) - (t[0] * t[0] + t[1] * t[1]
+                                                                + t[2] * t[2])
+            if not Fu < 0.0:
+                break
+            s_new = s - (t[0] * d[0] + t[1] * d[1] + t[2] * d[2]) / Fu
+            if periodic[0]:
+                s_new = lo[0] + np.mod(s_new - lo[0], span)
+            else:
+                s_new = min(max(s_new, lo[0]), hi[0])
+            done = abs(s_new - s) <= 1e-14 * (1.0 + span)
+            s = s_new
+            if done:
+                break
+    if periodic[0]:
+        s = lo[0] + np.mod(s - lo[0], span)
+    x2 = world_point(k2, p2, R2, o2, s, 0.0)
+    k = jet(k2, p2, s, 0.0)[3]
+    kw = (R2[0, 0] * k[0] + R2[0, 1] * k[1] + R2[0, 2] * k[2],
+          R2[1, 0] * k[0] + R2[1, 1] * k[1] + R2[1, 2] * k[2],
+          R2[2, 0] * k[0] + R2[2, 1] * k[1] + R2[2, 2] * k[2])
+    side = ((x[0] - x2[0]) * kw[0] + (x[1] - x2[1]) * kw[1] + (x[2] - x2[2]) * kw[2])
+    straight = kw[0] * kw[0] + kw[1] * kw[1] + kw[2] * kw[2] == 0.0
+    return s, it, np.array([x2[0], x2[1], x2[2]]), straight or side > 0.0
 
 
 def warm():
-    """Compiles or loads the seek's kernels: a curve against a curve and against a surface."""
-    from drake_dock.core.patches import Circle, PlaneRect, Segment, posed
+    """Compiles or loads the seek's kernels with the argument types of
+    `drake_dock.core.seeking.seek_couple`: a curve against a curve and against a surface, a
+    point against a surface and against a circle and an arc."""
+    from drake_dock.core.patches import Arc, Circle, PlaneRect, Segment
+    from drake_dock.core.kernels.jets import patch_spec
     eye, z = np.eye(3), np.zeros(3)
-    seg = posed(Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1)), eye, z)
-    seek_couple(seg, posed(Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0)), eye, z))
-    seek_couple(posed(Circle(0.3, 0.1), eye, z),
-                posed(PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)), eye, z))
+
+    def domain(patch, n):
+        return (np.array(patch.lower, dtype=float), np.array(patch.upper, dtype=float),
+                np.array(patch.periodic), np.array(patch.grid_points(n)[0]))
+
+    seg = Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1))
+    plane = PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0))
+    for c1, c2 in ((seg, Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0))), (Circle(0.3, 0.1), plane)):
+        seek(*patch_spec(c1), eye, z, *domain(c1, 12), *patch_spec(c2), eye, z, *domain(c2, 12),
+             2, 21, 3, -1.0, 0.0)
+    pt = np.array([0.1, 0.2, 0.3, 0.01, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    point_surface(pt, eye, z, *patch_spec(plane), eye, z, *domain(plane, 16), -1.0, 0.0)
+    for curve in (Circle(0.3), Arc(0.3, 0.0, (0.2, 1.4))):
+        point_curve(z, *patch_spec(curve), eye, z, *domain(curve, 64), 30)

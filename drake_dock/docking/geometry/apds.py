@@ -95,7 +95,7 @@ def guide_side(g: ApdsGeometry, i: int) -> PolarCurve:
         return rad, axial_of(*rad)
 
     return PolarCurve(radial, axial, (phi, phi + sigma * g.theta_end), parts,
-                      kernel_params=(A, sigma, phi, tan1, g.Rp, g.alpha2))
+                      kernel_params=(A, sigma, phi, tan1, g.Rp, g.alpha2, w_lo, w_hi))
 
 
 class _PetalMap:
@@ -109,14 +109,15 @@ class _PetalMap:
         self.upper = np.array([1.0, g.H])
         self.cot1 = 1.0 / math.tan(g.alpha1)
         self.A = g.Rp * math.sin(g.alpha2)
-        # The map's parameters for the compiled kernels (kind PETAL).
-        self.kernel_params = (self.phi0, self.cot1, self.A, g.alpha2, g.Rp, self.width)
         # Eq. (13) holds while x = A / rho < 1, zeta < (R - A) tan(alpha1). Its reach is the
         # domain grown at both ends by half the distance from zeta = H to that limit; beyond
         # it theta_1 is held (docs/model.md, "Degenerate couples"): the surface continues as
         # the cone between two fixed meridians.
         grow = 0.5 * ((g.Rp - self.A) / self.cot1 - g.H)
         self.z_reach = (-grow, g.H + grow)
+        # The map's parameters for the compiled kernels (kind PETAL).
+        self.kernel_params = (self.phi0, self.cot1, self.A, g.alpha2, g.Rp, self.width,
+                              *self.z_reach)
 
     def _t1(self, z):
         lo, hi = self.z_reach

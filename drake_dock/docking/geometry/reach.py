@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 
-from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import posed
+from drake_dock.core.seeking import seek_couple
 from drake_dock.docking.geometry.apds import apds_patches
 from drake_dock.docking.geometry.pairs import (R_MATCHED, PairSpec, side_edge_pairs,
                                                tip_tip_pairs)
@@ -66,8 +66,8 @@ def reach_sweep(g: ApdsGeometry, pairs, n: int, *, seed: int = 12, box=ReachBox(
         R, p, roll = random_pose(rng, box)
         poses = {"chaser_apds": (R, p), "target_apds": (np.eye(3), np.zeros(3))}
         for pr in pairs:
-            c = compiled_seek.seek_couple(posed(pr.patch1, *poses[pr.body1]),
-                                          posed(pr.patch2, *poses[pr.body2]))
+            c = seek_couple(posed(pr.patch1, *poses[pr.body1]),
+                            posed(pr.patch2, *poses[pr.body2]))
             if not c.interior:
                 continue
             row = out[pr.name]

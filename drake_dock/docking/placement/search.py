@@ -15,7 +15,6 @@ from scipy.optimize import brentq
 
 from drake_dock.core import covers
 from drake_dock.core.kernels import cover as compiled_cover
-from drake_dock.core.kernels import seek as compiled_seek
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.docking.geometry.pairs import CHASER_APDS, R_MATCHED, TARGET_APDS, PairSpec
@@ -227,13 +226,12 @@ class _TouchSteps:
 
 
 def pair_couples(pairs, poses, **grid):
-    """Seeks the closest couple of every pair; ``poses`` maps body name -> (R_WB, p_WB). The
-    compiled seek (`drake_dock.core.kernels.seek`) where the patches have kernel descriptions."""
+    """Seeks the closest couple of every pair (`seek_couple`); ``poses`` maps body name ->
+    (R_WB, p_WB)."""
     out = []
     for pr in pairs:
         P1, P2 = posed(pr.patch1, *poses[pr.body1]), posed(pr.patch2, *poses[pr.body2])
-        seek = compiled_seek.seek_couple if compiled_seek.supported(P1, P2) else seek_couple
-        out.append(seek(P1, P2, **grid))
+        out.append(seek_couple(P1, P2, **grid))
     return out
 
 
