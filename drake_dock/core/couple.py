@@ -28,7 +28,7 @@ tangents ta = s_u/|s_u| (CS) or t2/|t2| (CC), tb = n x ta. Signed gap g = n . d.
 
 Point-curve ("PC", a petal corner against a ring's inside circle): patch 1 is a point p (a
 sphere of radius r, `drake_dock.core.patches.Point`), d = p - c(s); n = sigma d/|d|,
-g = sigma |d| - r, ta = t2/|t2|; the contact system takes sigma = +1 (`hybrid.couple_sigma`:
+g = sigma |d| - r, ta = t2/|t2|; the contact system takes sigma = +1 (`relations.Relation.sigma`:
 n along d, also while the sphere overlaps the curve, g < 0).
 Its Jacobian is the scalar Fu = k2 . d - t2 . t2 (for a circle of radius R, -R rho_p with
 rho_p the distance of p from the axis: singular on the axis, where every s is closest); its
@@ -63,10 +63,9 @@ import numpy as np
 
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.jets import jet, patch_spec
+from drake_dock.core.relations import relation
 from drake_dock.errors import SingularCoupleError
 
-_PAIR = {"CC": K.CC, "CS": K.CS, "PC": K.PC, "PS": K.PS}
-_DIMS = {"CC": (1, 1), "CS": (1, 2), "PC": (0, 1), "PS": (0, 2)}
 
 
 @dataclasses.dataclass
@@ -119,18 +118,17 @@ def _vec(a):
 def _pair(kind, patch1, patch2):
     """(pair code, patch 1's kind and parameters, its point, patch 2's kind and parameters) of
     a pair of ``kind``, its patches checked against the kind."""
-    if kind not in _PAIR:
-        raise ValueError(f"couple kind {kind!r}: one of CC, CS, PC, PS")
-    d1, d2 = _DIMS[kind]
+    rel = relation(kind)
+    d1, d2 = rel.dims
     if patch1.dim != d1 or patch2.dim != d2:
         raise ValueError(f"a {kind} couple needs patches of dimensions {d1} and {d2}, not "
                          f"{type(patch1).__name__} ({patch1.dim}) and {type(patch2).__name__} "
                          f"({patch2.dim})")
     k2, q2 = kernel_spec(patch2)
-    if d1 == 0:
-        return _PAIR[kind], 0, q2, _vec(patch1.p), k2, q2
+    if rel.point:
+        return rel.code, 0, q2, _vec(patch1.p), k2, q2
     k1, q1 = kernel_spec(patch1)
-    return _PAIR[kind], k1, q1, (0.0, 0.0, 0.0), k2, q2
+    return rel.code, k1, q1, (0.0, 0.0, 0.0), k2, q2
 
 
 def _padded(u, m):

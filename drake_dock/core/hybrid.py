@@ -36,22 +36,7 @@ class Mode(enum.IntEnum):
 
 
 # ---------------------------------------------------------------------------- seeking
-def couple_sigma(kind: str, declared: float | None, gap: float, radius: float = 0.0) -> float:
-    """The orientation sigma of n (Definition 2): the declared one, else the side the patches
-    are on. A point-curve couple's n is always along d = p - c(s) (sigma = +1): its gap
-    |d| - r is negative while the sphere overlaps the curve, and d does not change side. A
-    point-surface couple's side is its centre's: ``gap`` (taken with sigma = +1) + ``radius``
-    (a sphere of radius r that overlaps the surface from the +N side is on that side)."""
-    if kind == "PC":
-        return 1.0
-    if declared is not None:
-        return declared
-    if kind == "PS":
-        gap = gap + radius
-    return 1.0 if gap >= 0.0 else -1.0
-
-
-# A couple of a pair whose side is declared (`couple_sigma`) found up to this far (m) on the
+# A couple of a pair whose side is declared (`drake_dock.core.relations.Relation.sigma`) found up to this far (m) on the
 # wrong side at a seek is a contact that came about between two seeks (the tracked and far
 # couples next to it moved on): it is tracked and takes part in the event's impact and modes.
 DECLARED_DEPTH = 1e-4

@@ -65,6 +65,7 @@ from pydrake.systems.framework import (EventStatus, LeafSystem, UnrestrictedUpda
 from drake_dock.core.contact_law import ContactLaw
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import model as K
+from drake_dock.core.relations import relation
 from drake_dock.errors import (DriftError, InputError, NumericalError, SingularCoupleError,
                                ZenoError)
 from drake_dock.systems import witnesses
@@ -100,11 +101,14 @@ def check_pairs(plant, pairs, energy_scale):
     if len(set(names)) != len(names):
         raise ValueError(f"pairs: names must be unique, got {names}")
     for p in pairs:
-        want = {"CC": (1, 1), "CS": (1, 2), "PC": (0, 1), "PS": (0, 2)}.get(p.kind)
-        if want is None or (p.patch1.dim, p.patch2.dim) != want:
+        try:
+            want = relation(p.kind).dims
+        except ValueError as e:
+            raise ValueError(f"pairs[{p.name}]: {e}") from None
+        if (p.patch1.dim, p.patch2.dim) != want:
             raise ValueError(f"pairs[{p.name}]: kind {p.kind!r} needs patch dims {want}, "
                              f"got ({p.patch1.dim}, {p.patch2.dim})")
-        if p.kind == "PC" and p.sigma not in (None, 1.0):
+        if relation(p.kind).along_d and p.sigma not in (None, 1.0):
             raise InputError(f"pairs[{p.name}].sigma", p.sigma,
                              "None or +1 (a point-curve couple's n is along d = p - c(s))")
 
@@ -146,7 +150,8 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
                                   self.links, self.far, dampers, self.energy_scale)
         self.nq, self.nv, self.nu, self.ie = ev.nq, ev.nv, ev.nu, ev.ie
         # The point-curve pairs: their side witness (`witnesses`).
-        self.side_pairs = frozenset(i for i, p in enumerate(self.pairs) if p.kind == "PC")
+        self.side_pairs = frozenset(i for i, p in enumerate(self.pairs)
+                                    if relation(p.kind).along_d)
         self.timing = Timing([p.name for p in pairs])
         self.transitions = Transitions(self, self.timing)
         self._rows = CoupleRows(self)

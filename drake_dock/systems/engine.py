@@ -28,6 +28,7 @@ from drake_dock.core.kernels.jets import N_PARAMS, patch_spec
 from drake_dock.core.kernels import records
 from drake_dock.core.kernels.records import pack
 from drake_dock.core.kernels.couple_row import CoupleRow
+from drake_dock.core.relations import relation
 from drake_dock.systems.evaluation import Evaluation, Kinematics
 
 
@@ -110,8 +111,9 @@ def _pair_arrays(pairs):
     bounded, spans = np.zeros((k, 3), np.int64), np.ones((k, 3))
     dims = np.zeros(k, np.int64)
     for i, p in enumerate(pairs):
-        kind[i] = E.KIND_CODE[p.kind]
-        if p.kind in ("PC", "PS"):
+        rel = relation(p.kind)
+        kind[i] = rel.code
+        if rel.point:
             prm1[i, :4] = (*p.patch1.p, p.patch1.radius)
         else:
             s1 = patch_spec(p.patch1)

@@ -9,6 +9,7 @@ from drake_dock.core.couple import point_curve_side
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import constraints as compiled_constraints
 from drake_dock.core.patches import posed
+from drake_dock.core.relations import relation
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import (DriftError, InputError, PainleveInconsistency, SeekingError,
                                SingularCoupleError)
@@ -21,7 +22,7 @@ def _reseek(p, c, margin, R2, conditioning_min) -> bool:
     """A couple c of pair p that is not far is sought again: at a domain end, with J singular,
     or (a point-curve pair) on the curve's convex side, Body 2 turned by R2."""
     return margin.min() <= 0.0 or c.conditioning <= conditioning_min or (
-        p.kind == "PC" and point_curve_side(p.patch2, R2, c.u[0], c.n) <= 0.0)
+        relation(p.kind).along_d and point_curve_side(p.patch2, R2, c.u[0], c.n) <= 0.0)
 
 
 def couples_of(ev, kin, u, states, which, t, strict=False):
@@ -32,7 +33,7 @@ def couples_of(ev, kin, u, states, which, t, strict=False):
     sigma = np.array([st.sigma for st in states])
     couples = ev.engine.couples(kin, u, sigma, which)
     for i, c in couples.items():
-        if ev.pairs[i].kind == "PC" and np.isnan(c.gap):
+        if relation(ev.pairs[i].kind).along_d and np.isnan(c.gap):
             raise SingularCoupleError("point-curve couple: the point lies on the curve "
                                       "(|d| = 0), its normal is undefined", time=t,
                                       couples=[ev.pairs[i].name])
@@ -218,8 +219,8 @@ class Transitions:
         if usable:
             raw = self.eng.couple(i, uc, Kinematics.at_rest(poses), 1.0, project=False)
             gap = raw.gap
-            sigma = hybrid.couple_sigma(p.kind, p.sigma, gap,
-                                        p.patch1.radius if p.kind == "PS" else 0.0)
+            rel = relation(p.kind)
+            sigma = rel.sigma(p.sigma, gap, p.patch1.radius if rel.point else 0.0)
             # A declared side (a ring face, solid on one side): a couple found a little on the
             # wrong side is a contact made between two seeks, not patches crossing past an end.
             crossing = hybrid.patches_cross(

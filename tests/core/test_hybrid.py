@@ -8,6 +8,7 @@ import pytest
 from drake_dock.core import hybrid
 from drake_dock.core.constraints import DETACH, SLIDE, STICK
 from drake_dock.core.hybrid import Mode
+from drake_dock.core.relations import relation
 
 FAR, TRACKED, SLIDING, STICKING = Mode.FAR, Mode.TRACKED, Mode.SLIDING, Mode.STICKING
 
@@ -22,10 +23,10 @@ def test_mode_is_the_port_status_code():
 
 
 def test_sigma_and_crossing_by_hand():
-    assert hybrid.couple_sigma("CS", -1.0, 0.3) == -1.0          # declared
-    assert hybrid.couple_sigma("CC", None, -0.2) == -1.0
-    assert hybrid.couple_sigma("CC", None, 0.0) == 1.0
-    assert hybrid.couple_sigma("PC", None, -0.2) == 1.0       # a point-curve n is along d
+    assert relation("CS").sigma(-1.0, 0.3) == -1.0          # declared
+    assert relation("CC").sigma(None, -0.2) == -1.0
+    assert relation("CC").sigma(None, 0.0) == 1.0
+    assert relation("PC").sigma(None, -0.2) == 1.0       # a point-curve n is along d
     tol = 1e-8
     # A couple 1 cm apart on the side of n: the closest couple, not crossing.
     assert not hybrid.patches_cross(0.01, 0.01, 1.0, tol)

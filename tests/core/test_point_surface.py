@@ -9,7 +9,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from drake_dock.core.couple import closest_point_conditions, evaluate_couple
-from drake_dock.core.hybrid import couple_sigma
+from drake_dock.core.relations import relation
 from drake_dock.core.patches import Cone, PlaneRect, Point, posed
 from drake_dock.core.seeking import contact_couple, seek_couple
 from tests.motions import Motion, check_rates_by_finite_differences
@@ -150,7 +150,7 @@ def test_an_overlapping_sphere_keeps_its_centres_side(height):
     c = seek_couple(posed(point, *X), posed(plane, *X))
     still = (np.zeros(3),) * 2
     raw = evaluate_couple("PS", point, X, still, plane, X, still, c.u, 1.0)
-    sigma = couple_sigma("PS", None, raw.gap, r)
+    sigma = relation("PS").sigma(None, raw.gap, r)
     assert sigma == math.copysign(1.0, height)
     ev = evaluate_couple("PS", point, X, still, plane, X, still, c.u, sigma)
     assert ev.gap == pytest.approx(abs(height) - r, abs=1e-15)

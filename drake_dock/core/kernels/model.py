@@ -12,9 +12,8 @@ from numba import njit
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.records import f1, f2, f3, i1, i2
 
-# Pair kinds (`couples`).
+# Pair kinds (`couples`; `drake_dock.core.relations` maps the kinds to them).
 CC, CS, PC, PS = K.CC, K.CS, K.PC, K.PS
-KIND_CODE = {"CC": CC, "CS": CS, "PC": PC, "PS": PS}
 # Modes (`drake_dock.core.hybrid.Mode`).
 FAR, TRACKED, SLIDING, STICKING = 0, 1, 2, 3
 # Witness kinds, in the order of `drake_dock.systems.witnesses.WITNESSES`: the impact (the gap
