@@ -44,7 +44,10 @@ def dask_client(workers: int | None = None, scheduler: str | None = None):
         if scheduler is None:
             n = default_workers() if workers is None else workers
             cluster = stack.enter_context(LocalCluster(
-                n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                n_workers=n, threads_per_worker=1, processes=True,
+                # The scheduler's HTTP server (health and metrics routes, no dashboard) on a
+                # free port: another cluster on Dask's default 8787 is no collision.
+                dashboard_address=":0", scheduler_kwargs={"dashboard": False},
                 silence_logs=logging.CRITICAL))
             client = stack.enter_context(Client(cluster))
         else:

@@ -59,7 +59,8 @@ def scheduler():
     from drake_dock.campaign.execute import CRASH_ISOLATION
     with dask.config.set(CRASH_ISOLATION):
         with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                          dashboard_address=None, silence_logs=logging.CRITICAL) as cluster:
+                          dashboard_address=":0", scheduler_kwargs={"dashboard": False},
+                          silence_logs=logging.CRITICAL) as cluster:
             yield cluster.scheduler_address
 
 

@@ -51,7 +51,8 @@ class Runner:
 def client():
     from distributed import Client, LocalCluster
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=False,
-                      dashboard_address=None) as cluster, Client(cluster) as c:
+                      dashboard_address=":0", scheduler_kwargs={"dashboard": False}) as cluster, \
+            Client(cluster) as c:
         yield c
 
 
