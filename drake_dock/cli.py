@@ -6,7 +6,8 @@ outcomes of a run (the first that holds ends it):
   captured   the latches can engage: the rings within simulation.capture_distance axially,
              capture_lateral across and capture_tilt_deg in tilt
   missed     the chaser passes beside the target (ring centres over 2 R apart across the
-             axis) or beyond its ring plane (over a petal height H behind it)
+             axis) or beyond its ring plane (over simulation.capture_distance behind it and
+             over capture_lateral off the axis, or over a petal height H behind it)
   rebound    the rings separate: their distance above its start and growing, with no
              thrust still to act (a couple may still graze)
   jammed     the distance to capture has not fallen by 1 mm in simulation.jam_time while

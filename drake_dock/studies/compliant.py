@@ -430,7 +430,7 @@ def run_compliant(scenario, state, cfg: CompliantConfig, *, t_max: float,
     try:
         sim.Initialize()
         sample()
-        watch = OutcomeWatch(rec["d"][0], sp.jam_time, beside=2.0 * g.R, beyond=g.H)
+        watch = OutcomeWatch.of(rec["d"][0], sp, g)
         sim.set_monitor(monitor)
         sim.AdvanceTo(t_max)
     except (Exception, SystemExit) as exc:    # a step failure of the continuous integrator,

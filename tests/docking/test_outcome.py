@@ -69,6 +69,17 @@ def test_missed_beside_or_beyond_the_target():
     assert outcome == "missed" and 1.5 - 1e-9 < t <= 1.51
 
 
+def test_missed_past_the_ring_plane_off_the_axis_but_not_on_it():
+    """Behind the target's ring face by more than the capture distance: missed where the
+    centre is off the axis by more than the lateral tolerance (first sample past 0.005 m
+    behind: 0.1 - 0.1 t < -0.005 from t = 1.05), not while on the axis."""
+    ts = np.linspace(0, 2, 201)
+    watch = lambda: OutcomeWatch(0.1, 5.0, beside=1.2, beyond=0.2, past=0.005, off_axis=0.01)
+    t, outcome = feed(watch(), ts, 0.1 - 0.1 * ts, lateral=[0.3] * len(ts))
+    assert outcome == "missed" and 1.05 - 1e-9 < t <= 1.06
+    assert feed(watch(), ts, 0.1 - 0.1 * ts, lateral=[0.005] * len(ts)) is None
+
+
 def _rot(axis, angle):
     """Rodrigues' rotation about the unit ``axis`` by ``angle``."""
     k = np.asarray(axis, float) / np.linalg.norm(axis)

@@ -6,8 +6,11 @@ relative pose over time and of whether post-contact thrust still acts).
   the tilt between the docking axes within ``simulation.capture_tilt_deg`` (`CaptureRule`;
   `drake_dock.docking.model.capture.CaptureMonitor` locates it with a witness).
 - ``missed``: the chaser passes beside the target (the rings' centres more than 2 R apart
-  across the axis: their disks no longer overlap) or beyond its ring plane (the chaser's ring
-  centre more than a petal height H behind the target's ring face).
+  across the axis: their disks no longer overlap) or beyond its ring plane: the chaser's ring
+  centre more than ``simulation.capture_distance`` behind the target's ring face while off the
+  axis by more than ``simulation.capture_lateral`` (its ring went round or through the
+  target's, whose ring is modelled as its face and circles: the latches cannot engage from
+  there), or more than a petal height H behind it anywhere.
 - ``rebound``: the rings separate: their distance above its start and growing, with no thrust
   still to act (a couple may still graze).
 - ``jammed``: the distance to capture (`CaptureRule.to_go`) has not fallen by ``JAM_DISTANCE``
@@ -82,15 +85,25 @@ class CaptureRule:
 class OutcomeWatch:
     """Fed the rings' pose (`misalignment`) and the distance to capture (`CaptureRule.to_go`)
     at each step; ``update`` returns (outcome, reason) once a rule other than capture holds,
-    else None. ``beside`` (m, 2 R) and ``beyond`` (m, H) are the `missed` rule's bounds."""
+    else None. ``beside`` (m, 2 R), ``beyond`` (m, H) and ``past`` (m, the capture distance,
+    off the axis by more than ``off_axis``, the capture's lateral tolerance) are the `missed`
+    rule's bounds."""
 
     d_start: float
     jam_time: float
     beside: float = math.inf
     beyond: float = math.inf
+    past: float = math.inf
+    off_axis: float = 0.0
     t_best: float = 0.0
     d_best: float = float("inf")
     d_last: float = float("inf")
+
+    @classmethod
+    def of(cls, d_start: float, simulation, geometry) -> "OutcomeWatch":
+        """The watch of a scenario's ``simulation`` and ``geometry`` sections."""
+        return cls(d_start, simulation.jam_time, beside=2.0 * geometry.R, beyond=geometry.H,
+                   past=simulation.capture_distance, off_axis=simulation.capture_lateral or 0.0)
 
     def update(self, t: float, d: float, lateral: float = 0.0, to_go: float | None = None,
                driven: bool = False):
@@ -108,6 +121,10 @@ class OutcomeWatch:
             return "missed", (f"the chaser passes beyond the target's ring plane: its ring "
                               f"centre {-d:.4g} m behind it (> H = {self.beyond:g} m), "
                               f"{lateral:.4g} m off the axis")
+        if d < -self.past and lateral > self.off_axis:
+            return "missed", (f"the chaser passes beyond the target's ring plane off the axis: "
+                              f"its ring centre {-d:.4g} m behind it (> {self.past:g} m), "
+                              f"{lateral:.4g} m off the axis (> {self.off_axis:g} m)")
         if not driven and growing and d > self.d_start:
             return "rebound", (f"the rings separate: ring distance {d:.6g} m, above its start "
                                f"{self.d_start:.6g} m and growing")

@@ -265,9 +265,8 @@ def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
                             lambda: (root.get_time(), _couples_in_play(dd, root))):
         sim.Initialize()
         rec.sample(root)
-        g = scenario.geometry
-        watch = OutcomeWatch(dd.capture.distance(dd.capture.GetMyContextFromRoot(root)),
-                             sp.jam_time, beside=2.0 * g.R, beyond=g.H)
+        watch = OutcomeWatch.of(dd.capture.distance(dd.capture.GetMyContextFromRoot(root)),
+                                sp, scenario.geometry)
         sim.set_monitor(monitor)
         try:
             status = sim.AdvanceTo(t_end)
