@@ -26,7 +26,7 @@ from drake_dock.errors import InputError
 PAPER = yaml.safe_load(PAPER_EXAMPLE.read_text())
 TEXT = yaml.safe_dump(PAPER)          # without comments: every byte is content
 EXAMPLES = 150
-SIMULATED = 12
+SIMULATED = 6
 SEEN = {}
 
 

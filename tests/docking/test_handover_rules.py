@@ -17,6 +17,7 @@ from drake_dock.docking.placement.place import contact_approach, place
 from drake_dock.docking.scenario.loading import load_scenario
 from drake_dock.errors import NumericalError
 from drake_dock.systems import handover_links
+from drake_dock.systems.simulator import tolerances
 
 COMPLETE = "contact: {pairs: complete}"
 
@@ -74,7 +75,11 @@ def test_without_the_rules_the_couples_go_to_and_fro(scenario, monkeypatch):
     assert ref.outcome == "captured"
     if r is not None:
         assert r.outcome == "captured"
-        assert r.capture_time >= ref.capture_time and len(r.impacts) >= len(ref.impacts)
+        # Not earlier than the witness can tell apart (Drake isolates the capture's zero to
+        # within its window).
+        window = tolerances(s.simulator_config).witness_window
+        assert r.capture_time >= ref.capture_time - window
+        assert len(r.impacts) >= len(ref.impacts)
 
 
 def test_the_complete_set_shifts_the_paper_example_by_its_first_contact(scenario):

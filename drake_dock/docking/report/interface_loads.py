@@ -53,6 +53,9 @@ def couple_force_magnitudes(ts: dict) -> np.ndarray:
     return np.linalg.norm(couple_forces_W(ts), axis=-1)
 
 
+TIE_RTOL = 1e-9     # couples' forces this close count as one peak (symmetry, round-off)
+
+
 def peak_loads(ts: dict, pairs) -> dict:
     """The peaks a docking engineer reads, each with the time of its first sample: the contact
     force and moment at the target's ring (magnitude; axial and lateral force; bending moment and
@@ -68,7 +71,10 @@ def peak_loads(ts: dict, pairs) -> dict:
     names = ts["couple_names"].tolist()
     if couple["time_s"] is not None:
         k = int(np.argmax(lam.max(1)))
-        couple["couple"] = names[int(np.argmax(lam[k]))]
+        # Symmetric couples carry equal forces to round-off: the first of those within
+        # TIE_RTOL of the peak, in pair order, whatever the last bits on this machine.
+        tied = np.flatnonzero(lam[k] >= (1.0 - TIE_RTOL) * lam[k].max())
+        couple["couple"] = names[int(tied[0])]
     else:
         couple["couple"] = None
     return {
