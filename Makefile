@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 OUT ?= out/paper_example
 
-.PHONY: demo test test-core bench clean notebook
+.PHONY: demo test test-core bench clean notebook docs
 
 # The install says what it does: pip lists each package it collects and installs; then the
 # numba kernels are compiled once, so that the first run simulates at full speed.
@@ -48,6 +48,36 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/evaluation.py
 	$(BIN)/python bench/campaign.py
 	$(BIN)/python bench/cold_start.py
+
+# Every figure, table and data file under docs/, each from the command that docs/results.md
+# gives for it, into $(DOCS_OUT) and then copied (hours on two cores: the two 1,000-sample
+# campaigns take most of it). Files that hold wall times say so; nothing else should change.
+DOCS_OUT ?= out/docs
+DD := $(BIN)/drake-dock
+docs: $(BIN)/.installed
+	$(DD) run models/paper_example.yaml --out $(DOCS_OUT)/paper_example --no-progress
+	cp $(DOCS_OUT)/paper_example/*.png docs/
+	$(DD) study stability --out $(DOCS_OUT)/stability
+	cp $(DOCS_OUT)/stability/stability_*.png docs/
+	cp $(DOCS_OUT)/stability/summary.txt docs/stability_summary.txt
+	$(DD) study speed-accuracy --out $(DOCS_OUT)/study
+	cp $(DOCS_OUT)/study/work_precision_*.png docs/
+	cp $(DOCS_OUT)/study/points.csv docs/speed_accuracy_points.csv
+	cp $(DOCS_OUT)/study/speedups.txt docs/speed_accuracy_speedups.txt
+	$(BIN)/python -m drake_dock.studies.funnel --shipped $(DOCS_OUT)/funnel_shipped
+	cp $(DOCS_OUT)/funnel_shipped/funnel.png $(DOCS_OUT)/funnel_shipped/funnel.csv docs/
+	$(DD) study conditions models/apds_funnel.yaml --out $(DOCS_OUT)/conditions_funnel
+	cp $(DOCS_OUT)/conditions_funnel/conditions.png docs/
+	$(DD) study roll --out $(DOCS_OUT)/roll
+	cp $(DOCS_OUT)/roll/roll.png docs/
+	$(DD) study crosscheck --out $(DOCS_OUT)/crosscheck
+	cp $(DOCS_OUT)/crosscheck/crosscheck.csv $(DOCS_OUT)/crosscheck/crosscheck.png docs/
+	$(DD) campaign models/idss_envelope.yaml --out $(DOCS_OUT)/idss_paper --no-progress
+	$(DD) campaign models/idss_envelope_funnel.yaml --out $(DOCS_OUT)/idss_funnel --no-progress
+	$(BIN)/python -m drake_dock.campaign.table export $(DOCS_OUT)/idss_paper docs/campaign_paper.csv
+	$(BIN)/python -m drake_dock.campaign.table export $(DOCS_OUT)/idss_funnel docs/campaign_funnel.csv
+	for c in paper funnel; do for f in capture_probability histograms; do \
+	  cp $(DOCS_OUT)/idss_$$c/$$f.png docs/campaign_$${c}_$$f.png; done; done
 
 clean:
 	rm -rf $(VENV) .venv-core out

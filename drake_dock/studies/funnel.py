@@ -67,6 +67,12 @@ class FunnelPlan:
     def full(cls):
         return cls()
 
+    @classmethod
+    def shipped(cls):
+        """The paper's geometry and the shipped funnel (the scenario's own, H 0.15 m) only,
+        in 4 halvings: docs/results.md's table and figure."""
+        return cls(rim_passages=(), funnel_heights=(0.15,), steps=4)
+
 
 def clearance(g) -> float:
     """c = Rs - (Rp - H cot(alpha1)) (m): the tip arcs' clearance inside the other ring's
@@ -265,3 +271,26 @@ def write_funnel(result, out_dir):
         (tmp / "summary.json").write_text(json.dumps(
             {"plan": result["plan"], "points": result["points"],
              "lines": summary_lines(result)}, indent=2) + "\n")
+
+
+def main(argv=None) -> int:
+    """``python -m drake_dock.studies.funnel --shipped DIR``: the shipped plan
+    (`FunnelPlan.shipped`) on models/apds_funnel.yaml, written into DIR."""
+    import argparse
+    from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
+    parser = argparse.ArgumentParser(prog="python -m drake_dock.studies.funnel")
+    parser.add_argument("--shipped", metavar="DIR", required=True,
+                        help="run the shipped plan and write its files into DIR")
+    args = parser.parse_args(argv)
+    try:
+        write_funnel(run_funnel(load_scenario(MODELS_DIR / "apds_funnel.yaml"),
+                                FunnelPlan.shipped()), args.shipped)
+    except DrakeDockError as e:
+        print(f"error: {e}")
+        return 2
+    print(f"wrote {args.shipped}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
