@@ -75,8 +75,8 @@ def _check(pa, pb):
     kernel_spec(pb)
 
 
-def _not_converged(dist):
-    return SeekingError(f"closest-couple Newton did not converge in {K.CLOSEST_MAX_ITER} "
+def _not_converged(dist, iterations=K.CLOSEST_MAX_ITER):
+    return SeekingError(f"closest-couple Newton did not converge in {iterations} "
                         f"iterations (at distance {dist:.3g} m)")
 
 
@@ -89,8 +89,10 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
     a surface or a curve by `point_surface` and `point_curve`. With ``distance_rtol`` the
     Newton finish ends once the distance has converged to that fraction, where it is beyond
     ``rtol_beyond``. A Newton finish that does not converge raises `SeekingError` unless it
-    ends within `CREEP_TOUCH` of touching, or (a curve's seek) another start is nearer; a
-    non-finite distance raises it too; a patch without a kernel description a ValueError."""
+    ends within `CREEP_TOUCH` of touching, or (a curve's seek) another start is nearer, or
+    (a curve's seek) the nearest start, once every start that did not converge is continued
+    for `CREEP_MAX_ITER` further iterations, has converged; a non-finite distance raises it
+    too; a patch without a kernel description a ValueError."""
     pa, pb = P1.patch, P2.patch
     _check(pa, pb)
     R1, o1 = _pose(P1)
@@ -126,18 +128,35 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
     # valley, e.g. a ring's circle almost parallel to the other ring's face, or a circle that
     # touches or pierces a face, where the minima form a curve) counts where it is not the
     # nearest, or where it ended within CREEP_TOUCH of touching (the contact-form finish and
-    # the modes then take it as a touch); else it is an error.
-    best, dist = -1, np.inf
-    for c in range(U.shape[0]):
-        d = float(np.linalg.norm(X1[c] - X2[c]))
-        if d < dist:
-            best, dist = c, d
+    # the modes then take it as a touch). Else every start that did not converge is continued
+    # for CREEP_MAX_ITER further iterations (`kernels.seek.creep_on`: each creeps along the
+    # valley to its own minimum, every step descending) and the nearest taken again; it is an
+    # error if that one has still not converged beyond CREEP_TOUCH.
+    best, dist = _nearest(X1, X2)
     if best < 0:
         raise SeekingError("no finite distance between the patches (a non-finite pose)")
     if status[best] and dist > K.CREEP_TOUCH:
-        raise _not_converged(dist)
+        for c in np.flatnonzero(status):
+            U[c], it, status[c], X1[c], X2[c], interior[c] = K.creep_on(
+                k1, q1, R1, o1, *_domain(pa, n_coarse)[:3], k2, q2, R2, o2,
+                *_domain(pb, n_coarse)[:3], U[c], rtol, float(rtol_beyond))
+            its[c] += it
+        best, dist = _nearest(X1, X2)
+        if status[best] and dist > K.CREEP_TOUCH:
+            raise _not_converged(dist, K.CLOSEST_MAX_ITER + K.CREEP_MAX_ITER)
     return Couple(U[best, :1], U[best, 1:], X1[best], X2[best], dist, int(its[best]),
                   bool(interior[best]))
+
+
+def _nearest(X1, X2):
+    """(index, distance) of the first nearest couple of points X1[c], X2[c]; (-1, inf) where no
+    distance is finite."""
+    best, dist = -1, np.inf
+    for c in range(X1.shape[0]):
+        d = float(np.linalg.norm(X1[c] - X2[c]))
+        if d < dist:
+            best, dist = c, d
+    return best, dist
 
 
 def is_interior(patch, u, rtol=1e-9) -> bool:

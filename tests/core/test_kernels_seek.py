@@ -162,22 +162,66 @@ def _circle_to_annulus(P1, P2, s):
     return math.hypot(z, rho - min(max(rho, lo), hi))
 
 
+def _least_circle_to_annulus(P1, P2):
+    """The least `_circle_to_annulus` over the circle: a grid of 4001 points, then a bounded
+    1-D minimisation around the best."""
+    from scipy.optimize import minimize_scalar
+    grid = np.linspace(0.0, 2 * math.pi, 4001)
+    k = int(np.argmin([_circle_to_annulus(P1, P2, s) for s in grid]))
+    return minimize_scalar(lambda s: _circle_to_annulus(P1, P2, s),
+                           bounds=(grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]),
+                           method="bounded", options={"xatol": 1e-12}).fun
+
+
 @pytest.mark.parametrize("case", CREEPING, ids=lambda c: c["pair"])
 def test_a_circle_through_a_face_near_its_edge_is_a_touch(case):
     """The target's rim piercing the chaser's face a few um from its inside edge (IDSS plan
     sample 0 on the paper's geometry): the minima form a curve and Newton creeps from one start.
     The seek takes it as a touch within CREEP_TOUCH, at the distance of a bounded 1-D
     minimisation of the closed-form point-to-annulus distance over the circle."""
-    from scipy.optimize import minimize_scalar
     pair = next(p for p in DockingScene(ApdsGeometry(), "complete").pairs if p.name == case["pair"])
     P1 = posed(pair.patch1, np.array(case["R1"]), np.array(case["o1"]))
     P2 = posed(pair.patch2, np.array(case["R2"]), np.array(case["o2"]))
     rtol, beyond = case["kw"]
     got = seek_couple(P1, P2, distance_rtol=rtol, rtol_beyond=beyond)
-    grid = np.linspace(0.0, 2 * math.pi, 4001)
-    k = int(np.argmin([_circle_to_annulus(P1, P2, s) for s in grid]))
-    best = minimize_scalar(lambda s: _circle_to_annulus(P1, P2, s),
-                           bounds=(grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]),
-                           method="bounded", options={"xatol": 1e-12})
     assert got.distance <= CREEP_TOUCH
-    assert got.distance == pytest.approx(best.fun, abs=1e-7)
+    assert got.distance == pytest.approx(_least_circle_to_annulus(P1, P2), abs=1e-7)
+
+
+VALLEY = json.loads(Path(__file__).with_name("creeping_valley_seeks.json").read_text())
+
+
+@pytest.mark.parametrize("case", VALLEY, ids=lambda c: c["note"].split(",")[0].split()[-1])
+def test_a_creeping_nearest_start_is_continued_to_the_minimum(case):
+    """The target's rim nearly parallel to the chaser's face, its nearest point a few um to
+    0.1 mm above it near the face's inside or outside edge (IDSS envelope plan samples 512,
+    573, 634): the minima form a valley flat along the circle and curved in the parameters,
+    and the nearest start's Newton has not converged in CLOSEST_MAX_ITER beyond CREEP_TOUCH
+    (the seek raised SeekingError). With the starts that did not converge continued
+    (CREEP_MAX_ITER), the nearest couple is at the distance of dense sampling + bounded L-BFGS
+    and of the bounded 1-D minimisation of the closed-form point-to-annulus distance over the
+    circle, to 1e-9 m, at points of both patches."""
+    from drake_dock.core import seeking as S
+    from drake_dock.core.couple import kernel_spec
+    from drake_dock.core.kernels import seek as K
+    pair = next(p for p in DockingScene(ApdsGeometry(), "complete").pairs if p.name == case["pair"])
+    P1 = posed(pair.patch1, np.array(case["R1"]), np.array(case["o1"]))
+    P2 = posed(pair.patch2, np.array(case["R2"]), np.array(case["o2"]))
+    rtol, beyond = case["kw"]
+    # The case is one the first CLOSEST_MAX_ITER iterations leave unconverged, nearest.
+    R1, o1 = S._pose(P1)
+    R2, o2 = S._pose(P2)
+    _, _, status, X1, X2, _ = K.seek(*kernel_spec(P1.patch), R1, o1, *S._domain(P1.patch, 12),
+                                     *kernel_spec(P2.patch), R2, o2, *S._domain(P2.patch, 12),
+                                     2, 21, 3, rtol, beyond)
+    d = np.linalg.norm(X1 - X2, axis=1)
+    assert status[np.argmin(d)] == 1 and d.min() > CREEP_TOUCH
+    got = seek_couple(P1, P2, distance_rtol=rtol, rtol_beyond=beyond)
+    # The couple's points are the patches' (sample 634's minimum lies on the face's outside
+    # edge, the iteration ends 4e-8 m short of it: no closest-point conditions to 1e-7).
+    np.testing.assert_allclose(got.p1, P1.position(got.u1), atol=1e-12)
+    np.testing.assert_allclose(got.p2, P2.position(got.u2), atol=1e-12)
+    assert got.distance == pytest.approx(np.linalg.norm(got.p1 - got.p2), abs=1e-13)
+    want = np.linalg.norm(brute_force_closest(P1, P2)[2])
+    assert got.distance == pytest.approx(want, abs=1e-9)
+    assert got.distance == pytest.approx(_least_circle_to_annulus(P1, P2), abs=1e-9)

@@ -34,6 +34,12 @@ FLAT = 1e-10
 CLOSEST_MAX_ITER = 200
 # m: a Newton finish that creeps this near touching is a touch (`newton`'s status).
 CREEP_TOUCH = 1e-6
+# The further iterations of the nearest start of a curve's seek whose Newton has not converged
+# in CLOSEST_MAX_ITER beyond CREEP_TOUCH (`creep_on`). A circle nearly parallel to a face, its
+# nearest point near the face's edge, leaves a valley of minima that is flat along the circle
+# and curved in the parameters: each straight step descends but runs off the valley's curve
+# after a few mrad, and the iteration creeps to the minimum in a few hundred iterations.
+CREEP_MAX_ITER = 2000
 
 
 @njit(cache=True)
@@ -272,6 +278,22 @@ def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
 
 
 @njit(cache=True)
+def creep_on(k1, p1, R1, o1, lo1, hi1, per1, k2, p2, R2, o2, lo2, hi2, per2, u, distance_rtol,
+             rtol_beyond):
+    """`newton` continued from a finished couple u of `seek` that did not converge, with the
+    seek's bounds, scales and tolerances, for at most CREEP_MAX_ITER further iterations: (u,
+    iterations, status, x1 (3,), x2 (3,), interior), as one couple of `seek`."""
+    lower, upper = np.concatenate((lo1, lo2)), np.concatenate((hi1, hi2))
+    periodic = np.concatenate((per1, per2))
+    scale = np.maximum(upper - lower, 1e-300)
+    u, it, status = newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale,
+                           1e-14, CREEP_MAX_ITER, distance_rtol, rtol_beyond)
+    _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, 1)
+    return (u, it, status, np.array([x1[0], x1[1], x1[2]]), np.array([x2[0], x2[1], x2[2]]),
+            _interior(u, lower, upper, periodic))
+
+
+@njit(cache=True)
 def _interior(u, lower, upper, periodic):
     """min(u - lower, upper - u) > 1e-9 span for every bounded parameter (NaN: not)."""
     for k in range(u.shape[0]):
@@ -369,8 +391,10 @@ def warm():
     seg = Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1))
     plane = PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0))
     for c1, c2 in ((seg, Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0))), (Circle(0.3, 0.1), plane)):
-        seek(*patch_spec(c1), eye, z, *domain(c1, 12), *patch_spec(c2), eye, z, *domain(c2, 12),
-             2, 21, 3, -1.0, 0.0)
+        U = seek(*patch_spec(c1), eye, z, *domain(c1, 12), *patch_spec(c2), eye, z,
+                 *domain(c2, 12), 2, 21, 3, -1.0, 0.0)[0]
+        creep_on(*patch_spec(c1), eye, z, *domain(c1, 12)[:3], *patch_spec(c2), eye, z,
+                 *domain(c2, 12)[:3], U[0], -1.0, 0.0)
     pt = np.array([0.1, 0.2, 0.3, 0.01, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     point_surface(pt, eye, z, *patch_spec(plane), eye, z, *domain(plane, 16), -1.0, 0.0)
     for curve in (Circle(0.3), Arc(0.3, 0.0, (0.2, 1.4))):
