@@ -265,7 +265,7 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
         E = self.engine.evaluate(t, x, modes, tau)
         self.timing.contact_dynamics += perf_counter() - t0
         self.timing.count_tracked_epoch(modes.index())
-        if E.buf[E.layout[11] + K.S_REPORT]:
+        if E.needs_report:
             check_evaluation(self, E, t)
         return E
 

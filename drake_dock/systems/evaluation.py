@@ -50,6 +50,11 @@ class Kinematics:
                           z(self.v))
 
 
+# The sections of the result buffer, in the order of the offsets `model.layout` returns.
+(XDOT, OUT, LAMBDA_N, LAMBDA_T, CONTACT_FORCE, WITNESS, BOUND, FRAME_R, FRAME_O, FRAME_W,
+ FRAME_V, SCALARS, BUSHINGS, END) = range(14)
+
+
 class Evaluation:
     """One evaluation (`Engine.evaluate`): views of its result buffer (`engine.layout`), made
     when asked (a derivative evaluation reads only xdot)."""
@@ -60,14 +65,21 @@ class Evaluation:
         self.xdot = buf[:engine.nx]
         self._far = False
 
-    def _section(self, a, b):
+    def _section(self, a):
+        """The buffer's section ``a`` (`OUT` ... `BUSHINGS`)."""
         L = self.layout
-        return self.buf[L[a]:L[b]]
+        return self.buf[L[a]:L[a + 1]]
+
+    @property
+    def needs_report(self) -> bool:
+        """Whether the kernel flagged this evaluation (a mode status other than OK, a
+        bushing out of range): `check_evaluation` says what."""
+        return bool(self.buf[self.layout[SCALARS] + E.S_REPORT])
 
     @functools.cached_property
     def out(self):
         """The couple rows of the pairs not far (n_near, couples.ROW), by `slot`."""
-        return self._section(1, 2).reshape(-1, K.ROW)
+        return self._section(OUT).reshape(-1, K.ROW)
 
     @functools.cached_property
     def slot(self) -> np.ndarray:
@@ -80,52 +92,52 @@ class Evaluation:
 
     @functools.cached_property
     def lam_n(self):
-        return self._section(2, 3)
+        return self._section(LAMBDA_N)
 
     @functools.cached_property
     def lam_t(self):
-        return self._section(3, 4).reshape(self.engine.k, 2)
+        return self._section(LAMBDA_T).reshape(self.engine.k, 2)
 
     @functools.cached_property
     def contact_force(self):
-        return self._section(4, 5)
+        return self._section(CONTACT_FORCE)
 
     @functools.cached_property
     def wv(self):
         """Witness values (n_near, engine.NW) of the pairs that are not far, by `slot`."""
-        return self._section(5, 6).reshape(-1, E.NW)
+        return self._section(WITNESS).reshape(-1, E.NW)
 
     @property
     def bound(self):
         """The far pairs' travel bounds (NaN for the others)."""
         self._far_pass()
-        return self._section(6, 7)
+        return self._section(BOUND)
 
     @functools.cached_property
     def R(self):
-        return self._section(7, 8).reshape(-1, 3, 3)
+        return self._section(FRAME_R).reshape(-1, 3, 3)
 
     @functools.cached_property
     def o(self):
-        return self._section(8, 9).reshape(-1, 3)
+        return self._section(FRAME_O).reshape(-1, 3)
 
     @functools.cached_property
     def w(self):
-        return self._section(9, 10).reshape(-1, 3)
+        return self._section(FRAME_W).reshape(-1, 3)
 
     @functools.cached_property
     def vf(self):
-        return self._section(10, 11).reshape(-1, 3)
+        return self._section(FRAME_V).reshape(-1, 3)
 
     @functools.cached_property
     def sc(self):
-        return self._section(11, 12)
+        return self._section(SCALARS)
 
     @functools.cached_property
     def bushings(self):
         """Per bushing: deflection (3), roll-pitch-yaw (3), spatial force on frame C (6,
         world)."""
-        return self._section(12, 13).reshape(-1, E.BUSH_ROW)
+        return self._section(BUSHINGS).reshape(-1, E.BUSH_ROW)
 
     @functools.cached_property
     def q(self):
