@@ -57,22 +57,19 @@ def _pose(P):
     return np.array(P.R, dtype=float, order="C"), np.array(P.p, dtype=float)
 
 
-def _point_prm(point):
-    prm = np.zeros(N_PARAMS)
-    prm[:3] = point.p
-    return prm
-
-
-def _check(pa, pb):
-    """A ValueError unless patch 1 is a point or a curve and patch 2 a curve or a surface, each
-    with a kernel description (a point is described by its coordinates)."""
+def _specs(pa, pb):
+    """The kernel descriptions (kind, parameters) of a seek's patches, a point as a `POINT` by
+    its coordinates; a ValueError unless patch 1 is a point or a curve and patch 2 a curve or a
+    surface, each with a kernel description."""
     if pa.dim > 1 or pb.dim not in (1, 2):
         raise ValueError(f"no seek between {type(pa).__name__} (dimension {pa.dim}) and "
                          f"{type(pb).__name__} (dimension {pb.dim}): patch 1 is a point or a "
                          f"curve, patch 2 a curve or a surface")
-    if pa.dim == 1:
-        kernel_spec(pa)
-    kernel_spec(pb)
+    if pa.dim == 0:
+        prm = np.zeros(N_PARAMS)
+        prm[:3] = pa.p
+        return (K.POINT, prm), kernel_spec(pb)
+    return kernel_spec(pa), kernel_spec(pb)
 
 
 def _not_converged(dist, iterations=K.CLOSEST_MAX_ITER):
@@ -94,36 +91,42 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
     for `CREEP_MAX_ITER` further iterations, has converged; a non-finite distance raises it
     too; a patch without a kernel description a ValueError."""
     pa, pb = P1.patch, P2.patch
-    _check(pa, pb)
+    (k1, q1), (k2, q2) = _specs(pa, pb)
     R1, o1 = _pose(P1)
     R2, o2 = _pose(P2)
-    (k2, q2) = kernel_spec(pb)
     rtol = -1.0 if distance_rtol is None else float(distance_rtol)
-    if pa.dim == 0:
-        if pb.dim == 1:
-            x = R1 @ pa.p + o1
-            s, it, x2, concave = K.point_curve(x, k2, q2, R2, o2,
-                                               *_domain(pb, POINT_CURVE_GRID), POINT_CURVE_ITER)
-            # A potential contact only on the curve's concave side (docs/model.md, "The
-            # petal corner").
-            u2, status = np.array([s]), 0
-            interior = concave and is_interior(pb, u2)
-        else:
-            u2, it, status, x, x2, interior = K.point_surface(
-                _point_prm(pa), R1, o1, k2, q2, R2, o2, *_domain(pb, POINT_SURFACE_GRID),
-                rtol, float(rtol_beyond))
-        centre = float(np.linalg.norm(x - x2))
-        if status and centre > K.CREEP_TOUCH:
-            raise _not_converged(centre)
-        dist = centre - pa.radius
-        if not math.isfinite(dist):
-            raise SeekingError("no finite distance between the point and the patch (a "
-                               "non-finite pose)")
-        return Couple(np.zeros(0), u2, x, x2, dist, int(it), bool(interior))
-    k1, q1 = kernel_spec(pa)
-    U, its, status, X1, X2, interior = K.seek(
-        k1, q1, R1, o1, *_domain(pa, n_coarse), k2, q2, R2, o2, *_domain(pb, n_coarse), levels,
-        n_fine, candidates, rtol, float(rtol_beyond))
+    if pa.dim == 1:
+        D1, D2 = _domain(pa, n_coarse), _domain(pb, n_coarse)
+        return _seek_curve(k1, q1, R1, o1, D1, k2, q2, R2, o2, D2, levels, n_fine, candidates,
+                           rtol, float(rtol_beyond))
+    if pb.dim == 1:
+        x = R1 @ pa.p + o1
+        s, it, x2, concave = K.point_curve(x, k2, q2, R2, o2, *_domain(pb, POINT_CURVE_GRID),
+                                           POINT_CURVE_ITER)
+        # A potential contact only on the curve's concave side (docs/model.md, "The petal
+        # corner").
+        u2, status = np.array([s]), 0
+        interior = concave and is_interior(pb, u2)
+    else:
+        u2, it, status, x, x2, interior = K.point_surface(
+            q1, R1, o1, k2, q2, R2, o2, *_domain(pb, POINT_SURFACE_GRID), rtol,
+            float(rtol_beyond))
+    centre = float(np.linalg.norm(x - x2))
+    if status and centre > K.CREEP_TOUCH:
+        raise _not_converged(centre)
+    dist = centre - pa.radius
+    if not math.isfinite(dist):
+        raise SeekingError("no finite distance between the point and the patch (a "
+                           "non-finite pose)")
+    return Couple(np.zeros(0), u2, x, x2, dist, int(it), bool(interior))
+
+
+def _seek_curve(k1, q1, R1, o1, D1, k2, q2, R2, o2, D2, levels, n_fine, candidates, rtol,
+                rtol_beyond) -> Couple:
+    """`seek_couple` of a curve (kind k1, parameters q1, pose R1, o1, `_domain` D1) against a
+    curve or a surface (k2, q2, R2, o2, D2) by `kernels.seek.seek`, creeping on where needed."""
+    U, its, status, X1, X2, interior = K.seek(k1, q1, R1, o1, *D1, k2, q2, R2, o2, *D2, levels,
+                                              n_fine, candidates, rtol, rtol_beyond)
     # The nearest couple. A start whose Newton did not converge (it creeps: a nearly flat
     # valley, e.g. a ring's circle almost parallel to the other ring's face, or a circle that
     # touches or pierces a face, where the minima form a curve) counts where it is not the
@@ -138,8 +141,7 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
     if status[best] and dist > K.CREEP_TOUCH:
         for c in np.flatnonzero(status):
             U[c], it, status[c], X1[c], X2[c], interior[c] = K.creep_on(
-                k1, q1, R1, o1, *_domain(pa, n_coarse)[:3], k2, q2, R2, o2,
-                *_domain(pb, n_coarse)[:3], U[c], rtol, float(rtol_beyond))
+                k1, q1, R1, o1, *D1[:3], k2, q2, R2, o2, *D2[:3], U[c], rtol, rtol_beyond)
             its[c] += it
         best, dist = _nearest(X1, X2)
         if status[best] and dist > K.CREEP_TOUCH:

@@ -9,19 +9,6 @@ from numba import njit
 
 from drake_dock.core.kernels.jets import PETAL, petal_point, petal_row, position
 
-# A point patch (patch 1 of a point pair): its parameters are the point's coordinates.
-POINT = -1
-
-
-@njit(cache=True)
-def world_point(kind, prm, R, o, u0, u1):
-    """R r(u) + o (Eq. 20); a `POINT`'s r is its coordinates."""
-    r = (prm[0], prm[1], prm[2]) if kind == POINT else position(kind, prm, u0, u1)
-    return (R[0, 0] * r[0] + R[0, 1] * r[1] + R[0, 2] * r[2] + o[0],
-            R[1, 0] * r[0] + R[1, 1] * r[1] + R[1, 2] * r[2] + o[1],
-            R[2, 0] * r[0] + R[2, 1] * r[1] + R[2, 2] * r[2] + o[2])
-
-
 @njit(cache=True)
 def _frame(R, o):
     """R and o as twelve scalars, read once for a grid's loop."""
@@ -31,7 +18,7 @@ def _frame(R, o):
 
 @njit(cache=True)
 def _place(F, r, X, a):
-    """X[a] = R r + o (Eq. 20) for the `_frame` F, as `world_point` computes it."""
+    """X[a] = R r + o (Eq. 20) for the `_frame` F, as `seek.world_point` computes it."""
     X[a, 0] = F[0] * r[0] + F[1] * r[1] + F[2] * r[2] + F[9]
     X[a, 1] = F[3] * r[0] + F[4] * r[1] + F[5] * r[2] + F[10]
     X[a, 2] = F[6] * r[0] + F[7] * r[1] + F[8] * r[2] + F[11]

@@ -21,9 +21,11 @@ import math
 import numpy as np
 from numba import njit
 
-from drake_dock.core.kernels.grids import POINT, hierarchical, positions, within, world_point
+from drake_dock.core.kernels.grids import hierarchical, positions, within
 from drake_dock.core.kernels.jets import CIRCLE, jet, position
 
+# A point patch (patch 1 of a point pair): its parameters are the point's coordinates.
+POINT = -1
 EPS8 = 8 * np.finfo(float).eps
 # Eigenvalues of the descent step's Hessian below FLAT max(1, |w|max) are flat directions.
 FLAT = 1e-10
@@ -94,6 +96,15 @@ def _descent_step(H, g):
     c = -(V.T @ g) / np.maximum(w, 1e-16 * top)
     flat = w < FLAT * top
     return V @ np.where(flat, 0.0, c), V @ np.where(flat, c, 0.0)
+
+
+@njit(cache=True)
+def world_point(kind, prm, R, o, u0, u1):
+    """R r(u) + o (Eq. 20); a `POINT`'s r is its coordinates."""
+    r = (prm[0], prm[1], prm[2]) if kind == POINT else position(kind, prm, u0, u1)
+    return (R[0, 0] * r[0] + R[0, 1] * r[1] + R[0, 2] * r[2] + o[0],
+            R[1, 0] * r[0] + R[1, 1] * r[1] + R[1, 2] * r[2] + o[1],
+            R[2, 0] * r[0] + R[2, 1] * r[1] + R[2, 2] * r[2] + o[2])
 
 
 @njit(cache=True)
@@ -238,19 +249,24 @@ def newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale, tol
 
 
 @njit(cache=True)
+def _couple_domain(lo1, hi1, per1, lo2, hi2, per2):
+    """A couple's bounds, periodic flags and scales (its spans, floored at 1e-300) from its
+    two patches' domains, as `newton` takes them."""
+    lower, upper = np.concatenate((lo1, lo2)), np.concatenate((hi1, hi2))
+    return lower, upper, np.concatenate((per1, per2)), np.maximum(upper - lower, 1e-300)
+
+
+@njit(cache=True)
 def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2, levels, n_fine,
          candidates, distance_rtol, rtol_beyond):
     """The start couples of `hierarchical`, each finished by `newton` unless an earlier one
     started within 1e-9 of the spans (one finish serves both): the finished couples u (C, n),
     their iterations, statuses, points x1, x2 (C, 3) and whether they are interior
     (`seeking.is_interior` of both parts), in the order of the starts."""
+    lower, upper, periodic, scale = _couple_domain(lo1, hi1, per1, lo2, hi2, per2)
+    tol = 1e-9 * (upper - lower)
     starts = hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
                           levels, n_fine, candidates)
-    lower, upper = np.concatenate((lo1, lo2)), np.concatenate((hi1, hi2))
-    periodic = np.concatenate((per1, per2))
-    span = upper - lower
-    scale = np.maximum(span, 1e-300)
-    tol = 1e-9 * span
     C, n = starts.shape
     U, its, status = np.empty((C, n)), np.zeros(C, dtype=np.int64), np.zeros(C, dtype=np.int64)
     X1, X2 = np.empty((C, 3)), np.empty((C, 3))
@@ -283,9 +299,7 @@ def creep_on(k1, p1, R1, o1, lo1, hi1, per1, k2, p2, R2, o2, lo2, hi2, per2, u, 
     """`newton` continued from a finished couple u of `seek` that did not converge, with the
     seek's bounds, scales and tolerances, for at most CREEP_MAX_ITER further iterations: (u,
     iterations, status, x1 (3,), x2 (3,), interior), as one couple of `seek`."""
-    lower, upper = np.concatenate((lo1, lo2)), np.concatenate((hi1, hi2))
-    periodic = np.concatenate((per1, per2))
-    scale = np.maximum(upper - lower, 1e-300)
+    lower, upper, periodic, scale = _couple_domain(lo1, hi1, per1, lo2, hi2, per2)
     u, it, status = newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale,
                            1e-14, CREEP_MAX_ITER, distance_rtol, rtol_beyond)
     _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, 1)
