@@ -8,7 +8,6 @@ import math
 
 import numpy as np
 
-from drake_dock.core import covers
 from drake_dock.core.kernels import cover as compiled_cover
 
 # Covers of the broad phase: cells per parameter and per block, by patch dimension.
@@ -58,10 +57,9 @@ class FarPairs:
         self._p0 = np.zeros((len(pairs), 3))
 
     def covers(self, i):
-        """The covers (`BROAD_CELLS`) of pair i's two patches, compiled where the patches have
-        kernel descriptions (kept on the patches)."""
+        """The covers (`BROAD_CELLS`, `kernels.cover.patch_cover`) of pair i's two patches
+        (kept on the patches)."""
         return [compiled_cover.patch_cover(p, *BROAD_CELLS[p.dim])
-                or covers.patch_cover(p, *BROAD_CELLS[p.dim])
                 for p in (self.pairs[i].patch1, self.pairs[i].patch2)]
 
     def cover_gap(self, i, poses):

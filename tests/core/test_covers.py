@@ -1,6 +1,7 @@
 """The bounding-sphere covers (`drake_dock.core.covers`, compiled in
 `drake_dock.core.kernels.cover`): every sampled point of a cell lies in its sphere and its slab,
-every cell in its block's sphere; the compiled covers and touched steps equal the reference;
+every cell in its block's sphere; the compiled covers and touched steps equal the reference
+(a patch no kernel describes, a point, has the reference's cover);
 without slabs the touched steps equal a brute force over every sphere pair and step (the exact
 least distance of a sphere pair over a step), with them they lie between that and the steps
 where the pointwise bound (spheres and slabs) reaches 0 at sampled travels; and the covers'
@@ -13,7 +14,7 @@ import pytest
 
 from drake_dock.core import covers
 from drake_dock.core.kernels import cover as compiled
-from drake_dock.core.patches import Circle, Cone, PlaneRect, Segment, posed
+from drake_dock.core.patches import Circle, Cone, PlaneRect, Point, Segment, posed
 from drake_dock.core.seeking import seek_couple
 from drake_dock.docking.geometry.pairs import CHASER_APDS
 from drake_dock.docking.geometry.scene import DockingScene
@@ -52,6 +53,11 @@ def test_cells_enclose_the_patch(patch):
               + ref.radii[blocks])
     assert np.all(inside <= ref.block_radii[:, None] * (1 + 1e-15))
 
+
+
+def test_a_patch_without_kernel_description_has_the_reference_cover():
+    point = Point((0.1, 0.2, 0.3), 0.01)
+    assert compiled.patch_cover(point, 1, 1) is covers.patch_cover(point, 1, 1)
 
 def _posed_covers(pr, approach):
     R, p0 = approach.pose(0.0)
@@ -158,8 +164,7 @@ def test_cover_gap_compiled_equals_reference_and_lies_below_the_seek():
         X = {CHASER_APDS: (R, np.array([*rng.uniform(-0.1, 0.1, 2), rng.uniform(-0.2, 0.5)])),
              "target_apds": (np.eye(3), np.zeros(3))}
         for pr in pairs[trial::6]:
-            c1, c2 = (compiled.patch_cover(p, *COVER_CELLS[p.dim])
-                      or covers.patch_cover(p, *COVER_CELLS[p.dim]) for p in (pr.patch1, pr.patch2))
+            c1, c2 = (compiled.patch_cover(p, *COVER_CELLS[p.dim]) for p in (pr.patch1, pr.patch2))
             a, b = c1.posed(*X[pr.body1]), c2.posed(*X[pr.body2])
             got, ref = compiled.cover_gap(a, b), covers.cover_gap(a, b)
             assert got == pytest.approx(ref, rel=0, abs=1e-12), pr.name

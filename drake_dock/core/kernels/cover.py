@@ -8,7 +8,7 @@ import math
 import numpy as np
 from numba import njit
 
-from drake_dock.core.covers import Cover, block_layout
+from drake_dock.core import covers
 from drake_dock.core.kernels.jets import jet, patch_spec
 
 
@@ -154,18 +154,19 @@ def cover_gap(a, b) -> float:
 
 
 def patch_cover(patch, n: int, block: int):
-    """`drake_dock.core.covers.patch_cover` from the compiled jets, or None for a patch no
-    kernel describes; kept on the patch."""
+    """`drake_dock.core.covers.patch_cover` from the compiled jets, or the reference's own for
+    a patch no kernel describes (a `Point`, say); kept on the patch."""
     cache = patch.__dict__.setdefault("_compiled_covers", {})
-    if (n, block) in cache:
-        return cache[(n, block)]
-    spec = patch_spec(patch)
-    hit = None
-    if spec is not None:
-        U, half, blocks = block_layout(patch, n, block)
-        centres, radii, normals, flat = cell_spheres(spec[0], spec[1], U, half)
-        hit = Cover.from_cells(centres, radii, blocks, normals, flat)
-    cache[(n, block)] = hit
+    hit = cache.get((n, block))
+    if hit is None:
+        spec = patch_spec(patch)
+        if spec is None:
+            hit = covers.patch_cover(patch, n, block)
+        else:
+            U, half, blocks = covers.block_layout(patch, n, block)
+            centres, radii, normals, flat = cell_spheres(spec[0], spec[1], U, half)
+            hit = covers.Cover.from_cells(centres, radii, blocks, normals, flat)
+        cache[(n, block)] = hit
     return hit
 
 

@@ -13,7 +13,6 @@ import heapq
 import numpy as np
 from scipy.optimize import brentq
 
-from drake_dock.core import covers
 from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.patches import posed
 from drake_dock.core.seeking import contact_couple, seek_couple
@@ -169,12 +168,10 @@ COVER_CELLS = {0: (1, 1), 1: (256, 16), 2: (32, 8)}
 
 
 def pair_covers(pr: PairSpec):
-    """The covers of a pair's two patches (`COVER_CELLS`), compiled where the patches have
-    kernel descriptions."""
+    """The covers of a pair's two patches (`COVER_CELLS`, `kernels.cover.patch_cover`)."""
     out = []
     for patch in (pr.patch1, pr.patch2):
-        cells = COVER_CELLS[patch.dim]
-        out.append(compiled_cover.patch_cover(patch, *cells) or covers.patch_cover(patch, *cells))
+        out.append(compiled_cover.patch_cover(patch, *COVER_CELLS[patch.dim]))
     return out
 
 
