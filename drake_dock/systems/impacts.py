@@ -150,10 +150,11 @@ class EventImpulses:
     def log(self, x, x_new):
         """Logs each impulse as an `Impact` with the states just before and just after it, the
         event having taken state x to x_new (a step-end sample is the state before the event;
-        its result is not seen by any step end). An event can solve two (an LZB impact, then
-        an impact without collision where the modes after it have no consistent one): the
-        first one's x_plus is the second's x_minus, with its pairs as the impact left them
-        (`left`, before the modes were selected); the last one's is the event's result."""
+        its result is not seen by any step end); the caller seals ``modes`` next. An event can
+        solve two (an LZB impact, then an impact without collision where the modes after it
+        have no consistent one): the first one's x_plus is the second's x_minus, with its pairs
+        as the impact left them (`left`, before the modes were selected); the last one's is the
+        event's result."""
         ev, modes = self.ev, self.modes
         x_minus = x.copy()
         for j, imp in enumerate(self.solved):
@@ -162,7 +163,9 @@ class EventImpulses:
                 x_plus[ev.nq:ev.nq + ev.nv] = imp.v_plus
                 pairs, loss = imp.pairs_plus, imp.impact_loss_plus
             else:
-                pairs, loss = tuple(copied_states(modes.pairs)), modes.impact_loss
+                # The states the event leaves: sealed with the modes `Transitions.resolve`
+                # returns, so shared, never changed.
+                pairs, loss = tuple(modes.pairs), modes.impact_loss
             modes.impacts.append(Impact(
                 self.t, imp.couples, imp.restitution, imp.normal_impulse,
                 imp.tangential_impulse, imp.energy_lost, imp.without_collision, x_minus, x_plus,

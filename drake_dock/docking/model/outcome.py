@@ -24,20 +24,29 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import numpy as np
+
 
 OUTCOMES = ("captured", "missed", "rebound", "jammed", "timeout")
 JAM_DISTANCE = 1e-3     # m: the progress that resets the jam clock
+
+
+def _floats(a) -> list:
+    """An array's entries as (nested lists of) Python floats."""
+    return np.asarray(a, dtype=float).tolist()
 
 
 def misalignment(R_t, p_t, R_c, p_c) -> tuple[float, float, float]:
     """The chaser ring's pose in the target ring's frame (rotation R_t, centre p_t; R_c, p_c the
     chaser's; the two docking axes face each other): the axial and the lateral offset of its
     centre (m) and the tilt between the axes (rad, atan2 of |z_t x -z_c| and z_t . -z_c).
-    Plain float arithmetic (it runs at every witness evaluation of a run)."""
-    (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = (tuple(map(float, row)) for row in R_t)
-    d0, d1, d2 = (float(c) - float(o) for c, o in zip(p_c, p_t))
-    (_, _, a0), (_, _, a1), (_, _, a2) = R_c
-    a0, a1, a2 = -float(a0), -float(a1), -float(a2)           # z_c: the chaser's axis reversed
+    Plain float arithmetic on the arrays' entries as floats (it runs at every witness
+    evaluation of a run)."""
+    (x0, y0, z0), (x1, y1, z1), (x2, y2, z2) = _floats(R_t)
+    (t0, t1, t2), (c0, c1, c2) = _floats(p_t), _floats(p_c)
+    d0, d1, d2 = c0 - t0, c1 - t1, c2 - t2
+    (_, _, a0), (_, _, a1), (_, _, a2) = _floats(R_c)
+    a0, a1, a2 = -a0, -a1, -a2                                 # z_c: the chaser's axis reversed
     cx, cy, cz = z1 * a2 - z2 * a1, z2 * a0 - z0 * a2, z0 * a1 - z1 * a0     # z_t x z_c
     tilt = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), z0 * a0 + z1 * a1 + z2 * a2)
     return (z0 * d0 + z1 * d1 + z2 * d2,
