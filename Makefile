@@ -29,8 +29,10 @@ $(BIN)/.notebook: $(BIN)/.installed
 notebook: $(BIN)/.notebook
 	$(BIN)/jupyter notebook $(if $(filter 0,$(shell id -u)),--allow-root) notebooks/tutorial.ipynb
 
+# Two pytest workers (pytest-xdist), a test file to each in turn: the suite is single-threaded
+# and the machines have two cores.
 test: $(BIN)/.installed
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 # tests/core in a virtual environment without Drake (numpy, scipy, numba, pytest, pyyaml only).
 test-core:
