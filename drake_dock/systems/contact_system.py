@@ -320,11 +320,6 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
                                                      self.side_pairs)
         return hit
 
-    def witness_epoch(self, context) -> int:
-        """Changes whenever an event has changed the state or the modes (a witness's history
-        from before it is not continued by its values after it)."""
-        return self.get_modes(context).mode_changes
-
     def _witness_value(self, context, i, code):
         """The value of pair i's witness of kind ``code`` (`engine.W_GAP` ...), computed by
         the evaluation (Drake evaluates every witness at both ends of every step)."""

@@ -15,20 +15,19 @@ bisection (to 0.95 w, inside the window) isolates it. The secant converges super
 steps. Events, their times and the integration's error control are Drake's own; only the
 maximum step size changes, and it returns to its configured value after each event.
 
-Sources are systems with ``witness_array(context)`` (the values of the witness functions
-they return now, all with direction positive-then-non-positive, as an array), ``witness_layout(
-context)`` (a value, compared with ==, that changes whenever the set of witnesses changes), and optionally
-``witness_epoch(context)``, which changes whenever an event changes their state or modes
-(values from different epochs are not joined by a secant), ``witness_rate_array(context)``
-(each witness's time derivative where the source knows it, NaN elsewhere: a couple's gap) and
-``witness_second_rate_array(context, mask)`` (second derivatives of the witnesses in ``mask``),
-and ``witness_target_leads(context)``: the time (s) from now at which a step should end, just
-past it, rather than isolate a witness (the source's transition is taken at the next step's
-start);
-those are also predicted by their Taylor parabola, the second derivative taken from the last
-two rates, or asked for at the first point of an epoch (just after an impact, where no history
-predicts the landing). The predictions are compiled (`drake_dock.core.kernels.leads`), over
-all witnesses at once.
+Sources are systems with ``witness_now(context)``, which returns a `WitnessNow` (epoch, layout,
+w, d, target): ``w`` the values of the witness functions they return now, all with direction
+positive-then-non-positive, as an array; ``layout`` a value, compared with ==, that changes
+whenever the set of witnesses changes; ``epoch`` a value that changes whenever an event changes
+their state or modes (values from different epochs are not joined by a secant); ``d`` each
+witness's time derivative where the source knows it, NaN elsewhere (a couple's gap); and
+``target`` the time (s) from now at which a step should end, just past it, rather than isolate
+a witness (the source's transition is taken at the next step's start; inf for none). A source
+with rates may also give ``witness_second_rate_array(context, mask)`` (second derivatives of
+the witnesses in ``mask``); those are also predicted by their Taylor parabola, the second
+derivative taken from the last two rates, or asked for at the first point of an epoch (just
+after an impact, where no history predicts the landing). The predictions are compiled
+(`drake_dock.core.kernels.leads`), over all witnesses at once.
 """
 import math
 
@@ -92,11 +91,7 @@ class WitnessApproach:
         hist = {}
         for s in self.sources:
             c = s.GetMyContextFromRoot(root)
-            epoch = s.witness_epoch(c) if hasattr(s, "witness_epoch") else 0
-            layout = s.witness_layout(c)
-            w = s.witness_array(c)
-            d = (s.witness_rate_array(c) if hasattr(s, "witness_rate_array")
-                 else np.full(len(w), np.nan))
+            epoch, layout, w, d, lead = s.witness_now(c)
             h = self._hist.get(id(s))
             if h is None or h.key[0] != epoch or (h.key[1] is not layout
                                                   and h.key[1] != layout):
@@ -105,12 +100,11 @@ class WitnessApproach:
             hist[id(s)] = h
             need = h.need
             best = min(best, earliest_zero(h.T, h.W, h.D, h.n, need))
-            if need.any():
+            if np.count_nonzero(need):
                 wdd = s.witness_second_rate_array(c, need)
                 for j in np.flatnonzero(need).tolist():
                     best = min(best, t + _lead_jet(float(w[j]), float(d[j]), float(wdd[j])))
-            if hasattr(s, "witness_target_leads"):
-                target = min(target, t + s.witness_target_leads(c))
+            target = min(target, t + lead)
         self._hist = hist
         return best, target
 

@@ -5,6 +5,7 @@ step-end target of the far pairs' seek at a step's start."""
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -45,6 +46,18 @@ class ArmedWitnesses:
         return cls(names, pair, code, any(i is None for i, _ in armed), gap, slot)
 
 
+class WitnessNow(NamedTuple):
+    """What a witness source gives `WitnessApproach` at a context (`drake_dock.systems.
+    stepping`): its ``epoch``, the ``layout`` of its armed witnesses, their values ``w``, their
+    rates ``d`` (NaN where unknown) and the step-end ``target`` (s from now, inf for none)."""
+
+    epoch: int
+    layout: tuple
+    w: np.ndarray
+    d: np.ndarray
+    target: float
+
+
 class WitnessPredictions:
     """The arrays a `RigidContactSystem` gives `WitnessApproach` (`drake_dock.systems.
     stepping` states what each method returns)."""
@@ -52,7 +65,9 @@ class WitnessPredictions:
     def armed_witnesses(self, context) -> "ArmedWitnesses":
         """The witnesses `DoGetWitnessFunctions` returns now as arrays (`ArmedWitnesses`),
         kept on the modes' index."""
-        modes = self.get_modes(context)
+        return self._armed_of(self.get_modes(context), context)
+
+    def _armed_of(self, modes, context) -> "ArmedWitnesses":
         derived = modes.index().derived
         hit = derived.get("armed_arrays")
         if hit is None:
@@ -60,43 +75,35 @@ class WitnessPredictions:
                                                               self.pairs)
         return hit
 
-    def witness_layout(self, context) -> tuple:
-        """The names of the armed witnesses (it changes whenever their set changes)."""
-        return self.armed_witnesses(context).names
-
-    def witness_array(self, context) -> np.ndarray:
-        """The values of the witnesses `DoGetWitnessFunctions` returns now, in the order of
-        `armed_witnesses` (the far pairs' first when armed; inf when far pairs are sought at
-        the step's start before their clearance is used up: `witness_target_leads` stands
-        for it)."""
+    def witness_now(self, context) -> WitnessNow:
+        """`WitnessNow` at the context, from its one evaluation:
+        - ``epoch``: the modes' mode changes (every event changes it);
+        - ``layout``: the armed witnesses' names (it changes whenever their set changes);
+        - ``w``: the values of the witnesses `DoGetWitnessFunctions` returns now, in the order
+          of `armed_witnesses` (the far pairs' first when armed; inf when far pairs are sought
+          at the step's start before their clearance is used up: ``target`` stands for it);
+        - ``d``: g' = v_n for the gap witnesses of the tracked couples while the gap is
+          positive, NaN elsewhere;
+        - ``target``: when a far pair is due a seek at a step's start (`_on_step`) at the
+          present rate of its travel bound; a step that ends there leaves the seek to the
+          next step's start, and no witness needs isolating."""
         E = self._cache.Eval(context)
-        a = self.armed_witnesses(context)
+        modes = self.get_modes(context)
+        a = self._armed_of(modes, context)
         w = E.wv.ravel().take(a.flat)
-        if not a.far:
-            return w
-        return np.concatenate([[E.far_witness if self.options.reseek_early <= 0 else math.inf],
-                               w])
-
-    def witness_target_leads(self, context) -> float:
-        """The step-end target of `WitnessApproach` (`drake_dock.systems.stepping`), s from
-        now: when a far pair is due a seek at a step's start (`_on_step`) at the present rate
-        of its travel bound; a step that ends there leaves the seek to the next step's start,
-        and no witness needs isolating."""
-        return self._cache.Eval(context).far_early
-
-    def witness_rate_array(self, context) -> np.ndarray:
-        """The time derivative of each witness of `witness_array` where known, NaN elsewhere:
-        g' = v_n for the gap witnesses of the tracked couples."""
-        E = self._cache.Eval(context)
-        a = self.armed_witnesses(context)
         d = a.no_rates.copy()
-        # The impact witness is the gap while positive: its rate v_n; otherwise unknown.
-        out = E.out.ravel()
-        d[a.gap] = np.where(out.take(a.g_flat) > 0.0, out.take(a.gap_flat), np.nan)
-        return np.concatenate([[np.nan], d]) if a.far else d
+        if a.g_flat.size:
+            # The impact witness is the gap while positive: its rate v_n; otherwise unknown.
+            out = E.out.ravel()
+            g, vn = out.take(a.g_flat), out.take(a.gap_flat)
+            d[a.gap] = np.where(g > 0.0, vn, np.nan)
+        if a.far:
+            far = E.far_witness if self.options.reseek_early <= 0 else math.inf
+            w, d = np.concatenate([[far], w]), np.concatenate([[np.nan], d])
+        return WitnessNow(modes.mode_changes, a.names, w, d, E.far_early)
 
     def witness_second_rate_array(self, context, mask) -> np.ndarray:
-        """Second time derivatives of the witnesses of `witness_array` in ``mask`` (gap
+        """Second time derivatives of the witnesses of `WitnessNow.w` in ``mask`` (gap
         witnesses of tracked couples), g'' = W^3 . v' + b_n (Eq. 52) at the evaluation's
         accelerations: a couple leaving an impact has no history in the new epoch from which
         `WitnessApproach` could predict its landing. NaN elsewhere."""
@@ -113,14 +120,13 @@ class WitnessPredictions:
 
     def witness_values(self, context) -> dict:
         """The values of the witnesses `DoGetWitnessFunctions` returns now, by description."""
-        return dict(zip(self.armed_witnesses(context).names,
-                        self.witness_array(context).tolist()))
+        now = self.witness_now(context)
+        return dict(zip(now.layout, now.w.tolist()))
 
     def witness_rates(self, context) -> dict:
-        """`witness_rate_array` by description, the known rates only."""
-        names = self.armed_witnesses(context).names
-        return {n: r for n, r in zip(names, self.witness_rate_array(context).tolist())
-                if not math.isnan(r)}
+        """`WitnessNow.d` by description, the known rates only."""
+        now = self.witness_now(context)
+        return {n: r for n, r in zip(now.layout, now.d.tolist()) if not math.isnan(r)}
 
     def witness_second_rates(self, context, names) -> dict:
         """`witness_second_rate_array` by description, for the witnesses ``names``."""

@@ -7,6 +7,8 @@ event ends the simulation (`EventStatus.ReachedTermination`), so the capture tim
 the witness isolation accuracy."""
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from pydrake.systems.framework import (EventStatus, LeafSystem, PublishEvent,
                                        WitnessFunctionDirection)
@@ -14,6 +16,10 @@ from pydrake.systems.framework import (EventStatus, LeafSystem, PublishEvent,
 from drake_dock.core.kernels.free_bodies import frame_poses
 from drake_dock.docking.model.outcome import CaptureRule, misalignment
 from drake_dock.docking.model.plant import DockingPlant
+from drake_dock.systems.witness_source import WitnessNow
+
+_LAYOUT = ("capture",)
+_NO_RATE = np.full(1, np.nan)
 
 
 def ring_poses(dp: DockingPlant, plant_context):
@@ -88,8 +94,8 @@ class CaptureMonitor(LeafSystem):
     def witness_values(self, context) -> dict:
         return {"capture": self.to_go(context) - self.rule.axial}
 
-    def witness_layout(self, context):
-        return ("capture",)
-
-    def witness_array(self, context):
-        return np.array([self.to_go(context) - self.rule.axial])
+    def witness_now(self, context) -> WitnessNow:
+        """Its one witness for `WitnessApproach` (`drake_dock.systems.stepping`): one epoch, no
+        known rate, no step-end target."""
+        return WitnessNow(0, _LAYOUT, np.array([self.to_go(context) - self.rule.axial]),
+                          _NO_RATE, math.inf)
