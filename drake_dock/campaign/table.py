@@ -20,6 +20,7 @@ import pyarrow.parquet as pq
 
 from drake_dock.campaign.progress import ORDER
 from drake_dock.campaign.report import wilson
+from drake_dock.campaign.sample import RESULT_COLUMNS
 from drake_dock.campaign.store import atomic_write
 from drake_dock.errors import DrakeDockError, InputError
 
@@ -36,19 +37,26 @@ def read_rows(path) -> list[dict]:
                          "or a .parquet or .csv file of its rows")
     if path.suffix == ".csv":
         with open(path, newline="") as f:
-            return [{k: _cell(v) for k, v in row.items()} for row in csv.DictReader(f)]
+            return [{k: _cell(path, n, k, v) for k, v in row.items()}
+                    for n, row in enumerate(csv.DictReader(f), start=2)]
     return pq.read_table(path).to_pylist()
 
 
-def _cell(text: str):
+# The CSV's column types as the store's schema has them (`store.schema`): the sample and its
+# seed, the result columns, and every other column a varied input (a float).
+_CSV_TYPES = {"sample": int, "seed": int, **RESULT_COLUMNS}
+
+
+def _cell(path, line: int, column: str, text: str):
+    """A CSV cell as its column's type (`write_rows_csv`: an empty cell is None)."""
     if text == "":
         return None
-    for kind in (int, float):
-        try:
-            return kind(text)
-        except ValueError:
-            pass
-    return text
+    kind = _CSV_TYPES.get(column, float)
+    try:
+        return kind(text)
+    except ValueError:
+        raise InputError(f"{path} line {line}, column {column}", text,
+                         f"{'an integer' if kind is int else 'a number'} or an empty cell")
 
 
 def write_rows_csv(rows: list[dict]) -> bytes:

@@ -73,6 +73,25 @@ def test_the_rows_csv_round_trips_every_float_and_drops_the_wall_time(tmp_path):
     assert T.column(back) == T.column(rows)
 
 
+def test_the_rows_csv_reads_each_column_as_its_schema_type(tmp_path):
+    """Text that reads as a number stays text in a text column, and a cell that is not of its
+    column's type is an InputError naming the file's line and column (the store's schema, not
+    a guess from the cell)."""
+    rows = _rows()
+    rows[0]["reason"], rows[1]["error"], rows[2]["outcome"] = "404", "nan", "1e3"
+    path = tmp_path / "rows.csv"
+    assert T.main(["export", str(_parquet(rows, tmp_path)), str(path)]) == 0
+    back = T.read_rows(path)
+    assert (back[0]["reason"], back[1]["error"], back[2]["outcome"]) == ("404", "nan", "1e3")
+    text = path.read_text().splitlines()
+    header = text[0].split(",")
+    cells = text[3].split(",")
+    cells[header.index("impacts")] = "3.5"
+    path.write_text("\n".join(text[:3] + [",".join(cells)] + text[4:]) + "\n")
+    with pytest.raises(InputError, match="line 4, column impacts = '3.5'.*an integer"):
+        T.read_rows(path)
+
+
 def _parquet(rows, tmp_path):
     import pyarrow as pa
     import pyarrow.parquet as pq
