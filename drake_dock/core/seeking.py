@@ -40,17 +40,6 @@ class Couple:
         return np.concatenate([self.u1, self.u2])
 
 
-def _domain(patch, n):
-    """(lower, upper, periodic, the coarse grid of n points per parameter) of a patch as the
-    kernels take them (writable, C-ordered: one compiled signature), kept on it."""
-    cache = patch.__dict__.setdefault("_kernel_domain", {})
-    hit = cache.get(n)
-    if hit is None:
-        hit = cache[n] = (np.array(patch.lower, dtype=float), np.array(patch.upper, dtype=float),
-                          np.array(patch.periodic), np.array(patch.grid_points(n)[0]))
-    return hit
-
-
 def _pose(P):
     """A posed patch's R and p as writable C-ordered copies (one compiled signature whatever
     the caller's arrays)."""
@@ -96,12 +85,12 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
     R2, o2 = _pose(P2)
     rtol = -1.0 if distance_rtol is None else float(distance_rtol)
     if pa.dim == 1:
-        D1, D2 = _domain(pa, n_coarse), _domain(pb, n_coarse)
+        D1, D2 = K.patch_domain(pa, n_coarse), K.patch_domain(pb, n_coarse)
         return _seek_curve(k1, q1, R1, o1, D1, k2, q2, R2, o2, D2, levels, n_fine, candidates,
                            rtol, float(rtol_beyond))
     if pb.dim == 1:
         x = R1 @ pa.p + o1
-        s, it, x2, concave = K.point_curve(x, k2, q2, R2, o2, *_domain(pb, POINT_CURVE_GRID),
+        s, it, x2, concave = K.point_curve(x, k2, q2, R2, o2, *K.patch_domain(pb, POINT_CURVE_GRID),
                                            POINT_CURVE_ITER)
         # A potential contact only on the curve's concave side (docs/model.md, "The petal
         # corner").
@@ -109,7 +98,7 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
         interior = concave and is_interior(pb, u2)
     else:
         u2, it, status, x, x2, interior = K.point_surface(
-            q1, R1, o1, k2, q2, R2, o2, *_domain(pb, POINT_SURFACE_GRID), rtol,
+            q1, R1, o1, k2, q2, R2, o2, *K.patch_domain(pb, POINT_SURFACE_GRID), rtol,
             float(rtol_beyond))
     centre = float(np.linalg.norm(x - x2))
     if status and centre > K.CREEP_TOUCH:
