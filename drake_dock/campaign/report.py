@@ -37,7 +37,7 @@ def stats(values) -> dict | None:
             "max": float(v.max()), "samples": int(v.size)}
 
 
-def sample_values(row: dict, fields) -> dict:
+def row_values(row: dict, fields) -> dict:
     """The sample's {path: value} read back from its row's input columns."""
     out = {}
     for f in fields:
@@ -80,7 +80,7 @@ def summarize(rows: list[dict], plan, fields, base, root, out_text: str) -> dict
     (root / "worst").mkdir(exist_ok=True)
     for row, why in worst_samples(rows):
         name = f"sample_{row['sample']:07d}"
-        scenario = sample_scenario(base, sample_values(row, fields))
+        scenario = sample_scenario(base, row_values(row, fields))
         atomic_write(root / "worst" / f"{name}.yaml",
                      (f"# campaign sample {row['sample']}: {why}\n" + yaml_dump_typed(scenario))
                      .encode())

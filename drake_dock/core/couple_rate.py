@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from drake_dock.core.couple import evaluate_couple
+from drake_dock.core.relations import kind_of
 from drake_dock.errors import SingularCoupleError
 
 
@@ -25,7 +26,7 @@ def couple_rate(P1, P2, u1, u2, twist1, twist2, *, kind=None, conditioning_min=1
 
     Raises `SingularCoupleError` when J's conditioning (|det J| / product of its row norms)
     falls below ``conditioning_min``."""
-    kind = kind or ("CC" if P2.patch.dim == 1 else "CS")
+    kind = kind or kind_of(P1.patch.dim, P2.patch.dim)
     u = np.concatenate([np.atleast_1d(u1), np.atleast_1d(u2)]).astype(float)
     ev = evaluate_couple(kind, P1.patch, (P1.R, P1.p), twist1, P2.patch, (P2.R, P2.p), twist2,
                          u, 1.0, project=False)

@@ -56,3 +56,13 @@ def relation(kind: str) -> Relation:
         return RELATIONS[kind]
     except (KeyError, TypeError):
         raise ValueError(f"pair kind: one of {', '.join(RELATIONS)}, got {kind!r}") from None
+
+
+def kind_of(dim1: int, dim2: int) -> str:
+    """The pair kind of patches of dimensions dim1 and dim2 (`Relation.dims`); ValueError for
+    dimensions no relation has."""
+    for r in RELATIONS.values():
+        if r.dims == (dim1, dim2):
+            return r.kind
+    raise ValueError(f"pair kind: no relation between patches of dimensions {dim1} and {dim2} "
+                     f"(allowed: {', '.join(str(r.dims) for r in RELATIONS.values())})")

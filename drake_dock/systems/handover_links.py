@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from drake_dock.core import handover as rule
+from drake_dock.core.relations import relation
 
 
 class HandoverLinks:
@@ -22,7 +23,8 @@ class HandoverLinks:
                     raise ValueError(f"handovers: no pair named {name!r}")
             i, j = index[h.edge_pair], index[h.surface_pair]
             e, s = pairs[i], pairs[j]
-            if (e.kind, s.kind) != ("CC", "CS") or e.patch1 is not s.patch1 \
+            if (relation(e.kind).dims, relation(s.kind).dims) != ((1, 1), (1, 2)) \
+                    or e.patch1 is not s.patch1 \
                     or e.frame1 is not s.frame1 or e.frame2 is not s.frame2:
                 raise ValueError(f"handovers[{h.edge_pair}, {h.surface_pair}]: must be a C-C "
                                  f"and a C-S pair with the same curve on the same frames")

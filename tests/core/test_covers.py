@@ -19,7 +19,7 @@ from drake_dock.core.seeking import seek_couple
 from drake_dock.docking.geometry.pairs import CHASER_APDS
 from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.placement.search import Approach
-from drake_dock.docking.placement.search import COVER_CELLS, touch_steps, travel_grid
+from drake_dock.docking.placement.search import COVER_CELLS, pair_touch_steps, travel_grid
 from drake_dock.docking.scenario.dimensions import ApdsGeometry
 
 
@@ -75,7 +75,7 @@ def test_compiled_touch_steps_equal_the_reference(approach):
     g = ApdsGeometry()
     pairs = DockingScene(g, "paper").pairs
     grid = np.array(travel_grid(g, approach))
-    got = touch_steps(pairs, approach, grid)
+    got = pair_touch_steps(pairs, approach, grid)
     for j, pr in enumerate(pairs):
         np.testing.assert_array_equal(got[j], covers.touch_steps(*_posed_covers(pr, approach),
                                                                  grid), pr.name)
@@ -134,7 +134,7 @@ def test_bound_lies_below_the_seek_distance():
     approach = APPROACHES[0]
     pairs = DockingScene(g, "paper").pairs
     grid = np.array(travel_grid(g, approach))[::3]
-    touched = touch_steps(pairs, approach, grid)
+    touched = pair_touch_steps(pairs, approach, grid)
     for j, pr in enumerate(pairs):
         moving, fixed, e = _posed_covers(pr, approach)
         for k, lam in enumerate(grid):

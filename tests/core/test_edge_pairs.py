@@ -248,13 +248,13 @@ def test_tip_arcs_face_the_surfaces_their_pairs_name(geom):
     """A tip arc has a pair with a guide surface of the other APDS exactly when, at some
     relative roll in the scenario's range (-60 to 60 deg), a point of the arc lies over the
     surface's angular span at its base, the widest (Eq. 13): sampled rolls and arc points."""
-    from drake_dock.docking.placement.search import relative_pose
+    from drake_dock.docking.placement.search import coaxial_pose
     P = apds_patches(geom)
     names = {p.name for p in DockingScene(geom, "complete").pairs if p.name.startswith("cs_") and
              "tip" in p.name}
     reach = set()
     for yaw in np.radians(np.linspace(-60.0, 60.0, 241)):
-        R = relative_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
+        R = coaxial_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
         for x, y, turn in (("C", "T", R), ("T", "C", R.T)):
             for j in (1, 2, 3):
                 tip = P.tips[j]
@@ -272,13 +272,13 @@ def test_corners_reach_the_surfaces_their_pairs_name(geom):
     when, at some relative roll in the scenario's range (-60 to 60 deg), the corner lies over
     the surface's angular span at its base (sampled rolls): a second rule beside the code's
     (the corner's azimuth at the matched facing within 70 deg of the span)."""
-    from drake_dock.docking.placement.search import relative_pose
+    from drake_dock.docking.placement.search import coaxial_pose
     P = apds_patches(geom)
     names = {p.name for p in DockingScene(geom, "complete").pairs if p.kind == "PS"
              and "tip" not in p.name}
     reach = set()
     for yaw in np.radians(np.linspace(-60.0, 60.0, 241)):
-        R = relative_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
+        R = coaxial_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
         for x, y, turn in (("C", "T", R), ("T", "C", R.T)):
             for i in range(1, 7):
                 c = turn @ corner_point(geom, i)
@@ -294,13 +294,13 @@ def test_corners_come_over_the_tip_lands_their_pairs_name(geom):
     relative roll strictly inside the scenario's range (sampled rolls, -59.9 to 59.9 deg), the
     corner lies over the tip arc's span: a second rule beside the code's (`LAND_REACH`). Each
     corner comes over one tip, from a roll of 2 theta_end on (closed form)."""
-    from drake_dock.docking.placement.search import relative_pose
+    from drake_dock.docking.placement.search import coaxial_pose
     P = apds_patches(geom)
     names = {p.name for p in DockingScene(geom, "complete").pairs
              if p.kind == "PS" and "tip" in p.name}
     reach, first = set(), {}
     for yaw in np.radians(np.linspace(-59.9, 59.9, 1199)):
-        R = relative_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
+        R = coaxial_pose(yaw, 0.0)[0]               # chaser APDS frame in the target's
         for x, y, turn in (("C", "T", R), ("T", "C", R.T)):
             for i in range(1, 7):
                 c = turn @ corner_point(geom, i)
@@ -329,14 +329,14 @@ def test_sides_reach_the_edges_their_pairs_name(geom):
     offset): sampled rolls and curve points. These are the sides 60 deg from the partner and
     the tip arcs 30 and 90 deg from the side's root."""
     from drake_dock.docking.geometry.pairs import CC_SIDE_PAIRS
-    from drake_dock.docking.placement.search import relative_pose
+    from drake_dock.docking.placement.search import coaxial_pose
     P = apds_patches(geom)
     names = {p.name for p in DockingScene(geom, "complete").pairs[12:]
              if p.name.startswith("cc_") and "ring" not in p.name and "rim" not in p.name
              and not p.name.startswith("cc_Ctip")}
     margin = math.radians(10.0)
     rolls = np.radians(np.linspace(-60.0, 60.0, 241))
-    R = {roll: relative_pose(roll, 0.0)[0] for roll in rolls}    # the chaser's frame
+    R = {roll: coaxial_pose(roll, 0.0)[0] for roll in rolls}    # the chaser's frame
     near = lambda a, b: bool((np.abs((a[:, None] - b[None, :] + math.pi) % (2 * math.pi)
                                      - math.pi) < margin).any())
     reach = set()
@@ -413,7 +413,7 @@ def test_tip_tip_pairs_follow_the_closed_form(geom):
     closed-form couple and distance to 1e-12, the normal is along the
     axis, and u* integrated by Eq. (47) along a motion (the chaser closing at 0.05 m/s and
     drifting sideways at 0.02 m/s) equals the closed form to 1e-8."""
-    from drake_dock.docking.placement.search import relative_pose
+    from drake_dock.docking.placement.search import coaxial_pose
     P = apds_patches(geom)
     pairs = [p for p in DockingScene(geom, "complete").pairs if p.name.startswith("cc_Ctip")]
     assert len(pairs) == 6
@@ -423,7 +423,7 @@ def test_tip_tip_pairs_follow_the_closed_form(geom):
         while True:
             roll = math.radians(rng.uniform(-60.0, 60.0))
             c0 = rng.uniform(-0.1, 0.1, 2)
-            R, _ = relative_pose(roll, 0.0)
+            R, _ = coaxial_pose(roll, 0.0)
             pose = lambda t: (R, np.array([c0[0] + 0.02 * t, c0[1], 0.43 - 0.05 * t]))
             if all(len(_tip_tip_exact(geom, P.tips, j, k, *pose(t))) == 1
                    for t in np.linspace(0.0, 0.5, 6)):

@@ -6,7 +6,7 @@ import pytest
 
 from drake_dock.core.couple import evaluate_couple
 from drake_dock.core.patches import PlaneRect, Point, Segment
-from drake_dock.core.relations import RELATIONS, relation
+from drake_dock.core.relations import RELATIONS, kind_of, relation
 
 PATCHES = {0: Point(np.zeros(3), 0.01), 1: Segment(np.zeros(3), np.array([1.0, 0.0, 0.0])),
            2: PlaneRect(np.zeros(3), np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))}
@@ -30,6 +30,18 @@ def test_each_kind_takes_its_patches_and_no_others(kind):
             with pytest.raises(ValueError, match="dimensions"):
                 evaluate_couple(kind, PATCHES[w1], AT, STILL, PATCHES[w2], AT, STILL,
                                 np.zeros(w1 + w2), 1.0)
+
+
+def test_the_kind_of_two_patches_dimensions_is_the_relation_that_takes_them():
+    """kind_of inverts Relation.dims, and the patches a relation takes have those dimensions
+    (a point 0, a segment 1, a rectangle 2); dimensions no relation has are refused."""
+    shapes = {0: Point((0.0, 0.0, 0.0)), 1: Segment((0, 0, 0), (1, 0, 0)),
+              2: PlaneRect((0, 0, 0), (1, 0, 0), (0, 1, 0))}
+    for kind, r in RELATIONS.items():
+        assert kind_of(shapes[r.dims[0]].dim, shapes[r.dims[1]].dim) == kind
+    for dims in ((2, 2), (2, 1), (1, 0), (0, 0)):
+        with pytest.raises(ValueError, match=f"dimensions {dims[0]} and {dims[1]}"):
+            kind_of(*dims)
 
 
 def test_sigma_by_hand():

@@ -404,7 +404,7 @@ def test_lockstep_marches_find_the_full_marches_closings(seed):
     pairs = DockingScene(g, "complete").pairs
     grid = travel_grid(g, approach)
     k = max(i for i in range(len(grid) - 1) if grid[i] >= lam_c)
-    touch = search.touch_steps(pairs, approach, grid)
+    touch = search.pair_touch_steps(pairs, approach, grid)
     gaps = search._Gaps(pairs, approach, grid)
     marched = [j for j in np.flatnonzero(touch[:, k])
                if not (0 < gaps.gap(j, k) < np.inf and gaps.gap(j, k + 1) <= 0)

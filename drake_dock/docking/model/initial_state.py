@@ -16,3 +16,6 @@ class InitialState:
     d0: float                  # initial ring-face distance
     closing_pairs: list
     contact_offset: tuple = (0.0, 0.0)   # the ring centre's lateral offset at first contact
+    # The `DockingScene` the placement found it in (`simulate` builds its Diagram on it when
+    # it is the scenario's; not compared).
+    scene: object = dataclasses.field(default=None, compare=False, repr=False)

@@ -22,6 +22,7 @@ import numpy as np
 from pydrake.systems.analysis import Simulator, SimulatorStatus
 
 from drake_dock.core.hybrid import Mode
+from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.model.diagram import DiagramSpec, DockingDiagram, build_docking_diagram
 from drake_dock.docking.model.initial_state import InitialState
 from drake_dock.docking.model.outcome import OutcomeWatch, progress_fraction
@@ -206,6 +207,16 @@ def _couples_in_play(dd: DockingDiagram, root) -> list:
         return []
 
 
+def _scene_of(scenario, state):
+    """The state's `DockingScene` where it is the scenario's (its geometry and pair set), else
+    None (`DiagramSpec.of` makes the scenario's)."""
+    scene = state.scene
+    if scene is not None and scene.key == DockingScene.key_of(scenario.geometry,
+                                                              scenario.contact.pairs):
+        return scene
+    return None
+
+
 def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
              progress=None, duration: float | None = None,
              witness_approach: bool = True) -> RunResult:
@@ -216,9 +227,11 @@ def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
     system's typed errors (`NumericalError`), and any other failure of the integration as a
     `NumericalError` with the time and the couples in play. ``witness_approach`` shortens the
     steps before predicted witness zeros (`drake_dock.systems.stepping.WitnessApproach`); off,
-    Drake's plain isolation is used."""
+    Drake's plain isolation is used. A Diagram built here is built on the state's scene
+    (`InitialState.scene`) where that is the scenario's, so the scene is made once."""
     with numerical_failure("the Diagram's set-up", lambda: (0.0, ())):
-        dd = dd or build_docking_diagram(DiagramSpec.of(scenario))
+        dd = dd or build_docking_diagram(DiagramSpec.of(scenario, scene=_scene_of(scenario,
+                                                                                  state)))
         rec = _Recorder(dd)
         sim = docking_simulator(dd, state, scenario.simulator_config)
     t_end = scenario.simulation.duration if duration is None else duration

@@ -89,7 +89,7 @@ def _placed(scenario, cache) -> InitialState:
         V_WB={"target": (zero, zero), "target_apds": (zero, zero), "chaser": (w_WC, v_WC)},
         d_contact=d_c, d0=d0, closing_pairs=closing,
         contact_offset=tuple((np.array(approach.aim) - approach.height(d_c) * np.array(
-            ic.lateral_velocity) / ic.chaser_speed).tolist()))
+            ic.lateral_velocity) / ic.chaser_speed).tolist()), scene=cache.scene)
 
 
 def contact_approach(scenario, cache: PlacementCache | None = None):

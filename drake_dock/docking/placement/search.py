@@ -15,6 +15,7 @@ from scipy.optimize import brentq
 
 from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.patches import posed
+from drake_dock.core.relations import relation
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.docking.geometry.pairs import CHASER_APDS, R_MATCHED, TARGET_APDS, PairSpec
 from drake_dock.docking.geometry.rotations import rot_vec, rot_z
@@ -23,7 +24,7 @@ from drake_dock.errors import SeekingError
 from drake_dock.systems.contact_types import ContactOptions
 
 
-def relative_pose(yaw_rad: float, d: float):
+def coaxial_pose(yaw_rad: float, d: float):
     """Pose (R, p) of the chaser APDS in the target APDS frame: coaxial, ring faces d apart,
     the target (with its APDS) turned by yaw about the axis from the matched facing."""
     return rot_z(-yaw_rad) @ R_MATCHED, np.array([0.0, 0.0, d])
@@ -44,7 +45,7 @@ class Approach:
 
     @functools.cached_property
     def _rotation(self):
-        R = relative_pose(self.yaw, 0.0)[0]
+        R = coaxial_pose(self.yaw, 0.0)[0]
         return rot_vec((*self.tilt, 0.0)) @ R if self.tilt != (0.0, 0.0) else R
 
     def pose(self, lam: float):
@@ -83,7 +84,7 @@ def first_contact(cache, approach: Approach, *, among=None, stop=None,
     ``approach`` from far away, and the pairs that close with it. The search
     steps the ring-face distance by 1 cm, or by 1/100 of its start distance for a larger APDS
     (H > 0.475 m), so that it takes at most about 100 steps (``step``: another step of lam); a
-    pair is sought only at the ends of the steps its patches can touch in (`touch_steps`), and
+    pair is sought only at the ends of the steps its patches can touch in (`pair_touch_steps`), and
     marched through a step whose travel its couple comes within
     (`march_root`); roots to ``xtol``.
 
@@ -175,7 +176,7 @@ def pair_covers(pr: PairSpec):
     return out
 
 
-def touch_steps(pairs, approach: Approach, grid):
+def pair_touch_steps(pairs, approach: Approach, grid):
     """Booleans (pairs, steps): the covers of pair j's patches can touch between grid[k] and
     grid[k + 1] (`drake_dock.core.covers.touch_steps`); elsewhere the pair is apart."""
     return _TouchSteps(pairs, approach, grid).chunk(0, len(grid) - 1)
@@ -187,7 +188,7 @@ TOUCH_CHUNK = 32
 
 
 class _TouchSteps:
-    """`touch_steps` of a search's grid, found on demand: its first `TOUCH_CHUNK` steps, then
+    """`pair_touch_steps` of a search's grid, found on demand: its first `TOUCH_CHUNK` steps, then
     the rest. A step's booleans depend on the grid only through that step's ends, so a
     chunk's are the whole grid's."""
 
@@ -254,7 +255,7 @@ def seek_gaps(pairs, approach, d, refs):
             dirs.append(None)
             continue
         v = cp.p1 - cp.p2
-        if pr.sigma is not None and pr.kind == "CS":
+        if pr.sigma is not None and relation(pr.kind).dims == (1, 2):
             # A declared side (a ring's face, solid on one side): the side of the surface's
             # normal sigma N the curve's point lies on, as the contact system takes it.
             T = posed(pr.patch2, *poses[pr.body2]).first(cp.u2)
