@@ -1,0 +1,392 @@
+"""The numbers docs/results.md's prose quotes from the committed outputs under docs/, against
+those outputs: the stability study's `docs/stability_summary.txt`, the funnel study's
+`docs/funnel.csv` (with the shipped plan read from `drake_dock/studies/funnel.py`'s source),
+the two campaigns' `docs/campaign_paper.csv` and `docs/campaign_funnel.csv`, and the
+crosscheck's `docs/crosscheck.csv`.
+
+`make docs` rewrites those files; the prose around them is copied by hand. Each quoted number
+is found by a short literal phrase of its section (`{}` a number, `{w}` a name), which must
+occur there exactly once, so a reworded sentence fails here naming the phrase. Each is then
+compared, at the precision it is quoted with (2.2e-6: two significant digits; 0.26: two
+decimals), with the value computed from the file the way the prose describes it. The
+headline table, the campaign table and the pair counts have their own tests
+(tests/docking/test_paper_example.py, tests/campaign/test_campaign_table.py,
+tests/docking/test_doc_counts.py). Nothing here needs Drake: the files are read with csv."""
+import ast
+import csv
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.stats import binomtest
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+RESULTS = (DOCS / "results.md").read_text()
+NUM = r"([-+]?\d[\d,]*(?:\.\d+)?(?:e[-+]?\d+)?)"
+WORD = r"([\w*]+)"
+
+
+def section(title: str) -> str:
+    """The text of results.md's section ``## title``, up to the next ``## ``."""
+    m = re.search(rf"^## {re.escape(title)}\n(.*?)(?=^## |\Z)", RESULTS, flags=re.M | re.S)
+    assert m, f"docs/results.md has no section '## {title}'"
+    return m.group(1)
+
+
+def _regex(phrase: str) -> str:
+    parts = re.split(r"(\{w?\})", phrase)
+    return "".join(NUM if p == "{}" else WORD if p == "{w}"
+                   else re.escape(p).replace(r"\ ", r"\s+") for p in parts)
+
+
+def agrees(quoted: str, value) -> bool:
+    """Whether ``value`` rounds to the number quoted, at the quoted precision; a name or a
+    bool equals its text."""
+    if isinstance(value, (str, bool)):
+        return quoted == str(value)
+    q = quoted.replace(",", "").lstrip("+")
+    mantissa, e, _ = q.lower().partition("e")
+    digits = len(mantissa.partition(".")[2])
+    return float(f"{value:.{digits}{'e' if e else 'f'}}") == float(q)
+
+
+class Quotes:
+    """Collects the disagreements of one section's quoted numbers, to report them together."""
+
+    def __init__(self, title: str):
+        self.title, self.text, self.bad, self.checked = title, section(title), [], 0
+
+    def check(self, phrase: str, *values):
+        """The phrase occurs once in the section and its numbers are ``values``."""
+        found = re.findall(_regex(phrase), self.text)
+        if len(found) != 1:
+            self.bad.append(f"'{phrase}' occurs {len(found)} times in '## {self.title}', "
+                            "not once: reworded? check its numbers against the output again")
+            return
+        if not values:
+            return
+        quoted = found[0] if isinstance(found[0], tuple) else (found[0],)
+        assert len(quoted) == len(values), phrase
+        for q, v in zip(quoted, values):
+            self.checked += 1
+            if not agrees(q, v):
+                self.bad.append(f"'{phrase}': quoted {q}, the output gives {v!r}")
+
+    def done(self):
+        assert not self.bad, "\n".join(self.bad)
+
+
+def _num(text: str):
+    """A CSV cell: None if empty, a number where it is one, else the text."""
+    if text == "":
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def read_csv(name: str) -> list[dict]:
+    with open(DOCS / name, newline="") as f:
+        return [{k: _num(v) for k, v in row.items()} for row in csv.DictReader(f)]
+
+
+def wilson(k: int, n: int):
+    ci = binomtest(k, n).proportion_ci(confidence_level=0.95, method="wilson")
+    return ci.low, ci.high
+
+
+# 1. Stability where methods fail: docs/stability_summary.txt ---------------------------------
+STABILITY = (DOCS / "stability_summary.txt").read_text()
+
+
+def _summary(pattern: str) -> tuple:
+    m = re.search(pattern, STABILITY)
+    assert m, f"docs/stability_summary.txt has no line matching {pattern!r}"
+    return m.groups()
+
+
+def test_stability_numbers_are_the_summary_files():
+    s = Quotes("Stability where methods fail")
+    sawtooth, top_step = _summary(r"drake_dock at most (\S+) at output steps up to (\S+) s")
+    s.check("Its index is at most {} at output steps (step caps) from 1e-3 to {} s",
+            float(sawtooth), float(top_step))
+    lo, hi, lzb = _summary(r"stiffness ratio (\S+?e[-+]\d+)-(\S+): LZB within (\S+) of")
+    s.check("contact stiffness ratio K2/K1 from {} to {}.", float(lo), float(hi))
+    s.check("DOP853) within {} over the whole range", float(lzb))
+    mu_c, k, n = _summary(r"mu_c = (\S+);.*\((\d+) of (\d+) values\)")
+    s.check("consistent only for mu < mu_c = {}.", float(mu_c))
+    s.check("for the {} of {} values there", int(k), int(n))
+    captures = re.findall(r"docking at mu = (\S+): captured at (\S+) s", STABILITY)
+    assert len(captures) == 4, captures
+    s.check("It captures at {}, {}, {} and {} s for mu = {}, {}, {} and {}.",
+            *[float(t) for _, t in captures], *[float(mu) for mu, _ in captures])
+    grazing, = _summary(r"\(d\) grazing: impacts detected for delta < 0 only: (\w+)")
+    assert grazing == "True", "the summary no longer finds impacts for delta < 0 only"
+    s.check("For delta >= +1e-9 m there is no impact.")
+    zeno, max_impacts, couple = _summary(r"closed form: (\w+); guard off: more than "
+                                         r"max_impacts = (\d+) impacts \[.*couples (\w+)\]")
+    assert zeno == "True", "the summary's Zeno impact counts no longer equal the closed form"
+    s.check("the number of impacts equals the closed form")
+    s.check("at `max_impacts` ({}), naming the couple (`{w}`) and the time of the {}th impact",
+            int(max_impacts), couple, int(max_impacts) + 1)
+    s.done()
+    # The headline table repeats case (c)'s capture time at mu = 0.1.
+    h = Quotes("The paper's example (Sect. 8.2)")
+    h.check("| capture (axial ring-centre distance 5 mm) | t = {} s |",
+            float(dict(captures)["0.1"]))
+    h.done()
+
+
+# 2. The funnel: docs/funnel.csv and the shipped plan -----------------------------------------
+def shipped_plan() -> dict:
+    """`FunnelPlan.shipped()`'s fields, read from funnel.py's source (importing it needs
+    Drake): the class's defaults, with the keywords `shipped` passes."""
+    tree = ast.parse((ROOT / "drake_dock" / "studies" / "funnel.py").read_text())
+    cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "FunnelPlan")
+    plan = {n.target.id: ast.literal_eval(n.value) for n in cls.body
+            if isinstance(n, ast.AnnAssign)}
+    shipped = next(n for n in cls.body if isinstance(n, ast.FunctionDef) and n.name == "shipped")
+    call = next(n for n in ast.walk(shipped) if isinstance(n, ast.Call))
+    plan.update({k.arg: ast.literal_eval(k.value) for k in call.keywords})
+    return plan
+
+
+def probes(found: float, hi: float, steps: int) -> list:
+    """The offsets `funnel.capture_range` tries on [0, hi] when it finds ``found``, the
+    coaxial run capturing (as the prose says): 0, hi, then the halvings."""
+    tried = [0.0, hi]
+    if found >= hi - 1e-12:
+        return tried
+    lo = 0.0
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        tried.append(mid)
+        lo, hi = (mid, hi) if mid <= found + 1e-12 else (lo, mid)
+    return tried
+
+
+def test_funnel_numbers_are_the_funnel_csvs():
+    plan = shipped_plan()
+    points = read_csv("funnel.csv")
+    assert len(points) == 2 * len(plan["thrusts"])
+    pt = {(p["geometry"].split()[0], p["thrust_N"]): p for p in points}
+    runs = {}          # (geometry, thrust, direction) -> [offsets probed], in m
+    for (geometry, thrust), p in pt.items():
+        ranges = [float(x) for x in p["ranges_by_direction_m"].strip("[]").split(",")]
+        for d, r in zip(plan["directions_deg"], ranges):
+            runs[geometry, thrust, d] = (r, probes(r, p["clearance_m"] + plan["beyond"],
+                                                   plan["steps"]))
+    mm = 1e3
+    f = Quotes("The funnel")
+    paper, funnel = pt["paper", 0.0], pt["funnel", 0.0]
+    f.check("Rs = Rp = {} m, H = {} m, so the tips clear", funnel["Rs"], funnel["H"])
+    f.check("c = H cot(alpha1) = {} mm), without thrust and with {} N for {} s, offsets at {} deg "
+            "(the middle of a petal) and {} deg (between two petals), {} halvings between 0 and "
+            "c + {} mm, a {} m/s probe approach with {} deg of roll",
+            mm * funnel["clearance_m"], plan["thrusts"][1], plan["thrust_duration"],
+            *plan["directions_deg"], plan["steps"], mm * plan["beyond"],
+            plan["closing_speed"], plan["roll_deg"])
+    for label, thrust in (("paper (Rs {} m, petals on R)", 0.0), ("paper", 300.0)):
+        r30, r90 = (mm * runs["paper", thrust, d][0] for d in plan["directions_deg"])
+        first_off = mm * min(o for o in runs["paper", thrust, 90.0][1] if o > 0)
+        how = "none" if thrust == 0 else "300 N for 3 s"
+        f.check(f"| {label} | {{}} | {how} | {{}} / {{}}: coaxial captures, {{}} mm off does not |",
+                *([paper["Rs"]] if thrust == 0 else []), mm * pt["paper", thrust]["clearance_m"],
+                r30, r90, first_off)
+    for label, thrust in (("funnel (Rs = Rp {} m, H {} m)", 0.0), ("funnel", 300.0)):
+        (r30, _), (r90, tried) = (runs["funnel", thrust, d] for d in plan["directions_deg"])
+        how = "none" if thrust == 0 else "300 N for 3 s"
+        f.check(f"| {label} | {{}} mm | {how} | at least {{}} / {{}} mm ({{}} mm does not) |",
+                *([funnel["Rs"], funnel["H"]] if thrust == 0 else []),
+                mm * pt["funnel", thrust]["clearance_m"], mm * r30, mm * r90,
+                mm * min(o for o in tried if o > r90 + 1e-12))
+    f.check("off the axis by the smallest offset probed, {} mm, no run captures",
+            mm * min(o for o in runs["paper", 0.0, 30.0][1] if o > 0))
+    r90 = runs["funnel", 0.0, 90.0][0]
+    f.check("captures up to {} mm between the petals, {} % of its clearance",
+            mm * r90, 100 * r90 / funnel["clearance_m"])
+    (r30, _), (r90, _) = (runs["funnel", 300.0, d] for d in plan["directions_deg"])
+    f.check("with 300 N up to its full clearance, {} mm, and over a petal up to the bisection's "
+            "end, {} mm", mm * r90, mm * r30)
+    assert abs(r90 - pt["funnel", 300.0]["clearance_m"]) < 1e-9, "300 N: range != clearance"
+    past = [o for (g, _, d), (_, tried) in runs.items() if g == "funnel" and d == 90.0
+            for o in tried if o > pt["funnel", 0.0]["clearance_m"] + 1e-9]
+    f.check("{} of the {} probes, all at {} mm or more, between the petals",
+            len(past), sum(len(t) for _, t in runs.values()), mm * min(past))
+    at_c = [o for d in plan["directions_deg"] for o in runs["funnel", 0.0, d][1]
+            if abs(o - funnel["clearance_m"]) < 1e-9]
+    f.check("the one run at exactly {} mm without thrust", mm * funnel["clearance_m"])
+    assert len(at_c) == 1, f"{len(at_c)} probes at the clearance without thrust, not one"
+    captured = sum(r["outcome"] == "captured" for r in read_csv("campaign_funnel.csv"))
+    f.check("the IDSS campaign {} of its 1,000 samples", captured)
+    f.done()
+
+
+# 3. The IDSS envelope campaigns: docs/campaign_paper.csv, docs/campaign_funnel.csv -----------
+CAMPAIGNS = "The IDSS envelope campaigns: the paper geometry and the funnel"
+
+
+def _error_times_couples(rows):
+    """[(t, couples)] of the typed errors: the time and couples their message ends with."""
+    out = []
+    for r in rows:
+        m = re.search(r"\[t = (\S+) s; couples ([^\]]+)\]$", r["error"])
+        assert m, f"sample {r['sample']:.0f}: no time and couples in {r['error']!r}"
+        out.append((float(m.group(1)), m.group(2).split(", ")))
+    return out
+
+
+def _kinetic(rows):
+    return [float(re.search(r"relative kinetic energy (\S+) J", r["reason"]).group(1))
+            for r in rows]
+
+
+def test_campaign_bullets_are_the_campaigns_rows():
+    c = Quotes(CAMPAIGNS)
+    rows = read_csv("campaign_paper.csv")
+    by = {o: [r for r in rows if r["outcome"] == o]
+          for o in ("captured", "jammed", "missed", "rebound", "error")}
+    n = len(rows)
+    c.check("**The paper's geometry captures none of the {} samples** (the 95 % interval's "
+            "upper end is {})", n, wilson(len(by["captured"]), n - len(by["error"]))[1])
+    assert not by["captured"], "the paper geometry's campaign captures"
+    jam = by["jammed"]
+    c.check("{} samples end `jammed`: {} of them with the rings within {} cm of the petal "
+            "height ({} m) apart", len(jam),
+            sum(abs(r["final_axial"] - 0.2) <= 0.05 for r in jam), 5, 0.2)
+    free = [r for r in jam if "held by no couple" in r["reason"]]
+    c.check("{} of the {} held by no couple at the end", len(free), len(jam))
+    c.check("with {} to {} J of relative kinetic energy left after the thrust)",
+            min(_kinetic(free)), max(_kinetic(free)))
+    off = [r["final_lateral"] for r in by["missed"]]
+    c.check("{} end `missed`: the thrust pushes", len(off))
+    c.check("passes the target's ring plane {} to {} m off the axis.", min(off), max(off))
+    apart = [r["final_axial"] for r in by["rebound"]]
+    c.check("{} end `rebound` once the thrust has ended, the rings {} to {} m apart",
+            len(apart), min(apart), max(apart))
+    err = by["error"]
+    c.check("{} samples ({} %) stop in a typed `PainleveInconsistency`",
+            len(err), 100 * len(err) / n)
+    assert {r["reason"] for r in err} == {"PainleveInconsistency"}
+    times = [t for t, _ in _error_times_couples(err)]
+    for _, couples in _error_times_couples(err):
+        assert sorted(re.sub(r"\d+$", "*", x) for x in couples) == [
+            "cc_Cring_Ttip*", "cc_Tring_Ctip*"], couples
+    c.check("`cc_Cring_Ttip*` with `cc_Tring_Ctip*`, at {} to {} s)", min(times), max(times))
+    c.check("No error is untyped.")
+    assert not any(r["error"] and r["error"].startswith("internal error") for r in rows)
+    force = [r for r in rows if r["peak_contact_force"] is not None]
+    top = max(force, key=lambda r: r["peak_contact_force"])
+    c.check("The largest peak contact force, {} N (sample {} at",
+            top["peak_contact_force"], top["sample"])
+    c.check("the 95th percentile is {} N.",
+            np.percentile([r["peak_contact_force"] for r in force], 95))
+    drift = [r["momentum_drift"] for r in rows if r["momentum_drift"] is not None]
+    c.check("stays at {} at most (the quadrature", max(drift))
+    ledger = sorted((r for r in rows if r["energy_closure"] is not None),
+                    key=lambda r: r["energy_closure"])
+    worst = ledger[-1]
+    c.check("closes to {} or better but in one sample, {}, a jam after {} impacts, at {}.",
+            ledger[-2]["energy_closure"], worst["sample"], worst["impacts"],
+            worst["energy_closure"])
+    assert worst["outcome"] == "jammed"
+
+    rows = read_csv("campaign_funnel.csv")
+    n, cap = len(rows), [r for r in rows if r["outcome"] == "captured"]
+    named = n - sum(r["outcome"] == "error" for r in rows)     # the table's: errors left out
+    c.check("**The funnel variant captures {} of the {} samples**", len(cap), n)
+    c.check("capture probability {} (95 % interval {}-{})", len(cap) / named,
+            *wilson(len(cap), named))
+    jam = sorted((r for r in rows if r["outcome"] == "jammed"), key=lambda r: r["sample"])
+    short = [1e3 * float(re.search(r"distance to capture .*?\(at (\S+) m", r["reason"]).group(1))
+             for r in jam]
+    c.check("samples ({}, {}, {}) end `jammed` {} to {} mm short of the capture distance",
+            *[r["sample"] for r in jam], min(short), max(short))
+    assert all("held by no couple" in r["reason"] for r in jam)
+    c.check("held by no couple, with {} to {} J of relative kinetic energy left after the "
+            "thrust has ended", min(_kinetic(jam)), max(_kinetic(jam)))
+    err = [r for r in rows if r["outcome"] == "error"]
+    (t, couples), = _error_times_couples(err)
+    c.check("one ({}) stops in a typed `{w}` at {} s", err[0]["sample"], err[0]["reason"], t)
+    c.check("(`{w}`, `{w}`). The loads", *couples)
+    force = [r["peak_contact_force"] for r in rows if r["peak_contact_force"] is not None]
+    c.check("the peak contact force is {} N at the median and {} N at most",
+            np.median(force), max(force))
+    stroke = [1e3 * r["peak_stewart_stroke"] for r in rows if r["peak_stewart_stroke"] is not None]
+    c.check("strokes {} mm at the median and {} mm at most", np.median(stroke), max(stroke))
+    c.done()
+
+
+# 4. A referee, Drake's compliant contact: docs/crosscheck.csv ---------------------------------
+CROSSCHECK = "A referee: Drake's compliant contact"
+
+
+def crosscheck():
+    """The crosscheck's rows (each counts and agrees) and its columns as arrays."""
+    rows = read_csv("crosscheck.csv")
+    assert all(r["counts"] == "True" for r in rows), "a compliant run no longer counts"
+    return rows, lambda k: np.array([r[k] for r in rows], float)
+
+
+def test_crosscheck_numbers_are_the_crosscheck_csvs():
+    rows, col = crosscheck()
+    n = len(rows)
+    agree = sum(r["agree"] == "True" for r in rows)
+    diff, near = np.abs(col("capture_time_difference")), np.abs(col("near_capture_time_difference"))
+    x = Quotes(CROSSCHECK)
+    x.check("outcome agreement: {}/{} ({}%;", agree, n, 100 * agree / n)
+    x.check("median capture-time difference: {} % ({} conditions captured by both; largest {} %, "
+            "{} within 10 %; signed median {} %", 100 * np.median(diff), n, 100 * diff.max(),
+            int(np.sum(diff <= 0.1)), 100 * np.median(col("capture_time_difference")))
+    x.check("median near-capture-time difference: {} % (the first time within 1 mm of the "
+            "capture box; {} conditions where both come near; largest {} %)",
+            100 * np.median(near), n, 100 * near.max())
+    x.check("compliant runs that count: {}/{}", n, n)
+    x.check("the outcomes agree in all {} conditions", agree)
+    x.check("All {} capture times agree within 10 %: the median difference is {} %, the largest "
+            "{} %, and {} of them agree within 1 %.", int(np.sum(diff <= 0.1)),
+            100 * np.median(diff), 100 * diff.max(), int(np.sum(diff <= 0.01)))
+    refined = np.abs(col("refined_capture_time_s") / col("compliant_capture_time_s") - 1)
+    x.check("within 1 % of the compliant runs (median {} %)", 100 * np.median(refined))
+    rigid, compliant = col("rigid_peak_interface_force_N"), col("compliant_peak_interface_force_N")
+    x.check("peaks at {} to {} N.", rigid.min(), rigid.max())
+    x.check("at {} to {} kN.", compliant.min() / 1e3, compliant.max() / 1e3)
+    q = col("refined_peak_interface_force_N") / compliant
+    x.check("the refined runs give {} to {} times it (median {},", q.min(), q.max(), np.median(q))
+    m = col("rigid_peak_mean_interface_force_N")
+    q1, q2 = col("compliant_peak_mean_interface_force_N") / m, col(
+        "refined_peak_mean_interface_force_N") / m
+    x.check("Drake's value is {} to {} times drake_dock's (median {}); the refined runs' {} to {} "
+            "(median {})", q1.min(), q1.max(), np.median(q1), q2.min(), q2.max(), np.median(q2))
+    r11, = [r for r in rows if r["name"] == "random 11"]
+    t = {w: r11[f"{w}_capture_time_s"] for w in ("rigid", "compliant", "refined")}
+    tn = {w: r11[f"{w}_near_capture_time_s"] for w in ("rigid", "compliant", "refined")}
+    x.check("| random 11 | captured {} s | captured {} s ({} %) | captured {} s ({} %) | "
+            "{} / {} / {} s |", t["rigid"], t["compliant"], 100 * r11["capture_time_difference"],
+            t["refined"], 100 * (t["refined"] / t["rigid"] - 1), *tn.values())
+    x.check("at the same time ({} and {} s)", tn["rigid"], tn["refined"])
+    x.check("on the next swing, at {} and {} s.", t["rigid"], t["compliant"])
+    x.check("the outcomes agree in {} of {} conditions ({} %) and all {} capture times within "
+            "10 % (median {} %)", agree, n, 100 * agree / n, int(np.sum(diff <= 0.1)),
+            100 * np.median(diff))
+    impacts = col("rigid_impacts")
+    x.check("with a median of {} per run ({} to {})", np.median(impacts), impacts.min(),
+            impacts.max())
+    x.done()
+
+
+@pytest.mark.xfail(strict=True, reason="docs/crosscheck.csv: the refined and compliant capture "
+                   "times differ by more than 1 % in six conditions (random 5, 10, 11, 14, "
+                   "corner 2, 4; up to 3.4 % but random 11's 22 %), not only in random 11")
+def test_crosscheck_refined_runs_beyond_one_per_cent():
+    rows, col = crosscheck()
+    refined = np.abs(col("refined_capture_time_s") / col("compliant_capture_time_s") - 1)
+    beyond = [r["name"] for r, d in zip(rows, refined) if d > 0.01]
+    x = Quotes(CROSSCHECK)
+    x.check("The refined runs keep the capture times within {} % of the compliant runs "
+            "(median 0.32 %) but in one condition, random {} (below)", 1,
+            int(beyond[0].split()[-1]) if len(beyond) == 1 else ", ".join(beyond))
+    x.done()
