@@ -1,18 +1,19 @@
 """Wall time of the paper's example to capture, against the plant alone, and its targets.
 
-The paper's example (Sect. 8.2) to capture, build excluded, side by side with
-the same plant integrated by Drake alone (free flight with the Stewart element, no contact) over
-the same simulated time and with the same integrator settings. Prints the wall time (the
-median of ``--repeats`` identical runs on fresh diagrams, each printed), the real-time factor (simulated s per wall s), the derivative evaluations and the share of them
-spent isolating witness events (steps of more than 50 evaluations), and the ratio of the two
-runs, all measured in this run; and the same example with Drake's plain witness isolation
-(`simulate(..., witness_approach=False)`), for the ratio of the step shortening; and with a
-coarser step cap (``--coarse-step``) for its cost; and with the impacts by the reference LZB
-(scipy's DOP853, `ContactOptions.lzb_compiled` off), with the difference of the capture
-times; and, per evaluation, drake_dock's time against the plant's own and an empty Python
-LeafSystem's. Also the set-up (the initial state: the first-contact
-placement, its seeks, and their number; and that of another approach of the same geometry)
-and the kernels' cold and warm start (a fresh process that compiles them into an empty cache
+The paper's example (Sect. 8.2) to capture, build excluded, side by side with the same plant
+integrated by Drake alone (free flight with the Stewart element, no contact) over the same
+simulated time and with the same integrator settings. Prints the wall time (the median of
+``--repeats`` identical runs on fresh diagrams, each printed; the plant alone likewise, its runs
+alternating with them), the real-time factor (simulated s per wall s), the derivative
+evaluations and the share of them spent isolating witness events (steps of more than 50
+evaluations), and the ratio of the two runs, all measured in this run; and the same example with
+Drake's plain witness isolation (`simulate(..., witness_approach=False)`), for the ratio of the
+step shortening; and with a coarser step cap (``--coarse-step``) for its cost; and with the
+impacts by the reference LZB (scipy's DOP853, `ContactOptions.lzb_compiled` off), with the
+difference of the capture times; and, per evaluation, drake_dock's time against the plant's own
+and an empty Python LeafSystem's. Also the set-up (the initial state: the first-contact
+placement, its seeks, and their number; and that of another approach of the same geometry) and
+the kernels' cold and warm start (a fresh process that compiles them into an empty cache
 directory, then one that loads them from it). Then the targets, each `met` or `NOT met`: the
 ratio to the plant alone <= 10x (5x the aim), the set-up <= 0.02 s, under 0.5 s of wall time.
 
@@ -97,13 +98,18 @@ def main():
     iso = int(de[de > 50].sum())
     # The same run again on fresh diagrams: the wall time is the median of the runs (the first
     # run in a process also pays Python's warm-up; the machines are shared and noisy).
-    runs = [r] + [simulate(scenario, state, dd=build_docking_diagram(DiagramSpec.of(scenario)))
-                  for _ in range(args.repeats - 1)]
+    # The plant alone is timed beside each run, the two alternating, and its wall time is the
+    # median of as many runs (one run of a few ms alone is at the mercy of the machine's noise).
+    runs, frees = [r], [free_flight(scenario, state, r.end_time)]
+    for _ in range(args.repeats - 1):
+        runs.append(simulate(scenario, state,
+                             dd=build_docking_diagram(DiagramSpec.of(scenario))))
+        frees.append(free_flight(scenario, state, r.end_time))
     if any(x.capture_time != r.capture_time or x.evaluations != r.evaluations for x in runs):
         raise SystemExit("repeated runs differ: the simulation is not deterministic")
     walls = [x.wall_time for x in runs]
     wall = float(np.median(walls))
-    t_free, n_free = free_flight(scenario, state, r.end_time)
+    t_free, n_free = float(np.median([f[0] for f in frees])), frees[0][1]
     t_leaf = empty_leaf_cost(scenario.simulator_config.integration_scheme)
     reference_lzb = dataclasses.replace(dd.contact.options, lzb_compiled=False)
     py = simulate(scenario, state, dd=build_docking_diagram(
@@ -158,7 +164,9 @@ def main():
           f"{py.evaluations} evaluations; capture {py.capture_time!r} s vs "
           f"{r.capture_time!r} s (difference {abs(py.capture_time - r.capture_time):.1e} s); "
           f"ratio {py.wall_time / wall:.2f}x")
-    print(f"same plant without contact (Drake alone): {t_free:.4f} s")
+    print(f"same plant without contact (Drake alone): {t_free:.4f} s (median of {len(frees)} "
+          "runs, each beside one of drake_dock's: " + ", ".join(f"{f[0]:.4f}" for f in frees)
+          + ")")
     print(f"ratio to the plant alone: {wall / t_free:.1f}x")
     print(f"per evaluation: drake_dock {1e6 * wall / r.evaluations:.1f} us (whole run), the "
           f"plant alone {1e6 * t_free / n_free:.1f} us ({n_free} evaluations), an empty Python "
