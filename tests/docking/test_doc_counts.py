@@ -73,7 +73,8 @@ QUOTED = [
     ("docs/model.md", r"`paper` \((\d+) pairs\) or `complete`", count("paper")),
     ("docs/performance.md", r"What the (\d+) pairs of `complete` that only a large relative roll",
      count(families=LARGE_ROLL)),
-] + [(path, PAPERS, count("paper")) for path in ("README.md", "docs/model.md", "docs/results.md")]
+] + [(path, PAPERS, count("paper")) for path in ("README.md", "docs/model.md", "docs/algorithms.md",
+                                       "docs/results.md")]
 
 
 def _quoted(path, phrase) -> list:
