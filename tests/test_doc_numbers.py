@@ -349,8 +349,6 @@ def test_crosscheck_numbers_are_the_crosscheck_csvs():
     x.check("All {} capture times agree within 10 %: the median difference is {} %, the largest "
             "{} %, and {} of them agree within 1 %.", int(np.sum(diff <= 0.1)),
             100 * np.median(diff), 100 * diff.max(), int(np.sum(diff <= 0.01)))
-    refined = np.abs(col("refined_capture_time_s") / col("compliant_capture_time_s") - 1)
-    x.check("within 1 % of the compliant runs (median {} %)", 100 * np.median(refined))
     rigid, compliant = col("rigid_peak_interface_force_N"), col("compliant_peak_interface_force_N")
     x.check("peaks at {} to {} N.", rigid.min(), rigid.max())
     x.check("at {} to {} kN.", compliant.min() / 1e3, compliant.max() / 1e3)
@@ -373,20 +371,23 @@ def test_crosscheck_numbers_are_the_crosscheck_csvs():
             "10 % (median {} %)", agree, n, 100 * agree / n, int(np.sum(diff <= 0.1)),
             100 * np.median(diff))
     impacts = col("rigid_impacts")
-    x.check("with a median of {} per run ({} to {})", np.median(impacts), impacts.min(),
+    x.check("runs have a median of {} impacts ({} to {})", np.median(impacts), impacts.min(),
             impacts.max())
     x.done()
 
 
-@pytest.mark.xfail(strict=True, reason="docs/crosscheck.csv: the refined and compliant capture "
-                   "times differ by more than 1 % in six conditions (random 5, 10, 11, 14, "
-                   "corner 2, 4; up to 3.4 % but random 11's 22 %), not only in random 11")
 def test_crosscheck_refined_runs_beyond_one_per_cent():
+    """The refined compliant runs against the compliant ones: how many conditions agree within
+    1 %, the median, the largest difference but one, and the one far off (random 11)."""
     rows, col = crosscheck()
     refined = np.abs(col("refined_capture_time_s") / col("compliant_capture_time_s") - 1)
-    beyond = [r["name"] for r, d in zip(rows, refined) if d > 0.01]
+    order = np.argsort(refined)
+    worst = rows[order[-1]]["name"]
     x = Quotes(CROSSCHECK)
-    x.check("The refined runs keep the capture times within {} % of the compliant runs "
-            "(median 0.32 %) but in one condition, random {} (below)", 1,
-            int(beyond[0].split()[-1]) if len(beyond) == 1 else ", ".join(beyond))
+    x.check("within {} % of the compliant runs in {} of the {} conditions (median {} %); {} "
+            "others differ by at most {} %, and random {} by {} % (below)", 1,
+            int(np.sum(refined <= 0.01)), len(rows), 100 * np.median(refined),
+            int(np.sum(refined > 0.01)) - 1, 100 * refined[order[-2]],
+            int(worst.split()[-1]) if worst.startswith("random ") else worst,
+            100 * refined[order[-1]])
     x.done()
