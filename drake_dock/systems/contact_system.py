@@ -230,18 +230,19 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
         return self._cache.Eval(context)
 
     # ------------------------------------------------------------------ evaluation
-    def input_force(self, context, x=None) -> np.ndarray:
+    def input_force(self, context, x=None, modes=None) -> np.ndarray:
         """The inputs' generalized force: the ``generalized_force`` input plus each body
         wrench [torque, force] (world frame, at the body's origin), which is a free body's
         generalized force, plus the follower forces where they act (at the state ``x``, the
-        context's continuous state when None)."""
+        context's continuous state when None, after the first impact of ``modes``, the
+        context's modes when None)."""
         tau = (self._gf_port.Eval(context).copy() if self._gf_port.HasValue(context)
                else np.zeros(self.nv))
         for j, port in self._wrench_ports.values():
             if port.HasValue(context):
                 tau[j:j + 6] += port.Eval(context)
         if self.followers:
-            tc = self.first_contact_time(self.get_modes(context))
+            tc = self.first_contact_time(self.get_modes(context) if modes is None else modes)
             since = context.get_time() - tc if math.isfinite(tc) else -math.inf
             q = context.get_continuous_state_vector().CopyToVector() if x is None else x
             for f in self.followers:
@@ -256,7 +257,7 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     def _calc_eval(self, context, value):
         t, modes = context.get_time(), self.get_modes(context)
         x = context.get_continuous_state_vector().CopyToVector()
-        tau = self.input_force(context, x)
+        tau = self.input_force(context, x, modes)
         key = (t, x.tobytes(), modes_key(modes), tau.tobytes())
         value.set_value(self._evaluations.get(key, lambda: self._evaluate(t, x, modes, tau)))
 

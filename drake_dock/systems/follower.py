@@ -25,7 +25,10 @@ class FollowerForce:
 
     def acting(self, since_contact: float) -> bool:
         """Whether it acts ``since_contact`` s after the first contact (-inf before it)."""
-        return any(a <= since_contact < b for a, b in self.windows)
+        for a, b in self.windows:
+            if a <= since_contact < b:
+                return True
+        return False
 
     def axis(self, q) -> tuple:
         """The body's axis in the world at the positions q: the body's rotation (its
@@ -51,6 +54,4 @@ class FollowerForce:
         """Adds the wrench to the generalized force ``tau`` where it acts."""
         w = self.wrench(q, since_contact)
         if w is not None:
-            j = self.v_start
-            for k in range(6):
-                tau[j + k] += w[k]
+            tau[self.v_start:self.v_start + 6] += w
