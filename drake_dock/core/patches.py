@@ -7,12 +7,11 @@ R^3 in its body frame. Every patch provides, vectorised over leading axes:
 - ``first(u)``     -> (..., 3, dim)       d r / d u
 - ``second(u)``    -> (..., 3, dim, dim)  d^2 r / d u d u
 
-and, for one parameter point, ``jet(u)`` -> (r, T, K): the same three as tuples of floats
-(r a 3-tuple, T[a] and K[a][b] 3-tuples), the form the couple evaluation works in (a patch
-evaluated at one point is cheaper in plain floats than in numpy); and a box domain
-``lower <= u <= upper``; a parameter may be periodic (a full circle), in which
-case it is wrapped instead of bounded. `posed` maps a patch to the world through a body pose,
-Eq. (20): r = p_WB + R_WB r'(u).
+and, for one parameter point, ``jet(u)`` -> (r, T, K): the same three as tuples of floats (r a
+3-tuple, T[a] and K[a][b] 3-tuples), the form the couple evaluation works in (a patch evaluated
+at one point is cheaper in plain floats than in numpy); and a box domain lower <= u <= upper; a
+parameter may be periodic (a full circle), wrapped instead of bounded. `posed` maps a patch to
+the world through a body pose, Eq. (20): r = p_WB + R_WB r'(u).
 """
 from __future__ import annotations
 
@@ -63,10 +62,8 @@ class Patch:
 
     def clip(self, u):
         """Wraps periodic parameters and clips the others into the domain."""
-        u = self.wrap(u)
-        for k, per in enumerate(self.periodic):
-            if not per:
-                u[..., k] = np.clip(u[..., k], self.lower[k], self.upper[k])
+        u, bounded = self.wrap(u), ~np.asarray(self.periodic, dtype=bool)
+        u[..., bounded] = np.clip(u[..., bounded], self.lower[bounded], self.upper[bounded])
         return u
 
     def margin(self, u):
@@ -74,20 +71,14 @@ class Patch:
         +inf for periodic parameters. Shape (..., dim)."""
         u = np.asarray(u, dtype=float)
         m = np.minimum(u - self.lower, self.upper - u)
-        for k, per in enumerate(self.periodic):
-            if per:
-                m[..., k] = np.inf
+        m[..., np.asarray(self.periodic, dtype=bool)] = np.inf
         return m
 
     def grid(self, n):
         """A tensor grid of n points per parameter covering the domain, shape (n**dim, dim).
         Periodic parameters are sampled without repeating the end point."""
-        axes = []
-        for k in range(self.dim):
-            if self.periodic[k]:
-                axes.append(np.linspace(self.lower[k], self.upper[k], n, endpoint=False))
-            else:
-                axes.append(np.linspace(self.lower[k], self.upper[k], n))
+        axes = [np.linspace(self.lower[k], self.upper[k], n, endpoint=not self.periodic[k])
+                for k in range(self.dim)]
         mesh = np.meshgrid(*axes, indexing="ij")
         return np.stack([m.ravel() for m in mesh], axis=-1)
 
@@ -103,6 +94,15 @@ class Patch:
             r.flags.writeable = False
             hit = cache[n] = (U, r)
         return hit
+
+    def kernel_domain(self, n):
+        """(lower, upper, periodic, `grid` (n)) as the seek's kernels take them (writable copies:
+        one compiled signature), computed once per patch and n."""
+        cache = self.__dict__.setdefault("_kernel_domain", {})
+        if n not in cache:
+            cache[n] = (np.array(self.lower, dtype=float), np.array(self.upper, dtype=float),
+                        np.array(self.periodic), np.array(self.grid_points(n)[0]))
+        return cache[n]
 
     @property
     def span(self):

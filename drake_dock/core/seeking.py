@@ -85,12 +85,12 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
     R2, o2 = _pose(P2)
     rtol = -1.0 if distance_rtol is None else float(distance_rtol)
     if pa.dim == 1:
-        D1, D2 = K.patch_domain(pa, n_coarse), K.patch_domain(pb, n_coarse)
+        D1, D2 = pa.kernel_domain(n_coarse), pb.kernel_domain(n_coarse)
         return _seek_curve(k1, q1, R1, o1, D1, k2, q2, R2, o2, D2, levels, n_fine, candidates,
                            rtol, float(rtol_beyond))
     if pb.dim == 1:
         x = R1 @ pa.p + o1
-        s, it, x2, concave = K.point_curve(x, k2, q2, R2, o2, *K.patch_domain(pb, POINT_CURVE_GRID),
+        s, it, x2, concave = K.point_curve(x, k2, q2, R2, o2, *pb.kernel_domain(POINT_CURVE_GRID),
                                            POINT_CURVE_ITER)
         # A potential contact only on the curve's concave side (docs/model.md, "The petal
         # corner").
@@ -98,7 +98,7 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
         interior = concave and is_interior(pb, u2)
     else:
         u2, it, status, x, x2, interior = K.point_surface(
-            q1, R1, o1, k2, q2, R2, o2, *K.patch_domain(pb, POINT_SURFACE_GRID), rtol,
+            q1, R1, o1, k2, q2, R2, o2, *pb.kernel_domain(POINT_SURFACE_GRID), rtol,
             float(rtol_beyond))
     centre = float(np.linalg.norm(x - x2))
     if status and centre > K.CREEP_TOUCH:

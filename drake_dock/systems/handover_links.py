@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 
 from drake_dock.core import handover as rule
-from drake_dock.core.relations import relation
 
 
 class HandoverLinks:
@@ -23,7 +22,7 @@ class HandoverLinks:
                     raise ValueError(f"handovers: no pair named {name!r}")
             i, j = index[h.edge_pair], index[h.surface_pair]
             e, s = pairs[i], pairs[j]
-            if (relation(e.kind).dims, relation(s.kind).dims) != ((1, 1), (1, 2)) \
+            if (e.patch1.dim, e.patch2.dim, s.patch2.dim) != (1, 1, 2) \
                     or e.patch1 is not s.patch1 \
                     or e.frame1 is not s.frame1 or e.frame2 is not s.frame2:
                 raise ValueError(f"handovers[{h.edge_pair}, {h.surface_pair}]: must be a C-C "

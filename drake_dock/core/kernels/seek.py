@@ -390,17 +390,6 @@ def point_curve(x, k2, p2, R2, o2, lo, hi, periodic, U, max_iter):
     return s, it, np.array([x2[0], x2[1], x2[2]]), straight or side > 0.0
 
 
-def patch_domain(patch, n):
-    """(lower, upper, periodic, the coarse grid of n points per parameter) of a patch as the
-    seek's kernels take them (writable, C-ordered: one compiled signature), kept on it."""
-    cache = patch.__dict__.setdefault("_kernel_domain", {})
-    hit = cache.get(n)
-    if hit is None:
-        hit = cache[n] = (np.array(patch.lower, dtype=float), np.array(patch.upper, dtype=float),
-                          np.array(patch.periodic), np.array(patch.grid_points(n)[0]))
-    return hit
-
-
 def warm():
     """Compiles or loads the seek's kernels with the argument types of
     `drake_dock.core.seeking.seek_couple`: a curve against a curve and against a surface, a
@@ -412,11 +401,11 @@ def warm():
     seg = Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1))
     plane = PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0))
     for c1, c2 in ((seg, Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0))), (Circle(0.3, 0.1), plane)):
-        U = seek(*patch_spec(c1), eye, z, *patch_domain(c1, 12), *patch_spec(c2), eye, z,
-                 *patch_domain(c2, 12), 2, 21, 3, -1.0, 0.0)[0]
-        creep_on(*patch_spec(c1), eye, z, *patch_domain(c1, 12)[:3], *patch_spec(c2), eye, z,
-                 *patch_domain(c2, 12)[:3], U[0], -1.0, 0.0)
+        U = seek(*patch_spec(c1), eye, z, *c1.kernel_domain(12), *patch_spec(c2), eye, z,
+                 *c2.kernel_domain(12), 2, 21, 3, -1.0, 0.0)[0]
+        creep_on(*patch_spec(c1), eye, z, *c1.kernel_domain(12)[:3], *patch_spec(c2), eye, z,
+                 *c2.kernel_domain(12)[:3], U[0], -1.0, 0.0)
     pt = np.array([0.1, 0.2, 0.3, 0.01, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-    point_surface(pt, eye, z, *patch_spec(plane), eye, z, *patch_domain(plane, 16), -1.0, 0.0)
+    point_surface(pt, eye, z, *patch_spec(plane), eye, z, *plane.kernel_domain(16), -1.0, 0.0)
     for curve in (Circle(0.3), Arc(0.3, 0.0, (0.2, 1.4))):
-        point_curve(z, *patch_spec(curve), eye, z, *patch_domain(curve, 64), 30)
+        point_curve(z, *patch_spec(curve), eye, z, *curve.kernel_domain(64), 30)
