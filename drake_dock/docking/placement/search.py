@@ -15,7 +15,6 @@ from scipy.optimize import brentq
 
 from drake_dock.core.kernels import cover as compiled_cover
 from drake_dock.core.patches import posed
-from drake_dock.core.relations import relation
 from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.docking.geometry.pairs import CHASER_APDS, R_MATCHED, TARGET_APDS, PairSpec
 from drake_dock.docking.geometry.rotations import rot_vec, rot_z
@@ -255,7 +254,7 @@ def seek_gaps(pairs, approach, d, refs):
             dirs.append(None)
             continue
         v = cp.p1 - cp.p2
-        if pr.sigma is not None and relation(pr.kind).dims == (1, 2):
+        if pr.sigma is not None and (pr.patch1.dim, pr.patch2.dim) == (1, 2):
             # A declared side (a ring's face, solid on one side): the side of the surface's
             # normal sigma N the curve's point lies on, as the contact system takes it.
             T = posed(pr.patch2, *poses[pr.body2]).first(cp.u2)
