@@ -71,7 +71,7 @@ docs: $(BIN)/.installed
 	$(DD) study conditions models/apds_funnel.yaml --out $(DOCS_OUT)/conditions_funnel
 	cp $(DOCS_OUT)/conditions_funnel/conditions.png docs/
 	$(DD) study roll --out $(DOCS_OUT)/roll
-	cp $(DOCS_OUT)/roll/roll.png docs/
+	cp $(DOCS_OUT)/roll/roll.png $(DOCS_OUT)/roll/roll.csv docs/
 	$(DD) study crosscheck --out $(DOCS_OUT)/crosscheck
 	cp $(DOCS_OUT)/crosscheck/crosscheck.csv $(DOCS_OUT)/crosscheck/crosscheck.png docs/
 	$(DD) campaign models/idss_envelope.yaml --out $(DOCS_OUT)/idss_paper --no-progress

@@ -1,8 +1,8 @@
 """The numbers docs/results.md's prose quotes from the committed outputs under docs/, against
 those outputs: the stability study's `docs/stability_summary.txt`, the funnel study's
 `docs/funnel.csv` (with the shipped plan read from `drake_dock/studies/funnel.py`'s source),
-the two campaigns' `docs/campaign_paper.csv` and `docs/campaign_funnel.csv`, and the
-crosscheck's `docs/crosscheck.csv`.
+the two campaigns' `docs/campaign_paper.csv` and `docs/campaign_funnel.csv`, the
+crosscheck's `docs/crosscheck.csv` and the roll study's `docs/roll.csv`.
 
 `make docs` rewrites those files; the prose around them is copied by hand. Each quoted number
 is found by a short literal phrase of its section (`{}` a number, `{w}` a name), which must
@@ -391,3 +391,43 @@ def test_crosscheck_refined_runs_beyond_one_per_cent():
             int(worst.split()[-1]) if worst.startswith("random ") else worst,
             100 * refined[order[-1]])
     x.done()
+
+
+# 5. Beyond the box, the relative roll: docs/roll.csv ------------------------------------------
+ROLL = "Beyond the box: the relative roll"
+
+
+def test_roll_numbers_are_the_roll_csv():
+    rows = read_csv("roll.csv")
+    by = {r["target_yaw_deg"]: r for r in rows}
+    captured = sorted(r["target_yaw_deg"] for r in rows if r["outcome"] == "captured")
+    jammed = sorted(abs(r["target_yaw_deg"]) for r in rows if r["outcome"] == "jammed")
+    x = Quotes(ROLL)
+    x.check("whole roll range, {} to {} deg every {} deg ({} runs)", min(by), max(by),
+            sorted(by)[2] - sorted(by)[1], len(rows))
+    x.check("Every run ends in a named outcome: {} captured ({} to {} deg) and {} jammed",
+            len(captured), captured[0], captured[-1], len(jammed))
+    x.check("Momentum holds to {} (linear) and {} (angular), and the energy ledger closes to {}.",
+            max(r["momentum_drift_linear"] for r in rows),
+            max(r["momentum_drift_angular"] for r in rows),
+            max(abs(r["energy_closure"]) for r in rows))
+    x.check("captured at {} s with no contact", by[0.0]["capture_time_s"])
+    inner = [by[r] for r in sorted(by) if 0 < r <= captured[-1]]
+    x.check("From {} to {} deg the petals meet guide side on guide side, {} impacts", inner[0][
+        "target_yaw_deg"], inner[-1]["target_yaw_deg"], inner[0]["impacts"])
+    x.check("grows with the roll, from {} s to {} s", inner[0]["capture_time_s"],
+            inner[-1]["capture_time_s"])
+    x.done()
+    # What the prose says without a number: no outcome an error, no run found interpenetrating
+    # by either check, the impacts of the guide-on-guide runs, the jams all beyond 2 theta_end
+    # (37.18 deg), and outcomes and capture times symmetric in the roll.
+    assert all(r["outcome"] in ("captured", "jammed") for r in rows)
+    assert all(r["penetration_m"] <= 0 for r in rows)
+    assert {r["impacts"] for r in inner} == {inner[0]["impacts"]}
+    assert by[0.0]["impacts"] == 0
+    assert min(jammed) > 37.18
+    for r in rows:
+        m = by[-r["target_yaw_deg"]]
+        assert m["outcome"] == r["outcome"]
+        if r["outcome"] == "captured":
+            assert m["capture_time_s"] == pytest.approx(r["capture_time_s"], rel=1e-6)
