@@ -11,7 +11,8 @@ compared, at the precision it is quoted with (2.2e-6: two significant digits; 0.
 decimals), with the value computed from the file the way the prose describes it. The
 headline table, the campaign table and the pair counts have their own tests
 (tests/docking/test_paper_example.py, tests/campaign/test_campaign_table.py,
-tests/docking/test_doc_counts.py). Nothing here needs Drake: the files are read with csv."""
+tests/docking/test_doc_counts.py). Nothing here needs Drake: the files are read with csv, the
+paper example's geometry with yaml."""
 import ast
 import csv
 import re
@@ -19,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from scipy.stats import binomtest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -397,6 +399,15 @@ def test_crosscheck_refined_runs_beyond_one_per_cent():
 ROLL = "Beyond the box: the relative roll"
 
 
+def two_theta_end_deg() -> float:
+    """2 theta_end of the paper example's geometry (deg): theta_end = arcsin(R sin(alpha2) /
+    (R - H cot(alpha1))) - alpha2, the angular extent of a guide side (Eq. 15 as the paper
+    example's geometry reads it)."""
+    g = yaml.safe_load((ROOT / "drake_dock/models/paper_example.yaml").read_text())["geometry"]
+    a1, a2 = np.radians(g["alpha1_deg"]), np.radians(g["alpha2_deg"])
+    return 2 * np.degrees(np.arcsin(g["R"] * np.sin(a2) / (g["R"] - g["H"] / np.tan(a1))) - a2)
+
+
 def test_roll_numbers_are_the_roll_csv():
     rows = read_csv("roll.csv")
     by = {r["target_yaw_deg"]: r for r in rows}
@@ -420,12 +431,13 @@ def test_roll_numbers_are_the_roll_csv():
     x.done()
     # What the prose says without a number: no outcome an error, no run found interpenetrating
     # by either check, the impacts of the guide-on-guide runs, the jams all beyond 2 theta_end
-    # (37.18 deg), and outcomes and capture times symmetric in the roll.
+    # (the paper's closed form on the example's geometry), and outcomes and capture times
+    # symmetric in the roll.
     assert all(r["outcome"] in ("captured", "jammed") for r in rows)
     assert all(r["penetration_m"] <= 0 for r in rows)
     assert {r["impacts"] for r in inner} == {inner[0]["impacts"]}
     assert by[0.0]["impacts"] == 0
-    assert min(jammed) > 37.18
+    assert min(jammed) > two_theta_end_deg()
     for r in rows:
         m = by[-r["target_yaw_deg"]]
         assert m["outcome"] == r["outcome"]
