@@ -10,8 +10,9 @@ evaluations), and the ratio of the two runs, all measured in this run; and the s
 Drake's plain witness isolation (`simulate(..., witness_approach=False)`), for the ratio of the
 step shortening; and with a coarser step cap (``--coarse-step``) for its cost; and with the
 impacts by the reference LZB (scipy's DOP853, `ContactOptions.lzb_compiled` off), with the
-difference of the capture times; and, per evaluation, drake_dock's time against the plant's own
-and an empty Python LeafSystem's. Also the set-up (the initial state: the first-contact
+difference of the capture times; and with one witness function per transition instead of the
+joint one (`ContactOptions.joint_witness` off; median of as many runs); and, per evaluation,
+drake_dock's time against the plant's own and an empty Python LeafSystem's. Also the set-up (the initial state: the first-contact
 placement, its seeks, and their number; and that of another approach of the same geometry) and
 the kernels' cold and warm start (a fresh process that compiles them into an empty cache
 directory, then one that loads them from it). Then the targets, each `met` or `NOT met`: the
@@ -114,6 +115,10 @@ def main():
     reference_lzb = dataclasses.replace(dd.contact.options, lzb_compiled=False)
     py = simulate(scenario, state, dd=build_docking_diagram(
         DiagramSpec.of(scenario, options=reference_lzb)))
+    # One witness function per transition instead of the joint one, alternating as above.
+    each_options = dataclasses.replace(dd.contact.options, joint_witness=False)
+    each = [simulate(scenario, state, dd=build_docking_diagram(
+        DiagramSpec.of(scenario, options=each_options))) for _ in range(args.repeats)]
     plain = None
     if not args.skip_plain:
         dd2 = build_docking_diagram(DiagramSpec.of(scenario))
@@ -159,6 +164,12 @@ def main():
               f"{other.wall_time:.3f} s, {other.evaluations} evaluations, "
               f"{len(other.record.t)} samples; capture {other.capture_time:.9f} s vs "
               f"{r.capture_time:.9f} s; ratio {other.wall_time / wall:.2f}x")
+    wall_each = float(np.median([x.wall_time for x in each]))
+    print(f"with one witness function per transition (joint_witness off) instead of the joint "
+          f"one: {wall_each:.3f} s (median of {len(each)} runs), {each[0].evaluations} "
+          f"evaluations; capture {each[0].capture_time!r} s vs {r.capture_time!r} s "
+          f"(difference {abs(each[0].capture_time - r.capture_time):.1e} s); ratio "
+          f"{wall_each / wall:.2f}x")
     print(f"with the impacts by the reference LZB (scipy's DOP853) instead of the compiled "
           f"one: {py.wall_time:.3f} s, "
           f"{py.evaluations} evaluations; capture {py.capture_time!r} s vs "

@@ -188,9 +188,9 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
             lambda context, state: self._on_event(context, None, state))
         if options.reseek_early > 0:
             self.DeclarePerStepUnrestrictedUpdateEvent(self._on_step)
-        self._w, self._w_far = witnesses.declare(self, pairs, self._witness_value,
-                                                 self._far_value,
-                                                 UnrestrictedUpdateEvent(self._on_event))
+        self._w, self._w_far, self._w_joint = witnesses.declare(
+            self, pairs, self._witness_value, self._far_value, self._joint_value,
+            UnrestrictedUpdateEvent(self._on_event))
         # Evaluations by (time, state, modes, inputs); event results by (time, state,
         # mode_changes).
         self._evaluations = Memo(self.eval_memo_size)
@@ -255,11 +255,14 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
         return modes.impacts[0].t if modes.impacts else math.inf
 
     def _calc_eval(self, context, value):
+        value.set_value(self._lookup(context))
+
+    def _lookup(self, context) -> Evaluation:
         t, modes = context.get_time(), self.get_modes(context)
         x = context.get_continuous_state_vector().CopyToVector()
         tau = self.input_force(context, x, modes)
         key = (t, x.tobytes(), modes_key(modes), tau.tobytes())
-        value.set_value(self._evaluations.get(key, lambda: self._evaluate(t, x, modes, tau)))
+        return self._evaluations.get(key, lambda: self._evaluate(t, x, modes, tau))
 
     def _evaluate(self, t, x, modes, tau) -> Evaluation:
         t0 = perf_counter()
@@ -271,7 +274,7 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
         return E
 
     def DoCalcTimeDerivatives(self, context, derivatives):
-        derivatives.get_mutable_vector().SetFromVector(self._cache.Eval(context).xdot)
+        derivatives.get_mutable_vector().SetFromVector(self._lookup(context).xdot)
 
     # ------------------------------------------------------------------ outputs
     def _out_state(self, context, out):
@@ -309,7 +312,12 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
 
     # ------------------------------------------------------------------ witnesses
     def DoGetWitnessFunctions(self, context):
-        return [self._w_far if i is None else self._w[i][kind] for i, kind in self._armed(context)]
+        """The armed witnesses, or the one joint witness where they are all positive
+        (`witnesses`: Drake asks after every event, at the state it left)."""
+        armed = self._armed(context)
+        if armed and self.options.joint_witness and self._joint_value(context) > 0.0:
+            return [self._w_joint]
+        return [self._w_far if i is None else self._w[i][kind] for i, kind in armed]
 
     def _armed(self, context) -> list:
         """`witnesses.armed` for the context's modes, kept on their index when sealed."""
@@ -324,8 +332,12 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     def _witness_value(self, context, i, code):
         """The value of pair i's witness of kind ``code`` (`engine.W_GAP` ...), computed by
         the evaluation (Drake evaluates every witness at both ends of every step)."""
+        return self._cache.Eval(context).witness_table[i][code]
+
+    def _joint_value(self, context):
+        """The least value of the armed witnesses (`witnesses.JOINT_WITNESS`)."""
         E = self._cache.Eval(context)
-        return float(E.wv[E.slot[i], code])
+        return E.least_witness(self._armed_of(E.modes, context))
 
     def _far_value(self, context):
         return self._cache.Eval(context).far_witness

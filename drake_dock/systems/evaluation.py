@@ -3,6 +3,7 @@ the bodies' and frames' kinematics that the events' calculators take."""
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 
@@ -106,6 +107,25 @@ class Evaluation:
     def wv(self):
         """Witness values (n_near, engine.NW) of the pairs that are not far, by `slot`."""
         return self._section(WITNESS).reshape(-1, E.NW)
+
+    @functools.cached_property
+    def witness_table(self) -> list:
+        """`wv` as a list over all pairs (None for a far pair) of lists by kind: Drake asks for
+        each witness function's value on its own, at both ends of every step."""
+        rows = self.wv.tolist()
+        return [None if j < 0 else rows[j] for j in self.slot.tolist()]
+
+    def least_witness(self, armed) -> float:
+        """The least value of the `ArmedWitnesses` ``armed`` of this evaluation's modes (the far
+        pairs' witness among them when armed; inf for none), computed once."""
+        least = self.__dict__.get("_least")
+        if least is None:
+            values = self._section(WITNESS).tolist()
+            least = min((values[j] for j in armed.flat_list), default=math.inf)
+            if armed.far:
+                least = min(least, self.far_witness)
+            self._least = least
+        return least
 
     @property
     def bound(self):

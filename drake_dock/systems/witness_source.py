@@ -22,12 +22,13 @@ class ArmedWitnesses:
     witness of a tracked couple (``gap``, a mask); their places in an evaluation's witness
     values and couple rows (those of the pairs not far, by their place among them)."""
 
-    __slots__ = ("names", "pair", "code", "far", "gap", "flat", "gap_flat", "g_flat",
-                 "no_rates")
+    __slots__ = ("names", "pair", "code", "far", "gap", "flat", "flat_list", "gap_flat",
+                 "g_flat", "no_rates")
 
     def __init__(self, names, pair, code, far, gap, slot):
         self.names, self.pair, self.code, self.far, self.gap = names, pair, code, far, gap
         self.flat = slot * K.NW + code                  # into an evaluation's wv, raveled
+        self.flat_list = self.flat.tolist()
         self.gap_flat = slot[gap] * C.ROW + C.VN        # the gaps' v_n in its couple rows
         self.g_flat = slot[gap] * C.ROW + C.GAP         # and the gaps
         self.no_rates = np.full(len(pair), np.nan)

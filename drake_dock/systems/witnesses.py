@@ -30,6 +30,15 @@ The kinds, one per transition:
   again (a potential contact only there).
 - the far pairs' clearance: min (clearance - travel bound) over the far pairs (1 if no pair is
   far); its event seeks again every far pair whose clearance is used up.
+
+Every witness has the same direction and the same event, whose handler resolves every
+transition due at once: Drake is therefore given one witness, the least value of the armed
+ones (`JOINT_WITNESS`), wherever they are all positive just after an event (when Drake asks
+which witnesses are active). It triggers where the first of them reaches zero, as that one
+would, and Drake calls one function at both ends of a step instead of one per transition.
+Where an armed witness is not positive after an event (a transition left at its zero), the
+witnesses are given one by one, so that it does not hold back the others
+(`ContactOptions.joint_witness` False gives them one by one throughout).
 """
 from __future__ import annotations
 
@@ -39,6 +48,7 @@ from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import model as K
 
 FAR_WITNESS = "far pairs clearance"   # the one witness of all far pairs ("clear")
+JOINT_WITNESS = "least armed witness"  # the armed witnesses' least value (module docstring)
 DIRECTION = WitnessFunctionDirection.kPositiveThenNonPositive
 
 # kind: (name after the pair's name, its code in the evaluation's values)
@@ -56,17 +66,19 @@ BY_MODE = {Mode.FAR: (),
            Mode.STICKING: ("regular", "lambda", "cone")}
 
 
-def declare(system, pairs, value_at, far_value, event):
+def declare(system, pairs, value_at, far_value, joint_value, event):
     """The witness functions of ``system``: per pair a dict kind -> witness (named
-    "<pair> <name>"), and the far pairs' one; ``value_at(context, i, code)`` gives pair i's
-    value of the kind ``code``, ``far_value(context)`` the far pairs'."""
+    "<pair> <name>"), the far pairs' one and the joint one; ``value_at(context, i, code)``
+    gives pair i's value of the kind ``code``, ``far_value(context)`` the far pairs',
+    ``joint_value(context)`` the least armed one."""
     per_pair = [{kind: system.MakeWitnessFunction(f"{p.name} {name}", DIRECTION,
                                                   lambda c, i=i, k=code: value_at(c, i, k),
                                                   event)
                  for kind, (name, code) in WITNESSES.items()}
                 for i, p in enumerate(pairs)]
     far = system.MakeWitnessFunction(FAR_WITNESS, DIRECTION, far_value, event)
-    return per_pair, far
+    joint = system.MakeWitnessFunction(JOINT_WITNESS, DIRECTION, joint_value, event)
+    return per_pair, far, joint
 
 
 def armed(states, edge_pairs=(), side_pairs=()) -> list:

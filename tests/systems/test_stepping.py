@@ -1,6 +1,10 @@
 """`WitnessApproach` (step shortening before predicted witness zeros) on a bouncing disk with
 known impact times: the same events at the same times as Drake's plain isolation, with fewer
-derivative evaluations."""
+derivative evaluations. The joint witness (`drake_dock.systems.witnesses`,
+`ContactOptions.joint_witness`): Drake, given the least of the armed witnesses as one function,
+takes the same events at the same times, bit for bit, as given one function per transition (a
+second implementation, and the closed form); where an armed witness is not positive after an
+event, the witnesses are given one by one."""
 import math
 
 import numpy as np
@@ -15,8 +19,12 @@ H, E, ACC, MAX_STEP = 0.05, 0.5, 1e-8, 0.01
 CONFIG = SimulatorConfig(integration_scheme="runge_kutta5", accuracy=ACC, max_step_size=MAX_STEP)
 
 
-def bounce(approach: bool):
-    sc = disk_on_incline(0.0, mu=0.3, restitution=E, options=ContactOptions(zeno_speed=1e-2))
+def bounce(approach: bool, joint: bool = True, states: bool = False):
+    """The first three impacts of a disk dropped from H on a plane: their times and the
+    derivative evaluations (and with ``states`` the states after them); ``joint``:
+    `ContactOptions.joint_witness`."""
+    sc = disk_on_incline(0.0, mu=0.3, restitution=E,
+                         options=ContactOptions(zeno_speed=1e-2, joint_witness=joint))
     r = sc.params["radius"]
     sim = make_simulator(sc.system, CONFIG, lambda ctx: sc.set_state(
         ctx, (np.eye(3), np.array([0, 0, r + H])), (np.zeros(3), np.zeros(3))))
@@ -29,7 +37,9 @@ def bounce(approach: bool):
     v1 = math.sqrt(2 * G * H)
     t1 = math.sqrt(2 * H / G)
     sim.AdvanceTo(t1 + 2 * v1 / G * (E + E**2) + 0.01)      # the first three impacts
-    return [i.t for i in sc.system.get_modes(ctx).impacts], sc.system.evaluations - n0
+    impacts = sc.system.get_modes(ctx).impacts
+    out = [i.t for i in impacts], sc.system.evaluations - n0
+    return out + ([i.x_plus for i in impacts],) if states else out
 
 
 def test_same_impact_times_with_fewer_evaluations():
@@ -74,3 +84,39 @@ def test_gap_rates_of_a_falling_disk_are_its_velocity_and_gravity():
     assert rates[name] == pytest.approx(0.7, rel=1e-12)
     second = sc.system.witness_second_rates(ctx, [name])
     assert second[name] == pytest.approx(-G, rel=1e-9)
+
+
+def test_same_events_as_one_witness_per_transition():
+    v1, t1 = math.sqrt(2 * G * H), math.sqrt(2 * H / G)
+    expected = [t1 + sum(2 * v1 * E**j / G for j in range(1, k + 1)) for k in range(3)]
+    window = tolerances(CONFIG).witness_window
+    for approach in (False, True):      # Drake's plain isolation, and the step shortening
+        t_joint, n_joint, x_joint = bounce(approach, True, states=True)
+        t_each, n_each, x_each = bounce(approach, False, states=True)
+        assert len(t_joint) == 3
+        assert t_joint == t_each and n_joint == n_each
+        for a, b in zip(x_joint, x_each):
+            np.testing.assert_array_equal(a, b)
+        np.testing.assert_allclose(t_joint, expected, atol=2 * window + 1e-12)
+
+
+def test_the_joint_value_is_the_least_armed_one_and_steps_aside_at_a_zero():
+    sc = disk_on_incline(0.0, mu=0.3, restitution=E, options=ContactOptions(zeno_speed=1e-2))
+    r = sc.params["radius"]
+    h = 0.2 * sc.system.options.track_distance      # the couple tracked: gap and domain ends
+    sim = make_simulator(sc.system, CONFIG, lambda ctx: sc.set_state(
+        ctx, (np.eye(3), np.array([0, 0, r + h])), (np.zeros(3), np.zeros(3))))
+    sim.Initialize()
+    ctx = sc.system.GetMyMutableContextFromRoot(sim.get_mutable_context())
+    values = sc.system.witness_values(ctx)
+    assert len(values) >= 2 and min(values.values()) > 0
+    assert sc.system._joint_value(ctx) == min(values.values())
+    assert len(sc.system.GetWitnessFunctions(ctx)) == 1
+    # The disk's rim below the plane and sinking: its impact witness (v_n, the gap being
+    # negative) is not positive, and the witnesses are given one by one.
+    sc.set_state(ctx, (np.eye(3), np.array([0, 0, r - 1e-4])),
+                 (np.zeros(3), np.array([0.0, 0.0, -0.1])))
+    values = sc.system.witness_values(ctx)
+    assert min(values.values()) < 0
+    assert sc.system._joint_value(ctx) == min(values.values())
+    assert len(sc.system.GetWitnessFunctions(ctx)) == len(values)
