@@ -345,7 +345,8 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     # ------------------------------------------------------------------ events
     def _on_step(self, context, state):
         """Per-step event: far pairs whose travel bound has used ``reseek_early`` of their
-        clearance are sought again at the start of this step (`Transitions.reseek_far`); a
+        clearance, or will within ``reseek_horizon`` (`Evaluation.due_pairs`), are sought
+        again at the start of this step (`reseek_far`); a
         couple that drifted beyond ``drift_tol`` (a tracked one is sought again, one in contact
         projected) takes an event with every other transition due, as at a witness event.
         The clearance witness stays the guarantee; sought a little early, a pair needs no
@@ -353,18 +354,18 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
         E = self._cache.Eval(context)
         if E.drifting < 0 and not E.due:
             return EventStatus.DidNothing()
-        early = self.options.reseek_early
         if E.drifting < 0:
             x = context.get_continuous_state_vector().CopyToVector()
             done = reseek_far(self.transitions, context.get_time(), x,
-                              self.get_modes(context), E, early)
+                              self.get_modes(context), E)
             if done is not None:
                 state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(done[0])
                 state.get_mutable_abstract_state(self._mode_index).set_value(done[1])
                 return EventStatus.Succeeded()
-        return self._on_event(context, None, state, early=early)
+        return self._on_event(context, None, state, early=self.options.reseek_early,
+                              due=frozenset(E.due_pairs.tolist()) if E.due else ())
 
-    def _on_event(self, context, event, state, early=1.0):
+    def _on_event(self, context, event, state, early=1.0, due=()):
         x = context.get_continuous_state_vector().CopyToVector()
         t, modes = context.get_time(), self.get_modes(context)
         if event is None and modes.mode_changes == 0:
@@ -372,7 +373,7 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
         x_new, modes_new = self._events.get(
             (t, x.tobytes(), modes.mode_changes),
             lambda: self.transitions.resolve(t, x, modes, self.input_force(context),
-                                             lambda: self._cache.Eval(context), early))
+                                             lambda: self._cache.Eval(context), early, due))
         state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(x_new)
         state.get_mutable_abstract_state(self._mode_index).set_value(copy.deepcopy(modes_new))
         return EventStatus.Succeeded()

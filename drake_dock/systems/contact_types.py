@@ -69,6 +69,10 @@ class ContactOptions:
     reseek_floor: float = 1e-4       # m: smallest relative travel between two re-seeks
     reseek_early: float = 0.9        # far pairs are sought again at the first step start where
                                      # this fraction of their clearance is used (0: never)
+    reseek_horizon: float = 0.0      # s: or will be within this time at the present rate of
+                                     # their travel bound (`witness_values.due_in`); the
+                                     # docking diagram sets the step cap, so that no step is
+                                     # cut short to end where one falls due
     conditioning_min: float = 1e-6   # |det J| / prod(row norms) below which J is singular
     v_slip: float = 1e-6             # m/s: a couple slower than this may stick
     zeno_speed: float = 1e-3         # m/s: the Zeno guard (`drake_dock.core.hybrid`)
@@ -96,6 +100,9 @@ class ContactOptions:
                                      # resolves it (a contact system built directly)
 
     def __post_init__(self):
+        if not 0.0 <= self.reseek_horizon < math.inf:
+            raise InputError("ContactOptions.reseek_horizon", self.reseek_horizon,
+                             "a time >= 0 s")
         if self.painleve not in PAINLEVE:
             raise InputError("ContactOptions.painleve", self.painleve,
                              f"one of {', '.join(map(repr, PAINLEVE))}")

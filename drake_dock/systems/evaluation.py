@@ -10,7 +10,7 @@ import numpy as np
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels import model as E
 from drake_dock.core.kernels.couple_row import CoupleRow
-from drake_dock.core.kernels.witness_values import far_witness
+from drake_dock.core.kernels.witness_values import due_far, far_witness
 
 
 class Kinematics:
@@ -225,16 +225,23 @@ class Evaluation:
 
     @property
     def far_early(self) -> float:
-        """The time before a far pair is due a seek at a step's start (`due`) at the present
-        rate of its travel bound, inf without one."""
+        """The time before the next far pair not `due` now is due a seek at a step's start, at
+        the present rate of its travel bound, inf without one."""
         self._far_pass()
         return float(self.sc[E.S_FAR_EARLY])
 
     @property
     def due(self) -> bool:
-        """A far pair's travel bound has used ``reseek_early`` of its clearance."""
+        """A far pair's travel bound has used ``reseek_early`` of its clearance, or will within
+        ``reseek_horizon`` (`witness_values.due_in`)."""
         self._far_pass()
         return bool(self.sc[E.S_DUE])
+
+    @property
+    def due_pairs(self) -> np.ndarray:
+        """The far pairs (ascending) that `due` finds due."""
+        self._far_pass()
+        return due_far(self.engine.packed, self.engine.mode_arrays(self.modes), self.buf)
 
     @property
     def drifting(self) -> int:

@@ -1,6 +1,7 @@
 """The seeks at a step's start when nothing else is due (`RigidContactSystem._on_step`): far
-pairs whose travel bound has used ``reseek_early`` of their clearance are screened or sought
-again, without a full event, as long as each stays far."""
+pairs whose travel bound has used ``reseek_early`` of their clearance, or will within
+``reseek_horizon``, are screened or sought again, without a full event, as long as each stays
+far."""
 from __future__ import annotations
 
 from drake_dock.core.hybrid import Mode
@@ -8,18 +9,16 @@ from drake_dock.systems.contact_types import ContactModes
 from drake_dock.systems.evaluation import Kinematics
 
 
-def reseek_far(tr, t, x, modes, E, early):
+def reseek_far(tr, t, x, modes, E):
     """The seeks of the `Transitions` tr due at a step's start when nothing else is (no
-    witness crossed, no couple drifted): the far pairs whose travel bound has used ``early``
-    of their clearance (E the evaluation at (t, x, modes)) are screened or sought again, each
-    as in `Transitions.resolve`. Returns (x, modes) when each stays far, with only those pairs' far-pair
+    witness crossed, no couple drifted): the far pairs due (`Evaluation.due_pairs`, E the
+    evaluation at (t, x, modes)) are screened or sought again, each as in
+    `Transitions.resolve`. Returns (x, modes) when each stays far, with only those pairs' far-pair
     data and couples changed (the other pair states are shared, the modes' index patched,
     ``reseeks`` counted); None when a seek would change a mode (the caller resolves the
     event in full)."""
     index = modes.index()
-    far = index.far
-    bound = E.bound[far]
-    due = far[index.sought & (bound >= early * index.clearance)].tolist()
+    due = E.due_pairs.tolist()
     if not due:
         return None
     ev = tr.ev

@@ -55,11 +55,12 @@ class Transitions:
         self.pairs, self.law, self.options = ev.pairs, ev.law, ev.options
         self.eng = ev.engine
 
-    def resolve(self, t, x, modes, inputs, current, early=1.0):
+    def resolve(self, t, x, modes, inputs, current, early=1.0, due=()):
         """All the transitions due at time t and state x from `ContactModes` ``modes``;
         returns (x, modes). ``inputs`` is the inputs' generalized force; ``current()`` gives
         the evaluation at (t, x, modes). Far pairs are sought again when their travel bound
-        reaches ``early`` x their clearance."""
+        reaches ``early`` x their clearance, and the far pairs ``due`` in any case (those due
+        at a step's start, `Evaluation.due_pairs`)."""
         ev, opt = self.ev, self.options
         modes = modes.working_copy()
         modes.mode_changes += 1
@@ -82,7 +83,8 @@ class Transitions:
         for i, st in enumerate(modes.pairs):
             if i in handed or i in handed.values():
                 continue
-            if initial or (st.mode == Mode.FAR and travel[i] >= early * st.clearance):
+            if initial or (st.mode == Mode.FAR and (travel[i] >= early * st.clearance
+                                                    or i in due)):
                 if not self.screen(i, poses, modes.pairs):
                     sought.append((i, self.seek(i, poses, modes.pairs, u, t, False, initial)))
                 continue

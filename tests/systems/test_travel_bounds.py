@@ -53,3 +53,39 @@ def test_far_pair_travel_bound_covers_every_point_of_the_patch():
                                               rel=1e-14)
     states[1] = PairState(Mode.FAR)
     assert math.isinf(far.bounds([0, 1, 2], poses1, states)[1])
+
+
+@pytest.mark.parametrize("horizon", [0.0, 0.05, 1.0])
+def test_a_far_pair_falls_due_within_the_reseek_horizon_by_its_bounds_rate(horizon):
+    """A disk 0.5 m above a plane, sinking at 1 m/s, just sought: its travel bound is 0 and
+    grows at the speed of its rim's centre, so it reaches ``reseek_early`` of the clearance c
+    after 0.9 c / (1 m/s); the pair is due at this step's start iff that is within the horizon,
+    and otherwise the step-end target is that time."""
+    from pydrake.systems.analysis import Simulator
+
+    from drake_dock.studies.small_scenes import disk_on_incline
+    from drake_dock.systems.contact_system import ContactOptions
+    options = ContactOptions(reseek_horizon=horizon)
+    sc = disk_on_incline(0.0, options=options)
+    sim = Simulator(sc.system)
+    ctx = sim.get_mutable_context()
+    sc.set_state(ctx, (np.eye(3), np.array([0.0, 0.0, sc.params["radius"] + 0.5])),
+                 (np.zeros(3), np.array([0.0, 0.0, -1.0])))
+    sim.Initialize()
+    state = sc.system.get_modes(ctx).pairs[0]
+    assert state.mode == Mode.FAR and state.clearance > 0.1
+    E = sc.system.eval(ctx)
+    t_due = options.reseek_early * state.clearance / 1.0
+    assert E.bound[0] == pytest.approx(0.0, abs=1e-15)
+    if t_due <= horizon:
+        assert E.due and E.due_pairs.tolist() == [0] and math.isinf(E.far_early)
+    else:
+        assert not E.due and E.due_pairs.tolist() == []
+        assert E.far_early == pytest.approx(t_due, rel=1e-12)
+
+
+def test_the_reseek_horizon_is_checked():
+    from drake_dock.errors import InputError
+    from drake_dock.systems.contact_system import ContactOptions
+    with pytest.raises(InputError, match="reseek_horizon"):
+        ContactOptions(reseek_horizon=-1e-3)

@@ -272,7 +272,7 @@ def toy_model():
 def warm():
     """Compiles or loads the engine's kernels: one evaluation of `toy_model`, and its far pass."""
     from drake_dock.core.kernels.records import pack
-    from drake_dock.core.kernels.witness_values import far_witness
+    from drake_dock.core.kernels.witness_values import due_far, far_witness
     m, s, x = toy_model()
     mp, sp = pack(m), pack(s)
     nbush, k, F = m.bush_frames.shape[0], s.code.shape[0], m.frame_body.shape[0]
@@ -280,3 +280,4 @@ def warm():
                           s.near.shape[0])[-1])
     evaluate(mp, sp, x, np.zeros(int(m.sizes[Z_NV])), buf)
     far_witness(mp, sp, buf)
+    due_far(mp, sp, buf)

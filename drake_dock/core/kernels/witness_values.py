@@ -10,8 +10,8 @@ from numba import njit
 
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.jets import jet
-from drake_dock.core.kernels.model import (AFFINE, FAR, O_EARLY, S_DUE, S_FAR, S_FAR_EARLY,
-                                           Z_NV, Z_NX,
+from drake_dock.core.kernels.model import (AFFINE, FAR, O_EARLY, O_HORIZON, S_DUE, S_FAR,
+                                           S_FAR_EARLY, Z_NV, Z_NX,
                                            layout, unpack_model, unpack_modes)
 from drake_dock.core.kernels.jets import position
 
@@ -131,37 +131,74 @@ def bound_rate(m, i, R, o, w, vf):
 
 
 @njit(cache=True)
-def far_witness(mp, sp, buf):
-    """Into an evaluation's result buffer (`layout`): the far pairs' travel bounds (BOUND;
-    NaN for the pairs not far), their witness, the smallest clearance left, min (clearance -
-    bound) (1 if no pair is far; scalar S_FAR), the time before a pair sought before is due a
-    seek at a step's start, min (reseek_early clearance - bound) / (the bound's rate,
-    `bound_rate`) (inf for none; S_FAR_EARLY), and whether one is due (S_DUE). Asked by the witnesses and the step's start,
-    not by every evaluation."""
-    m = unpack_model(mp)
-    s = unpack_modes(sp)
+def due_in(m, s, i, R, o, w, vf, bound):
+    """The time before far pair i (sought before) is due a seek at a step's start: (reseek_early
+    clearance - bound) / (the bound's rate, `bound_rate`), 0 once its bound has reached
+    reseek_early of its clearance, inf at rest."""
+    left = m.options[O_EARLY] * s.clearance[i] - bound[i]
+    if left <= 0.0:
+        return 0.0
+    rate = bound_rate(m, i, R, o, w, vf)
+    return left / rate if rate > 0.0 else math.inf
+
+
+@njit(cache=True)
+def _far_views(m, s, buf):
+    """The far pass's views of an evaluation's result buffer (`layout`): the travel bounds,
+    the frames' rotations, origins, angular and linear velocities, and the scalars."""
     k, F, nbush = s.code.shape[0], m.frame_body.shape[0], m.bush_frames.shape[0]
     XD, OUT, LN, LT, GF, WV, BD, FR, FO, FW, FV, SC, BU, END = layout(
         m.sizes[Z_NX], k, m.sizes[Z_NV], F, nbush, s.near.shape[0])
-    bound = buf[BD:FR]
-    R, o = buf[FR:FO].reshape((F, 3, 3)), buf[FO:FW].reshape((F, 3))
-    w, vf = buf[FW:FV].reshape((F, 3)), buf[FV:SC].reshape((F, 3))
+    return (buf[BD:FR], buf[FR:FO].reshape((F, 3, 3)), buf[FO:FW].reshape((F, 3)),
+            buf[FW:FV].reshape((F, 3)), buf[FV:SC].reshape((F, 3)), buf[SC:BU])
+
+
+@njit(cache=True)
+def far_witness(mp, sp, buf):
+    """Into an evaluation's result buffer (`layout`): the far pairs' travel bounds (BOUND;
+    NaN for the pairs not far), their witness, the smallest clearance left, min (clearance -
+    bound) (1 if no pair is far; scalar S_FAR), whether a pair sought before is due a seek at
+    this step's start, its `due_in` within the reseek horizon (S_DUE), and the time before the
+    next of the others is (inf for none; S_FAR_EARLY). Asked by the witnesses and the step's
+    start, not by every evaluation."""
+    m = unpack_model(mp)
+    s = unpack_modes(sp)
+    k = s.code.shape[0]
+    bound, R, o, w, vf, scalars = _far_views(m, s, buf)
     far_bounds(m, s, R, o, bound)
     wfar = math.inf
     lead = math.inf
     due = 0.0
-    early = m.options[O_EARLY]
+    early, horizon = m.options[O_EARLY], m.options[O_HORIZON]
     for i in range(k):
         if s.code[i] == FAR:
             wfar = min(wfar, s.clearance[i] - bound[i])
             if s.sought[i] and early > 0.0:
-                left = early * s.clearance[i] - bound[i]
-                if left <= 0.0:
+                t_due = due_in(m, s, i, R, o, w, vf, bound)
+                if t_due <= horizon:
                     due = 1.0
                 else:
-                    rate = bound_rate(m, i, R, o, w, vf)
-                    if rate > 0.0:
-                        lead = min(lead, left / rate)
-    buf[SC + S_FAR] = 1.0 if wfar == math.inf else wfar
-    buf[SC + S_FAR_EARLY] = lead
-    buf[SC + S_DUE] = due
+                    lead = min(lead, t_due)
+    scalars[S_FAR] = 1.0 if wfar == math.inf else wfar
+    scalars[S_FAR_EARLY] = lead
+    scalars[S_DUE] = due
+
+
+@njit(cache=True)
+def due_far(mp, sp, buf):
+    """The far pairs (ascending) due a seek at this step's start (`far_witness`'s S_DUE): those
+    sought before whose `due_in` is within the reseek horizon, from an evaluation's result
+    buffer with its far pass done."""
+    m = unpack_model(mp)
+    s = unpack_modes(sp)
+    k = s.code.shape[0]
+    bound, R, o, w, vf, scalars = _far_views(m, s, buf)
+    out = np.empty(k, dtype=np.int64)
+    n = 0
+    if m.options[O_EARLY] > 0.0:
+        for i in range(k):
+            if s.code[i] == FAR and s.sought[i] and \
+                    due_in(m, s, i, R, o, w, vf, bound) <= m.options[O_HORIZON]:
+                out[n] = i
+                n += 1
+    return out[:n]

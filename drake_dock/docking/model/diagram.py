@@ -74,7 +74,8 @@ class DiagramSpec:
         """The spec of a scenario. ``scene``: the scenario's `DockingScene` where the caller
         has it (made here where None; `InputError` for another scene's). ``options``: the
         contact system's options, by default ContactOptions with LZB's accuracy following the
-        simulator's (`drake_dock.systems.simulator.tolerances`); where their ``broad_phase``
+        simulator's (`drake_dock.systems.simulator.tolerances`) and the far pairs' reseek
+        horizon its step cap (no step is cut short to end where a far pair falls due); where their ``broad_phase``
         is None, the scene's policy: the broad phase screens the far pairs of every set but
         `paper`, whose 12 pairs are sought as in Sect. 5.1 (docs/model.md, "Hybrid
         simulation"); an explicit True or False is kept. ``handovers`` declares the
@@ -87,7 +88,8 @@ class DiagramSpec:
                              "contact.pairs)", "another scene's")
         if options is None:
             options = ContactOptions(
-                impact_rtol=tolerances(scenario.simulator_config).impact_rtol)
+                impact_rtol=tolerances(scenario.simulator_config).impact_rtol,
+                reseek_horizon=scenario.simulator_config.max_step_size)
         if options.broad_phase is None:
             options = dataclasses.replace(options, broad_phase=scenario.contact.pairs != "paper")
         law = ContactLaw(**{f.name: getattr(scenario.contact, f.name)
