@@ -2,13 +2,15 @@
 of the modules it imports (numba checks only a kernel's own file), and no other. The parallel
 compile caches every kernel (each is compiled by some module's warm()) so that another process
 loads them without compiling; concurrent writers of one function's signatures leave an index
-that loads each of them."""
+that loads each of them. A kernel of the package is compiled once per argument types, not once
+per constant it is called with."""
 import os
 import shutil
 import subprocess
 import sys
 import textwrap
 
+from numba import njit
 from numba.core.registry import CPUDispatcher
 
 from drake_dock.core.kernels import compile_cache as cc
@@ -205,3 +207,25 @@ def test_a_unit_starts_after_the_owners_of_its_modules():
         owners = {min((u for u in order if d in deps[u]), key=lambda u: (len(deps[u]), u))
                   for d in deps[a]} - {a}
         assert bs == owners
+
+
+def _callee_called_with_two_constants(module: str):
+    """A kernel of ``module`` called by another with the constants 2 and 3; its signatures."""
+    def shift(x, k):
+        return x + k
+    shift.__module__ = module
+    shift = njit(shift)
+
+    @njit
+    def caller(x):
+        return shift(x, 2) * shift(x, 3)
+    assert caller(1.0) == 12.0                  # (1 + 2) (1 + 3)
+    return [tuple(str(a) for a in sig) for sig in shift.signatures]
+
+
+def test_a_kernel_of_the_package_is_compiled_once_per_argument_types_not_per_constant():
+    # numba's own rule, for a function outside the package: one machine code per constant.
+    assert _callee_called_with_two_constants("elsewhere") == [
+        ("float64", "Literal[int](2)"), ("float64", "Literal[int](3)")]
+    # A kernel of the package: one, for the constants' type.
+    assert _callee_called_with_two_constants(f"{cc.PACKAGE}.probe") == [("float64", "int64")]

@@ -25,6 +25,14 @@ once could leave an entry naming the other's machine code (numba issue #10128 sh
 race for gufuncs). `configure` makes that step hold an exclusive ``flock`` on the directory's
 ``index.lock``. A directory holds one key only, so a data file's name keeps its meaning.
 
+One machine code per argument types: numba types a constant argument of a call between kernels
+as a literal (``Literal[int](3)``, ``Literal[bool](True)``) and compiles the callee again for
+each constant it is called with (a record's field getter once per field, the seek's Newton
+solve once per iteration limit). `configure` makes a kernel of this package type its callers'
+arguments without their literal values (`_unliteral`): each callee is compiled once per
+argument types, which takes about a sixth off the compile (docs/performance.md, "Compiled
+kernels") and leaves the results bit for bit (no kernel branches on a constant's type).
+
 ``python -m drake_dock.core.kernels`` compiles (or loads) every kernel and prints the directory.
 """
 from __future__ import annotations
@@ -38,7 +46,8 @@ import pathlib
 import tempfile
 
 import numba
-from numba.core import caching, config
+from numba.core import caching, config, types
+from numba.core.dispatcher import Dispatcher
 from numba.core.caching import _CacheLocator
 
 try:
@@ -139,7 +148,7 @@ def module_key(name: str, package: pathlib.Path = _PACKAGE) -> str:
     """A digest of numba's version, `opt_level` and the sources (names and bytes) of
     `dependencies`: it changes when the module or a module it imports changes."""
     digest = hashlib.sha256(f"numba {numba.__version__} "
-                            f"opt {opt_level()}".encode())
+                            f"opt {opt_level()} unliteral".encode())
     for dep in dependencies(name, package):
         digest.update(dep.encode() + b"\0" + module_file(dep, package).read_bytes() + b"\0")
     return digest.hexdigest()[:16]
@@ -216,6 +225,19 @@ def _locked(save):
     return locked_save
 
 
+def _unliteral(get_call_template):
+    """numba's ``Dispatcher.get_call_template`` typing a call to a kernel of this package with
+    the arguments' types without their literal values (the module docstring)."""
+    @functools.wraps(get_call_template)
+    def call_template(self, args, kws):
+        if getattr(self.py_func, "__module__", "").startswith(PACKAGE + "."):
+            args = tuple(types.unliteral(a) for a in args)
+            kws = {k: types.unliteral(v) for k, v in kws.items()}
+        return get_call_template(self, args, kws)
+    call_template.drake_dock_unliteral = True
+    return call_template
+
+
 def _choose_base() -> pathlib.Path:
     """The base directory of the module docstring's rules (a fresh temporary directory when
     none of them is writable: the kernels are then compiled in every process)."""
@@ -228,8 +250,8 @@ def _choose_base() -> pathlib.Path:
 
 def configure() -> None:
     """Chooses the base directory, sets ``NUMBA_OPT`` to `opt_level` (numba reads it again
-    before it compiles), puts `KeyedLocator` first in numba's locators and locks the index
-    updates. Idempotent."""
+    before it compiles), puts `KeyedLocator` first in numba's locators, locks the index
+    updates and types the kernels' calls without literals (`_unliteral`). Idempotent."""
     global _base
     if _base is not None:
         return
@@ -244,4 +266,6 @@ def configure() -> None:
         impl._locator_classes.insert(0, KeyedLocator)
     if not getattr(caching.IndexDataCacheFile.save, "drake_dock_locked", False):
         caching.IndexDataCacheFile.save = _locked(caching.IndexDataCacheFile.save)
+    if not getattr(Dispatcher.get_call_template, "drake_dock_unliteral", False):
+        Dispatcher.get_call_template = _unliteral(Dispatcher.get_call_template)
 
