@@ -213,3 +213,10 @@ def test_stewart_stroke_from_the_poses(runs):
     np.testing.assert_allclose(ts["stewart_x"][:, 2], offset[:, 2], atol=1e-12)
     np.testing.assert_allclose(ts["stewart_rpy"][:, 2], yaw, atol=1e-12)
     assert np.abs(offset[:, 2]).max() > 0.01         # a stroke of centimetres
+
+
+def test_a_drift_below_round_off_is_named_round_off_in_a_title_and_above_it_shown():
+    from drake_dock.docking.report.results import ROUND_OFF, drift_text
+    assert drift_text(0.38 * ROUND_OFF) == drift_text(-0.38 * ROUND_OFF) == "< 1e-10 (round-off)"
+    assert float(drift_text(6.17e-7)) == 6.2e-7         # one decimal, by default
+    assert drift_text(None) == "undefined"

@@ -8,7 +8,7 @@ import numpy as np
 from drake_dock.docking.report.figure_kit import (PALETTE, Sheet, impact_lines, legend_beside,
                                                   time_axes, with_data)
 from drake_dock.docking.report.interface_loads import interface_loads
-from drake_dock.docking.report.results import IN_CONTACT, relative_text
+from drake_dock.docking.report.results import IN_CONTACT, drift_text
 
 
 
@@ -101,7 +101,7 @@ def energy_ledger_figure(ts, summary, out):
     sh.fig.suptitle(f"Energy ledger (inertial frame): initial {led['initial_total_J']:.4g} J"
                     + ("" if com is None else f", of which {com:.4g} J in the motion of the "
                        f"centre of mass") + f"\nlosses on the right (closure "
-                    f"{relative_text(led['closure_error_relative'], '.1e')} of the initial "
+                    f"{drift_text(led['closure_error_relative'])} of the initial "
                     f"energy)")
     return sh.save(out, "energy_ledger.png", legends)
 

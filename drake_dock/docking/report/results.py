@@ -194,9 +194,21 @@ def relative(value, scale):
     return float(value / scale) if scale > 0 else None
 
 
+ROUND_OFF = 1e-10    # a relative drift or closure below it is round-off, shown as such
+
+
 def relative_text(x, spec=".2e") -> str:
     """A relative quantity of the summary as text ("undefined" for None)."""
     return "undefined" if x is None else format(x, spec)
+
+
+def drift_text(x, spec=".1e") -> str:
+    """A relative drift or closure for a figure's title: its value, or "< 1e-10 (round-off)"
+    below `ROUND_OFF` (the digits of round-off move with any change of the arithmetic, and a
+    figure should not)."""
+    if x is not None and abs(x) < ROUND_OFF:
+        return f"< {ROUND_OFF:g} (round-off)"
+    return relative_text(x, spec)
 
 
 def centre_of_mass_kinetic_energy(ts: dict, masses) -> np.ndarray:

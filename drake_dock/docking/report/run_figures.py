@@ -11,7 +11,7 @@ from drake_dock.docking.report.figure_kit import (PALETTE, ROUND_OFF, Sheet, imp
                                                   legend_beside, negligible, time_axes, with_data)
 from drake_dock.docking.report.ledger_figures import (couple_forces_figure, energy_ledger_figure,
                                                       interface_loads_figure)
-from drake_dock.docking.report.results import relative_text
+from drake_dock.docking.report.results import ROUND_OFF, drift_text
 
 # The symmetric couples of Fig. 8 drawn over each other: wide light solid, dashed, thin dotted.
 STYLES = (dict(lw=6.0, alpha=0.55, ls="-"), dict(lw=2.8, ls=(0, (5, 3))),
@@ -180,7 +180,7 @@ def _impulses(sh, ax, ts, focus, idx, hit, floor):
 
 
 # A momentum drift below this fraction of its scale is round-off: not plotted.
-DRIFT_FLOOR = 1e-10
+DRIFT_FLOOR = ROUND_OFF
 
 
 def momentum_figure(ts, summary, momentum, out):
@@ -217,9 +217,8 @@ def momentum_figure(ts, summary, momentum, out):
     legends = time_axes(axs, ts)
     d = summary["momentum_drift_relative"]
     sh.fig.suptitle(f"Fig. 9 equivalent: momentum (largest drift relative to its scale: "
-                    f"linear {relative_text(d['linear'], '.1e')}, "
-                    f"angular {relative_text(d['angular'], '.1e')}"
-                    + ("" if visible else f"; below {DRIFT_FLOOR:g}: round-off") + ")")
+                    f"linear {drift_text(d['linear'])}, "
+                    f"angular {drift_text(d['angular'])})")
     return sh.save(out, "fig9_momentum.png", legends)
 
 
