@@ -57,14 +57,20 @@ def surface_params(edge: SurfaceEdge, lower, upper, e: float) -> list:
     return a
 
 
-def reaches_edge(edge: SurfaceEdge, lower, upper, a) -> bool:
+#: A seek's couple on the boundary of its domain converges onto the bound from inside: within
+#: this fraction of the parameter's span it lies on the edge (`reaches_edge`'s ``rtol``).
+SEEK_EDGE_RTOL = 1e-8
+
+
+def reaches_edge(edge: SurfaceEdge, lower, upper, a, rtol: float = 0.0) -> bool:
     """Rule: the surface couple a is on or past the edge (its ``fixed`` parameter at or past
-    that bound) and along it (its other parameter within its bounds: a couple past a corner is
-    on neither edge's curve)."""
+    that bound, or within ``rtol`` of its span inside it) and along it (its other parameter
+    within its bounds: a couple past a corner is on neither edge's curve)."""
     k, f = edge.fixed, edge.free
     if not lower[f] <= a[f] <= upper[f]:
         return False
-    return a[k] >= upper[k] if edge.upper else a[k] <= lower[k]
+    tol = rtol * (upper[k] - lower[k])
+    return a[k] >= upper[k] - tol if edge.upper else a[k] <= lower[k] + tol
 
 
 def to_edge(edge: SurfaceEdge, n1: int, u) -> list:

@@ -240,9 +240,11 @@ class Transitions:
                              "the bodies start interpenetrating")
         u[ev.couple_slice(i)] = uc
         # A couple where a hand-over is due (on a declared edge of the surface, or an edge
-        # couple over the face) is the linked pair's, not this pair's.
+        # couple over the face) is the linked pair's, not this pair's. One that is not usable
+        # ends on its domain's bound from inside: on the edge within SEEK_EDGE_RTOL.
         due = [j for j, _ in ev.links.due(i, uc, sigma * raw.n if usable else None,
-                                          poses[b][0])]
+                                          poses[b][0],
+                                          0.0 if usable else handover.SEEK_EDGE_RTOL)]
         mode, clearance = hybrid.after_seek(c.distance, usable and not due, crossing,
                                             was_contact, opt.track_distance, opt.reseek_floor)
         if mode == Mode.TRACKED:
