@@ -163,6 +163,9 @@ class ContactModes:
     impact_loss: float = 0.0
     mode_changes: int = 0           # events that resolved transitions
     reseeks: int = 0                # steps whose start sought far pairs again, nothing else
+    # The continuous state that the event which set these modes left (read-only; None for the
+    # initial modes): a step that starts at an event starts from it.
+    x_after: object = dataclasses.field(default=None, compare=False, repr=False)
 
     def __setattr__(self, name, value):
         if "_index" in self.__dict__:
@@ -180,7 +183,7 @@ class ContactModes:
         if index is None:
             return self.working_copy()
         new = ContactModes(self.pairs, list(self.impacts), self.impact_loss, self.mode_changes,
-                           self.reseeks)
+                           self.reseeks, self.x_after)
         new.__dict__["_index"] = index
         return new
 

@@ -37,10 +37,12 @@ def reseek_far(tr, t, x, modes, E):
         sought.append((i, after))
     for i, after in sought:
         tr.carry(i, after, states)
-    new = ContactModes(states, list(modes.impacts), modes.impact_loss, modes.mode_changes,
-                       modes.reseeks + 1)
     x_new = x.copy()
     x_new[ev.nq + ev.nv:ev.ie] = u
+    after = x_new.copy()
+    after.flags.writeable = False
+    new = ContactModes(states, list(modes.impacts), modes.impact_loss, modes.mode_changes,
+                       modes.reseeks + 1, after)
     new.seal(index.with_far(due, states))
     tr.eng.patch_far(modes, new, due)
     return x_new, new

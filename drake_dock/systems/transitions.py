@@ -25,6 +25,12 @@ def _reseek(p, c, margin, R2, conditioning_min) -> bool:
         relation(p.kind).along_d and point_curve_side(p.patch2, R2, c.u[0], c.n) <= 0.0)
 
 
+def _read_only_copy(x):
+    y = x.copy()
+    y.flags.writeable = False
+    return y
+
+
 def couples_of(ev, kin, u, states, which, t, strict=False):
     """The couples (`CoupleRow`) of the pairs ``which`` of the `RigidContactSystem` ``ev`` at
     u with their states' sigma; a point-curve couple whose point lies on its curve raises
@@ -111,6 +117,7 @@ class Transitions:
         x_new[ev.nq:ev.nq + ev.nv] = v
         x_new[ev.nq + ev.nv:ev.ie] = u
         impulses.log(x, x_new)
+        modes.x_after = _read_only_copy(x_new)
         return x_new, modes.seal()
 
     def _handovers(self, states, kin, u, t) -> tuple[dict, dict]:

@@ -4,7 +4,10 @@ The record holds one sample at the end of every integration step (so the step th
 impact's witness gives the state just before it) and, for each impact, one sample of the state
 just after it at the same time (from the impact log; no step end sees that state). An event
 with two impulses (an LZB impact, then an impact without collision) gives two samples after
-it, the first also the state just before the second. The simulation ends at
+it, the first also the state just before the second. With ``simulation.output_period`` the
+step ends give way to the multiples of the period, interpolated within each step
+(`_Grid`), so that the step is set by the accuracy and the events alone; the samples at
+impacts and the last state stay. The simulation ends at
 ``simulation.duration`` or at capture (`CaptureMonitor`'s witness).
 
 Integration: the scenario's ``simulator_config`` (Drake's `SimulatorConfig`), applied by
@@ -162,21 +165,39 @@ def docking_simulator(dd: DockingDiagram, state: InitialState, config,
 
 
 class _Recorder:
-    def __init__(self, dd: DockingDiagram):
+    """The record of a run: ``period`` None, a sample at every step end; else at the multiples
+    of ``period`` (`_Grid`)."""
+
+    def __init__(self, dd: DockingDiagram, period: float | None = None):
         self.dd = dd
         self.record = Record(dd)
         self.n_impacts = 0
         self._scratch = dd.diagram.CreateDefaultContext()
+        self.grid = None if period is None else _Grid(self, period)
 
-    def _append(self, root, kind):
+    def _sample_of(self, root):
         contact = self.dd.contact
         cc = contact.GetMyContextFromRoot(root)
-        self.record.append(root.get_time(), cc.get_continuous_state_vector().CopyToVector(),
-                           kind, contact.get_modes(cc), contact.input_force(cc))
+        return (root.get_time(), cc.get_continuous_state_vector().CopyToVector(),
+                contact.get_modes(cc), contact.input_force(cc))
 
-    def sample(self, root):
-        """A step end. Impacts logged since the last sample happened at that sample's time:
-        it becomes the pre-impact sample and the logged post-impact state follows it."""
+    def _append(self, root, kind):
+        t, x, modes, tau = self._sample_of(root)
+        self.record.append(t, x, kind, modes, tau)
+
+    def start(self, sim):
+        """After `Simulator.Initialize`: the first sample (and the grid's first step start)."""
+        if self.grid is None:
+            return self.sample(sim.get_context())
+        self._append(sim.get_context(), STEP)
+        self.grid.start(sim)
+
+    def sample(self, root, last: bool = False):
+        """A step end (``last``: the run's end). Impacts logged since the last step end
+        happened at that step end's time: it becomes the pre-impact sample and the logged
+        post-impact state follows it."""
+        if self.grid is not None:
+            return self.grid.step_end(root, last)
         contact = self.dd.contact
         modes = contact.get_modes(contact.GetMyContextFromRoot(root))
         new = modes.impacts[self.n_impacts:]
@@ -189,6 +210,14 @@ class _Recorder:
         if not r.t or root.get_time() > r.t[-1] or new:
             self._append(root, STEP)
 
+    def impacts_since(self, root, modes):
+        """The post-impact samples of the impacts logged since the last call."""
+        new = modes.impacts[self.n_impacts:]
+        for imp in new:
+            self._post_impact(root, imp, modes)
+        self.n_impacts = len(modes.impacts)
+        return new
+
     def _post_impact(self, root, imp, modes):
         s = self._scratch
         s.SetTimeStateAndParametersFrom(root)
@@ -196,6 +225,76 @@ class _Recorder:
         contact = self.dd.contact
         enter_after(contact, contact.GetMyMutableContextFromRoot(s), imp, modes.mode_changes)
         self._append(s, POST_IMPACT)
+
+
+class _Grid:
+    """The samples at the multiples k T of the output period T (k >= 1; the first sample is
+    the initial state). Each is the cubic Hermite interpolant of the step that holds it,
+    between the step's start (the state the event there left, `ContactModes.x_after`, or the
+    last step's end) and its end, with the contact system's derivatives there (fourth order
+    in the step, as accurate as the integration between the samples), under the step's modes.
+    A step end is kept only where it is needed: the state just before an impact logged at its
+    time (a PRE_IMPACT sample, the post-impact ones after it) and the last state of the run.
+    (Drake's own dense output cannot serve: witness isolation integrates a step again from its
+    start, and appending that step to the dense output fails.)"""
+
+    def __init__(self, rec: _Recorder, period: float):
+        self.rec, self.period = rec, float(period)
+        self.k = 1                       # the next multiple of the period to sample
+        self.last = None                 # the last step end: (t, x, modes, tau)
+
+    def start(self, sim):
+        self.last = self.rec._sample_of(sim.get_context())
+
+    def step_end(self, root, last):
+        rec, r = self.rec, self.rec.record
+        end = rec._sample_of(root)
+        t0, x0, modes0, tau0 = self.last
+        modes = end[2]
+        if modes.impacts[rec.n_impacts:]:
+            # The impacts took place at the last step end (the start of this step): the state
+            # before them, then after each.
+            if not r.t or t0 > r.t[-1]:
+                r.append(t0, x0, PRE_IMPACT, modes0, tau0)
+            elif r.kind[-1] == STEP:
+                r.kind[-1] = PRE_IMPACT
+            rec.impacts_since(root, modes)
+        if modes.x_after is not None and modes.x_after is not modes0.x_after:
+            x0 = modes.x_after           # an event at t0 started this step
+        self._interpolate(root, t0, x0, end)
+        self.last = end
+        if last and (not r.t or end[0] > r.t[-1]):
+            r.append(end[0], end[1], STEP, end[2], end[3])
+
+    def _interpolate(self, root, t0, x0, end):
+        """The multiples of the period in (t0, t1], the step that ended now."""
+        t1, x1, modes, _ = end
+        h = t1 - t0
+        if not h > 0.0 or self.k * self.period > t1:
+            return
+        rec, s = self.rec, self.rec._scratch
+        contact = rec.dd.contact
+        sc = contact.GetMyMutableContextFromRoot(s)
+        s.SetTimeStateAndParametersFrom(root)
+
+        def derivative(t, x):
+            s.SetTime(t)
+            sc.SetContinuousState(x)
+            return contact.eval(sc).xdot
+
+        f0, f1 = derivative(t0, x0), derivative(t1, x1)
+        while self.k * self.period <= t1:
+            tk = self.k * self.period
+            self.k += 1
+            if tk <= t0:
+                continue
+            a = (tk - t0) / h
+            h00, h10 = (1 + 2 * a) * (1 - a) ** 2, a * (1 - a) ** 2
+            h01, h11 = a * a * (3 - 2 * a), a * a * (a - 1)
+            s.SetTime(tk)
+            sc.SetContinuousState(h00 * x0 + h10 * h * f0 + h01 * x1 + h11 * h * f1)
+            t, x, m, tau = rec._sample_of(s)
+            rec.record.append(t, x, STEP, m, tau)
 
 
 def _couples_in_play(dd: DockingDiagram, root) -> list:
@@ -232,7 +331,7 @@ def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
     with numerical_failure("the Diagram's set-up", lambda: (0.0, ())):
         dd = dd or build_docking_diagram(DiagramSpec.of(scenario, scene=_scene_of(scenario,
                                                                                   state)))
-        rec = _Recorder(dd)
+        rec = _Recorder(dd, scenario.simulation.output_period)
         sim = docking_simulator(dd, state, scenario.simulator_config)
     t_end = scenario.simulation.duration if duration is None else duration
 
@@ -277,7 +376,7 @@ def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
     with numerical_failure("the simulation",
                             lambda: (root.get_time(), _couples_in_play(dd, root))):
         sim.Initialize()
-        rec.sample(root)
+        rec.start(sim)
         watch = OutcomeWatch.of(dd.capture.distance(dd.capture.GetMyContextFromRoot(root)),
                                 sp, scenario.geometry)
         sim.set_monitor(monitor)
@@ -288,7 +387,7 @@ def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
             # C++ that Python's collector cannot see would keep the run's record alive.
             sim.clear_monitor()
     wall = _time.perf_counter() - wall0
-    rec.sample(root)
+    rec.sample(root, last=True)
     terminated = status.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition
     if ended:
         outcome, reason = ended[0]

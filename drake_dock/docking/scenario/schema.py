@@ -100,6 +100,10 @@ class SimulationParams:
     # The latches' other tolerances (docs/model.md, "Capture"); null leaves one out of the test.
     capture_lateral: typing.Optional[float] = 0.01    # lateral ring-centre offset (m)
     capture_tilt_deg: typing.Optional[float] = 0.5    # tilt between the docking axes (deg)
+    # The outputs' sample spacing (s): the record holds the states at its multiples, from the
+    # integrator's dense output within each step, with the states just before and after each
+    # impact and the last; null: one sample at the end of every integration step.
+    output_period: typing.Optional[float] = None
 
 
 def default_simulator_config() -> SimulatorConfig:
@@ -107,7 +111,7 @@ def default_simulator_config() -> SimulatorConfig:
     fifth-order Runge-Kutta integrator with error control at ``accuracy`` (which also sets the
     witness isolation window and LZB's accuracy: `drake_dock.systems.simulator.tolerances`)
     and its step capped at ``max_step_size`` (s), which is also the sample spacing of the
-    outputs. At that cap the step is mostly the cap's, so the scheme's order sets the error:
+    outputs unless ``simulation.output_period`` sets its own. At that cap the step is mostly the cap's, so the scheme's order sets the error:
     Bogacki-Shampine (3 evaluations a step against RK5's 6) leaves the energy ledger open by
     a few 1e-6 over an off-nominal run, RK5 closes it to 1e-7 (docs/algorithms.md, "Integration";
     bench/paper_example.py runs both)."""

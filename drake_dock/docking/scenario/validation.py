@@ -103,6 +103,14 @@ def validate(s: Scenario) -> Scenario:
             0 < _finite("simulation.capture_tilt_deg", s.simulation.capture_tilt_deg) < 90):
         raise InputError("simulation.capture_tilt_deg", s.simulation.capture_tilt_deg,
                          "0 < tolerance < 90 deg, or null (not tested)")
+    period = s.simulation.output_period
+    if period is not None:
+        _positive("simulation.output_period", period)
+        if s.simulation.duration / period > MAX_STEPS:
+            raise InputError("simulation.output_period", period,
+                             f">= simulation.duration / {MAX_STEPS:.0e} = "
+                             f"{s.simulation.duration / MAX_STEPS:.3g} s, or null (every step end)",
+                             f"more than {MAX_STEPS:.0e} samples")
     if s.thrust is not None:
         _validate_thrust(s.thrust)
     _validate_simulator_config(s.simulator_config, s.simulation.duration)
