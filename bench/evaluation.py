@@ -3,9 +3,11 @@ empty Python LeafSystem in Drake's simulator (the least any Python system costs 
 and with the plant's own evaluation, for the paper's example and the IDSS box corner
 (`models/idss_box_corner.yaml`), all in this run.
 
-Per scene it prints the evaluations, `us per evaluation: <U>` (the contact system's time in its
-cache entry's calculation, the one compiled call with its Python around it, over the
-evaluations it computed) and `ratio to an empty LeafSystem: <N>x`; then the whole run's wall
+Per scene it prints the evaluations, `us per evaluation: <U>` (the contact system's time in
+`RigidContactSystem._lookup`, the one path of its derivatives and of its cache entry: the
+compiled call with its Python around it, memo hits included, over the integrator's derivative
+evaluations; with the computed evaluations and the memo's share) and `ratio to an empty
+LeafSystem: <N>x`; then the whole run's wall
 time per evaluation (witnesses, events, step control, recording and Drake's integrator
 included) and its ratio; and the outcome and capture time. The target (issue: N <= 10 for the
 evaluation) is checked on each scene's line.
@@ -31,26 +33,31 @@ TARGET = 10.0
 
 
 def timed_run(scenario, duration):
-    """(the `RunResult`, seconds in the contact system's cache calculations): the class's
-    calculation wrapped with a clock for this run."""
-    spent = [0.0]
-    calc = RigidContactSystem._calc_eval
+    """(the `RunResult`, seconds in the contact system's evaluation lookups, the number of
+    evaluations computed): the class's lookup and evaluation wrapped with a clock and a
+    counter for this run."""
+    spent, computed = [0.0], [0]
+    lookup, evaluate = RigidContactSystem._lookup, RigidContactSystem._evaluate
 
-    def clocked(self, context, value):
+    def clocked(self, context):
         t0 = time.perf_counter()
         try:
-            calc(self, context, value)
+            return lookup(self, context)
         finally:
             spent[0] += time.perf_counter() - t0
 
-    RigidContactSystem._calc_eval = clocked
+    def counted(self, *args):
+        computed[0] += 1
+        return evaluate(self, *args)
+
+    RigidContactSystem._lookup, RigidContactSystem._evaluate = clocked, counted
     try:
         dd = build_docking_diagram(DiagramSpec.of(scenario))
         r = simulate(scenario, place(scenario, PlacementCache(dd.scene)), dd=dd,
                      duration=duration)
     finally:
-        RigidContactSystem._calc_eval = calc
-    return r, spent[0]
+        RigidContactSystem._lookup, RigidContactSystem._evaluate = lookup, evaluate
+    return r, spent[0], computed[0]
 
 
 def main():
@@ -66,13 +73,14 @@ def main():
     print(f"empty Python LeafSystem: {empty * 1e6:.1f} us per evaluation")
     for name, scenario, duration in scenes:
         simulate(scenario, place(scenario), duration=0.01)   # every kernel and Drake's code
-        r, spent = timed_run(scenario, duration)
+        r, spent, computed = timed_run(scenario, duration)
         n = r.evaluations
         u = spent / n
         t_free, n_free = free_flight(scenario, r.initial, r.end_time)
-        print(f"{name}: {n} evaluations; us per evaluation: {u * 1e6:.1f}; ratio to an empty "
-              f"LeafSystem: {u / empty:.1f}x; the plant's own evaluation "
-              f"{t_free / n_free * 1e6:.1f} us ({u / (t_free / n_free):.1f}x)")
+        print(f"{name}: {n} evaluations ({computed} computed, the rest from the memo); us per "
+              f"evaluation: {u * 1e6:.1f}; ratio to an empty LeafSystem: {u / empty:.1f}x; "
+              f"the plant's own evaluation {t_free / n_free * 1e6:.1f} us "
+              f"({u / (t_free / n_free):.1f}x)")
         print(f"{name}: whole run {r.wall_time:.3f} s, {r.wall_time / n * 1e6:.0f} us per "
               f"evaluation ({r.wall_time / n / empty:.0f}x an empty LeafSystem's); outcome "
               f"{r.outcome}, capture time {r.capture_time}, impacts {len(r.impacts)}")
