@@ -61,6 +61,13 @@ def surface_params(edge: SurfaceEdge, lower, upper, e: float) -> list:
 #: this fraction of the parameter's span it lies on the edge (`reaches_edge`'s ``rtol``).
 SEEK_EDGE_RTOL = 1e-8
 
+#: A pair sought while a pair linked to it by a hand-over holds a contact at their shared
+#: edge: its couple is that contact when it lies within this of the edge, as a fraction of the
+#: span for a surface couple (`reaches_edge`'s ``rtol``), for an edge couple in its guard
+#: (`edge_guard`, a cosine). A seek converges its couple to about 1e-8 of the span and the
+#: edge couple's normal to about 1e-9, so at the edge the side it ends on is noise.
+SEEK_HELD_TOL = 1e-6
+
 
 def reaches_edge(edge: SurfaceEdge, lower, upper, a, rtol: float = 0.0) -> bool:
     """Rule: the surface couple a is on or past the edge (its ``fixed`` parameter at or past

@@ -248,10 +248,14 @@ class Transitions:
         u[ev.couple_slice(i)] = uc
         # A couple where a hand-over is due (on a declared edge of the surface, or an edge
         # couple over the face) is the linked pair's, not this pair's. One that is not usable
-        # ends on its domain's bound from inside: on the edge within SEEK_EDGE_RTOL.
+        # ends on its domain's bound from inside: on the edge within SEEK_EDGE_RTOL. Where a
+        # linked pair holds a contact, a couple within SEEK_HELD_TOL of their edge is it.
+        tol = handover.SEEK_HELD_TOL if any(states[j].mode.in_contact for j, _ in (
+            ev.links.of_edge.get(i, []) + ev.links.of_surface.get(i, []))) else 0.0
         due = [j for j, _ in ev.links.due(i, uc, sigma * raw.n if usable else None,
                                           poses[b][0],
-                                          0.0 if usable else handover.SEEK_EDGE_RTOL)]
+                                          max(tol, 0.0 if usable else handover.SEEK_EDGE_RTOL),
+                                          tol)]
         mode, clearance = hybrid.after_seek(c.distance, usable and not due, crossing,
                                             was_contact, opt.track_distance, opt.reseek_floor)
         if mode == Mode.TRACKED:

@@ -58,11 +58,13 @@ def test_a_surface_pair_touching_at_a_carried_edge_keeps_half_the_track_distance
 
 
 def test_without_the_seek_tolerance_the_pair_is_sought_at_the_floor(carried, monkeypatch):
-    """The same run with the edge tested exactly: the surface pair's couple, a hair inside
-    the edge, is not carried; its clearance is the reseek floor and it is sought many times
-    more often."""
+    """The same run with the edge tested exactly (neither the seek's tolerance nor that of a
+    contact held by the linked pair, `handover.SEEK_HELD_TOL`): the surface pair's couple, a
+    hair inside the edge, is not carried; its clearance is the reseek floor and it is sought
+    many times more often."""
     seeks = carried[3]
     monkeypatch.setattr(handover, "SEEK_EDGE_RTOL", 0.0)
+    monkeypatch.setattr(handover, "SEEK_HELD_TOL", 0.0)
     _, surface, opt, seeks_exact = _run_to(T_END)
     assert surface.mode == Mode.FAR and surface.distance < 1e-9
     assert surface.clearance == pytest.approx(opt.reseek_floor, rel=1e-12)
