@@ -62,7 +62,7 @@ def main():
     ap.add_argument("--skip-plain", action="store_true",
                     help="skip the side-by-side run with Drake's plain witness isolation")
     ap.add_argument("--coarse-step", type=float, default=0.01,
-                    help="also run with this step cap (the output spacing), 0 to skip")
+                    help="also run with this step cap (samples at its step ends), 0 to skip")
     ap.add_argument("--repeats", type=int, default=5,
                     help="runs of the example; the wall time printed is their median")
     ap.add_argument("--compare-scheme", default="bogacki_shampine3",
@@ -154,7 +154,7 @@ def main():
               f"{r.capture_time:.6f} s; speed-up of the step shortening "
               f"{plain.wall_time / wall:.1f}x")
     if coarse is not None:
-        print(f"with the step cap (= output spacing) {args.coarse_step:g} s instead of "
+        print(f"with the step cap {args.coarse_step:g} s (samples at step ends) instead of "
               f"{scenario.simulator_config.max_step_size:g} s: {coarse.wall_time:.3f} s, "
               f"{coarse.evaluations} evaluations, {len(coarse.record.t)} samples instead of "
               f"{len(r.record.t)}; capture {coarse.capture_time:.9f} s vs {r.capture_time:.9f} s; "
