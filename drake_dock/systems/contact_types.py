@@ -65,6 +65,8 @@ class ContactOptions:
     baumgarte: float = 20.0          # omega (rad/s) of the constraint stabilisation
     drift_feedback: float = 50.0     # 1/s, feedback of the couple projection into u*
     drift_tol: float = 1e-3          # largest projection step, relative to the domain span
+    handover_tol: float = 1e-3       # a hand-over's couple: largest Newton step onto its
+                                     # closest-point conditions, relative to the span
     track_distance: float = 0.02     # m: nearer interior isolated couples are tracked
     reseek_floor: float = 1e-4       # m: smallest relative travel between two re-seeks
     reseek_early: float = 0.9        # far pairs are sought again at the first step start where

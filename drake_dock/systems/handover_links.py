@@ -91,7 +91,7 @@ def accepts(ev, i, to, n, kin) -> bool:
       with a petal's cone has no isolated couple with it, and a singular couple would jump at
       its first projection.
     - j's couple must be the same pair of points as i's: its closest-point conditions
-      (Eq. 37-38) hold there to within ``drift_tol`` of its domain (one Newton step moves it
+      (Eq. 37-38) hold there to within ``handover_tol`` of its domain (one Newton step moves it
       less). They hold exactly at the guard's zero; a guard found negative at a later event,
       after the couple went on along the edge, is past it.
     - edge to surface: j's couple must move into its domain, the rate of its held parameter
@@ -106,6 +106,6 @@ def accepts(ev, i, to, n, kin) -> bool:
     cj = eng.couple(j, uj, kin, rule.carried_sigma(n, raw.n))
     if cj.conditioning <= ev.options.conditioning_min:
         return False
-    if (np.abs(cj.drift) / eng.model.spans[j, :len(cj.drift)]).max() > ev.options.drift_tol:
+    if (np.abs(cj.drift) / eng.model.spans[j, :len(cj.drift)]).max() > ev.options.handover_tol:
         return False
     return i not in ev.links.of_edge or ev.links.outward_rate(j, i, cj.udot) < 0.0
