@@ -165,8 +165,8 @@ class ContactModes:
     impact_loss: float = 0.0
     mode_changes: int = 0           # events that resolved transitions
     reseeks: int = 0                # steps whose start sought far pairs again, nothing else
-    # The continuous state that the event which set these modes left (read-only; None for the
-    # initial modes): a step that starts at an event starts from it.
+    # The continuous state that the event which set these modes left (`read_only`; None
+    # for the initial modes): a step that starts at an event starts from it.
     x_after: object = dataclasses.field(default=None, compare=False, repr=False)
 
     def __setattr__(self, name, value):
@@ -224,7 +224,8 @@ def _patched(a, at, values):
     return b
 
 
-def _read_only(a):
+def read_only(a):
+    """The array a, made unwritable (in place)."""
     a.flags.writeable = False
     return a
 
@@ -273,9 +274,9 @@ class ModesIndex:
         near = tuple(i for i, st in enumerate(states) if st.mode != FAR)
         return ModesIndex(
             near,
-            _read_only(np.array(far, dtype=np.intp)),
-            _read_only(np.array([states[i].clearance for i in far], dtype=float)),
-            _read_only(np.array([states[i].distance for i in far], dtype=float)),
-            _read_only(np.array([states[i].ref_X21 is not None for i in far], dtype=bool)),
+            read_only(np.array(far, dtype=np.intp)),
+            read_only(np.array([states[i].clearance for i in far], dtype=float)),
+            read_only(np.array([states[i].distance for i in far], dtype=float)),
+            read_only(np.array([states[i].ref_X21 is not None for i in far], dtype=bool)),
             np.array([st.sigma for st in states], dtype=float), {},
-            _read_only(np.array(near, dtype=np.intp)))
+            read_only(np.array(near, dtype=np.intp)))

@@ -42,19 +42,19 @@ class HandoverLinks:
         """Edge pair i's guard: the least over its surfaces (+inf if it has none)."""
         return min((w for _, _, w in self._guards(i, n, u, R2)), default=np.inf)
 
-    def due(self, i, u, n, R2, edge_rtol: float = 0.0, guard_tol: float = 0.0):
-        """(pair j, j's couple) for each hand-over of pair i's couple u whose guard is met: a
-        surface pair's couple on or past a declared edge (or within ``edge_rtol`` of its span,
-        `rule.reaches_edge`); an edge pair's guard not above ``guard_tol`` for its normal n
+    def due(self, i, u, n, R2, tol: float = 0.0):
+        """(pair j, j's couple) for each hand-over of pair i's couple u whose guard is met
+        within ``tol``: a surface pair's couple on or past a declared edge (or within tol of
+        its span, `rule.reaches_edge`); an edge pair's guard not above tol for its normal n
         (world; None: not checked), Body 2 turned by R2."""
         S = self.pairs[i].patch2
         for j, edge in self.of_surface.get(i, ()):
-            if rule.reaches_edge(edge, S.lower, S.upper, u[1:], edge_rtol):
+            if rule.reaches_edge(edge, S.lower, S.upper, u[1:], tol):
                 yield j, np.array(rule.to_edge(edge, 1, u))
         if n is None:
             return
         for j, edge, w in self._guards(i, n, u, R2):
-            if w <= guard_tol:
+            if w <= tol:
                 S = self.pairs[j].patch2
                 yield j, np.array(rule.to_surface(edge, 1, u, S.lower, S.upper))
 

@@ -5,7 +5,7 @@ far."""
 from __future__ import annotations
 
 from drake_dock.core.hybrid import Mode
-from drake_dock.systems.contact_types import ContactModes
+from drake_dock.systems.contact_types import ContactModes, read_only
 from drake_dock.systems.evaluation import Kinematics
 
 
@@ -39,10 +39,8 @@ def reseek_far(tr, t, x, modes, E):
         tr.carry(i, after, states)
     x_new = x.copy()
     x_new[ev.nq + ev.nv:ev.ie] = u
-    after = x_new.copy()
-    after.flags.writeable = False
     new = ContactModes(states, list(modes.impacts), modes.impact_loss, modes.mode_changes,
-                       modes.reseeks + 1, after)
+                       modes.reseeks + 1, read_only(x_new.copy()))
     new.seal(index.with_far(due, states))
     tr.eng.patch_far(modes, new, due)
     return x_new, new

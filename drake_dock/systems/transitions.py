@@ -14,6 +14,7 @@ from drake_dock.core.seeking import contact_couple, seek_couple
 from drake_dock.errors import (DriftError, InputError, PainleveInconsistency, SeekingError,
                                SingularCoupleError)
 from drake_dock.systems import handover_links, impacts
+from drake_dock.systems.contact_types import read_only
 from drake_dock.systems.evaluation import Kinematics
 from drake_dock.systems.handover_links import applied
 
@@ -23,12 +24,6 @@ def _reseek(p, c, margin, R2, conditioning_min) -> bool:
     or (a point-curve pair) on the curve's convex side, Body 2 turned by R2."""
     return margin.min() <= 0.0 or c.conditioning <= conditioning_min or (
         relation(p.kind).along_d and point_curve_side(p.patch2, R2, c.u[0], c.n) <= 0.0)
-
-
-def _read_only_copy(x):
-    y = x.copy()
-    y.flags.writeable = False
-    return y
 
 
 def couples_of(ev, kin, u, states, which, t, strict=False):
@@ -117,7 +112,7 @@ class Transitions:
         x_new[ev.nq:ev.nq + ev.nv] = v
         x_new[ev.nq + ev.nv:ev.ie] = u
         impulses.log(x, x_new)
-        modes.x_after = _read_only_copy(x_new)
+        modes.x_after = read_only(x_new.copy())
         return x_new, modes.seal()
 
     def _handovers(self, states, kin, u, t) -> tuple[dict, dict]:
@@ -250,12 +245,12 @@ class Transitions:
         # couple over the face) is the linked pair's, not this pair's. One that is not usable
         # ends on its domain's bound from inside: on the edge within SEEK_EDGE_RTOL. Where a
         # linked pair holds a contact, a couple within SEEK_HELD_TOL of their edge is it.
-        tol = handover.SEEK_HELD_TOL if any(states[j].mode.in_contact for j, _ in (
-            ev.links.of_edge.get(i, []) + ev.links.of_surface.get(i, []))) else 0.0
+        held = any(states[j].mode.in_contact for j, _ in (
+            ev.links.of_edge.get(i, []) + ev.links.of_surface.get(i, [])))
+        tol = max(handover.SEEK_HELD_TOL if held else 0.0,
+                  0.0 if usable else handover.SEEK_EDGE_RTOL)
         due = [j for j, _ in ev.links.due(i, uc, sigma * raw.n if usable else None,
-                                          poses[b][0],
-                                          max(tol, 0.0 if usable else handover.SEEK_EDGE_RTOL),
-                                          tol)]
+                                          poses[b][0], tol)]
         mode, clearance = hybrid.after_seek(c.distance, usable and not due, crossing,
                                             was_contact, opt.track_distance, opt.reseek_floor)
         if mode == Mode.TRACKED:

@@ -202,11 +202,9 @@ class _Recorder:
         modes = contact.get_modes(contact.GetMyContextFromRoot(root))
         new = modes.impacts[self.n_impacts:]
         r = self.record
-        for imp in new:
-            if r.t and r.t[-1] == imp.t and r.kind[-1] == STEP:
-                r.kind[-1] = PRE_IMPACT
-            self._post_impact(root, imp, modes)
-        self.n_impacts = len(modes.impacts)
+        if new and r.t and r.t[-1] == new[0].t and r.kind[-1] == STEP:
+            r.kind[-1] = PRE_IMPACT
+        self.impacts_since(root, modes)
         if not r.t or root.get_time() > r.t[-1] or new:
             self._append(root, STEP)
 
