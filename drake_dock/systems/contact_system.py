@@ -260,7 +260,10 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     def _lookup(self, context) -> Evaluation:
         t, modes = context.get_time(), self.get_modes(context)
         x = context.get_continuous_state_vector().CopyToVector()
-        tau = self.input_force(context, x, modes)
+        return self._evaluation_at(t, x, modes, self.input_force(context, x, modes))
+
+    def _evaluation_at(self, t, x, modes, tau) -> Evaluation:
+        """The evaluation at (t, x, modes, tau), from the memo when Drake asked for it before."""
         key = (t, x.tobytes(), modes_key(modes), tau.tobytes())
         return self._evaluations.get(key, lambda: self._evaluate(t, x, modes, tau))
 
@@ -321,7 +324,9 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
 
     def _armed(self, context) -> list:
         """`witnesses.armed` for the context's modes, kept on their index when sealed."""
-        modes = self.get_modes(context)
+        return self._armed_list(self.get_modes(context))
+
+    def _armed_list(self, modes) -> list:
         derived = modes.index().derived
         hit = derived.get("armed")
         if hit is None:
@@ -376,6 +381,7 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
                                              lambda: self._cache.Eval(context), early, due))
         state.get_mutable_continuous_state().get_mutable_vector().SetFromVector(x_new)
         state.get_mutable_abstract_state(self._mode_index).set_value(copy.deepcopy(modes_new))
+        self.tell_event(context, t, x_new, modes_new)
         return EventStatus.Succeeded()
 
 

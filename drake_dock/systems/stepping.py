@@ -13,7 +13,9 @@ integrator's step so that the step ends w/2 before the earliest predicted
 zero; once within w, the step is capped at 1.9 w, so that it crosses the zero and a single
 bisection (to 0.95 w, inside the window) isolates it. The secant converges superlinearly, so a zero is reached in a few
 steps. Events, their times and the integration's error control are Drake's own; only the
-maximum step size changes, and it returns to its configured value after each event.
+maximum step size changes. Drake calls the monitor before it applies the events found at a
+step's end: a source with ``add_event_listener`` tells `WitnessApproach.after_event` the state
+an event leaves (``witness_now_after``), and the step after the event is capped from there.
 
 Sources are systems with ``witness_now(context)``, which returns a `WitnessNow` (epoch, layout,
 w, d, target): ``w`` the values of the witness functions they return now, all with direction
@@ -40,7 +42,7 @@ class _History:
     """A source's last three points (times, values, rates) of one epoch and witness layout,
     in arrays the compiled predictions update in place (`leads.push`)."""
 
-    __slots__ = ("key", "T", "W", "D", "n", "need")
+    __slots__ = ("key", "T", "W", "D", "n", "need", "zero", "target")
 
     def __init__(self, key, size):
         self.key = key
@@ -49,6 +51,7 @@ class _History:
         self.D = np.full((3, size), np.nan)
         self.n = 0
         self.need = np.zeros(size, dtype=np.bool_)
+        self.zero = self.target = math.inf     # the predicted zero and the target (s)
 
     def add(self, t, w, d):
         """The point at t (replacing the last one at the same time or later)."""
@@ -76,7 +79,17 @@ class WitnessApproach:
         self.window = float(window)
         self._hist = {}
         self._shortened = 0
+        self._short = False
         self.shortened_steps = 0
+        for s in self.sources:
+            if hasattr(s, "add_event_listener"):
+                s.add_event_listener(self.after_event)
+
+    def close(self):
+        """Stops listening to the sources' events (a run's end)."""
+        for s in self.sources:
+            if hasattr(s, "remove_event_listener"):
+                s.remove_event_listener(self.after_event)
 
     def predicted_zero(self, root) -> float:
         """Earliest predicted zero time (inf if none); updates the history."""
@@ -86,42 +99,68 @@ class WitnessApproach:
         """(earliest predicted zero time of the witnesses, of the step-end targets), inf
         where none is predicted; updates the histories."""
         t = root.get_time()
-        best = math.inf
-        target = math.inf
         hist = {}
         for s in self.sources:
             c = s.GetMyContextFromRoot(root)
-            epoch, layout, w, d, lead = s.witness_now(c)
-            h = self._hist.get(id(s))
-            if h is None or h.key[0] != epoch or (h.key[1] is not layout
-                                                  and h.key[1] != layout):
-                h = _History((epoch, layout), len(w))
-            h.add(t, w, d)
-            hist[id(s)] = h
-            need = h.need
-            best = min(best, earliest_zero(h.T, h.W, h.D, h.n, need))
-            if np.count_nonzero(need):
-                wdd = s.witness_second_rate_array(c, need)
-                for j in np.flatnonzero(need).tolist():
-                    best = min(best, t + _lead_jet(float(w[j]), float(d[j]), float(wdd[j])))
-            target = min(target, t + lead)
+            hist[id(s)] = self._point(self._hist.get(id(s)), t, s.witness_now(c),
+                                      lambda mask, s=s, c=c: s.witness_second_rate_array(c,
+                                                                                         mask))
         self._hist = hist
-        return best, target
+        return self._earliest()
+
+    def _point(self, h, t, now, second_rates) -> _History:
+        """The history h (None for none) with the point ``now`` (`WitnessNow`) at t, a new one
+        when its epoch or layout changed, with its predicted zero and target kept on it."""
+        epoch, layout, w, d, lead = now
+        if h is None or h.key[0] != epoch or (h.key[1] is not layout and h.key[1] != layout):
+            h = _History((epoch, layout), len(w))
+        h.add(t, w, d)
+        need = h.need
+        best = earliest_zero(h.T, h.W, h.D, h.n, need)
+        if np.count_nonzero(need):
+            wdd = second_rates(need)
+            for j in np.flatnonzero(need).tolist():
+                # Without a second rate, the tangent.
+                wdd_j = 0.0 if math.isnan(wdd[j]) else float(wdd[j])
+                best = min(best, t + _lead_jet(float(w[j]), float(d[j]), wdd_j))
+        h.zero, h.target = best, t + lead
+        return h
+
+    def _earliest(self) -> tuple[float, float]:
+        return (min((h.zero for h in self._hist.values()), default=math.inf),
+                min((h.target for h in self._hist.values()), default=math.inf))
+
+    def after_event(self, source, context, t, x, modes):
+        """Event listener (``source.add_event_listener``): Drake calls the monitor before it
+        handles the events at a step's end, so the step after an event would be capped from
+        the witnesses before it; this caps it again from those at the state the event leaves
+        (a new epoch, whose first point predicts with the rates it has)."""
+        now, second_rates = source.witness_now_after(context, t, x, modes)
+        self._hist[id(source)] = self._point(None, t, now, second_rates)
+        self._set_step(t, *self._earliest(), again=True)
 
     def __call__(self, root):
-        t = root.get_time()
-        t_zero, t_target = self.predicted(root)
+        self._set_step(root.get_time(), *self.predicted(root))
+
+    def _set_step(self, t, t_zero, t_target, again=False):
+        """Caps the next step (the module docstring) from the earliest predicted zero and
+        target; ``again``: the same step's cap set anew (after an event)."""
         lead = t_zero - t
         step = self.max_step
         if lead < self.max_step + self.window and self._shortened < self.max_shortened:
             cross = self.cross * self.window
             step = lead - 0.5 * self.window if lead > self.window else cross
             step = max(step, cross)
-        if step < self.max_step:
+        short = step < self.max_step
+        if again and self._short:           # the step was counted when first capped
+            self._shortened -= 1
+            self.shortened_steps -= 1
+        if short:
             self._shortened += 1
             self.shortened_steps += 1
-        else:
+        elif not again:
             self._shortened = 0
+        self._short = short
         # A step-end target: the step ends just past it (its transition is taken at the next
         # step's start), never shorter than the crossing step.
         lead = t_target - t

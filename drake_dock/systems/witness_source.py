@@ -5,6 +5,7 @@ step-end target of the far pairs' seek at a step's start."""
 from __future__ import annotations
 
 import math
+import weakref
 from typing import NamedTuple
 
 import numpy as np
@@ -12,6 +13,7 @@ import numpy as np
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import couples as C
 from drake_dock.core.kernels import model as K
+from drake_dock.core.kernels.witness_values import regular_rates
 from drake_dock.systems import witnesses
 from drake_dock.systems.witnesses import FAR_WITNESS
 
@@ -23,7 +25,7 @@ class ArmedWitnesses:
     values and couple rows (those of the pairs not far, by their place among them)."""
 
     __slots__ = ("names", "pair", "code", "far", "gap", "flat", "flat_list", "gap_flat",
-                 "g_flat", "no_rates")
+                 "g_flat", "no_rates", "regular", "regular_pair", "regular_slot")
 
     def __init__(self, names, pair, code, far, gap, slot):
         self.names, self.pair, self.code, self.far, self.gap = names, pair, code, far, gap
@@ -32,6 +34,9 @@ class ArmedWitnesses:
         self.gap_flat = slot[gap] * C.ROW + C.VN        # the gaps' v_n in its couple rows
         self.g_flat = slot[gap] * C.ROW + C.GAP         # and the gaps
         self.no_rates = np.full(len(pair), np.nan)
+        self.regular = code == K.W_REGULAR              # the domain-end witnesses
+        self.regular_pair = pair[self.regular].astype(np.int64)
+        self.regular_slot = slot[self.regular].astype(np.int64)
 
     @classmethod
     def of(cls, armed, modes, pairs) -> "ArmedWitnesses":
@@ -69,12 +74,42 @@ class WitnessPredictions:
         return self._armed_of(self.get_modes(context), context)
 
     def _armed_of(self, modes, context) -> "ArmedWitnesses":
+        return self._armed_modes(modes)
+
+    def _armed_modes(self, modes) -> "ArmedWitnesses":
         derived = modes.index().derived
         hit = derived.get("armed_arrays")
         if hit is None:
-            hit = derived["armed_arrays"] = ArmedWitnesses.of(self._armed(context), modes,
+            hit = derived["armed_arrays"] = ArmedWitnesses.of(self._armed_list(modes), modes,
                                                               self.pairs)
         return hit
+
+    def add_event_listener(self, listener):
+        """``listener(source, context, t, x, modes)`` is called after each event with the
+        state it leaves (the context still holds the one it found: Drake applies the event
+        after its handler returns); kept by a weak reference to a bound method (a
+        `WitnessApproach` no longer used drops out)."""
+        self.__dict__.setdefault("_event_listeners", []).append(weakref.WeakMethod(listener))
+
+    def remove_event_listener(self, listener):
+        self._event_listeners = [r for r in getattr(self, "_event_listeners", [])
+                                 if r() is not None and r() != listener]
+
+    def tell_event(self, context, t, x, modes):
+        """Calls the event listeners (`add_event_listener`) with the state an event leaves."""
+        for ref in getattr(self, "_event_listeners", ()):
+            listener = ref()
+            if listener is not None:
+                listener(self, context, t, x, modes)
+
+    def witness_now_after(self, context, t, x, modes) -> tuple:
+        """(`WitnessNow`, its second rates as ``f(mask)``, `witness_second_rate_array`) at
+        the state (t, x, modes) that an event handled at ``context`` leaves, from the
+        evaluation Drake asks for there next (kept in the memo)."""
+        E = self._evaluation_at(t, x, modes, self.input_force(context, x, modes))
+        a = self._armed_modes(modes)
+        return self._witness_now_of(E, modes, a), lambda mask: self._second_rates_of(E, a,
+                                                                                     mask)
 
     def witness_now(self, context) -> WitnessNow:
         """`WitnessNow` at the context, from its one evaluation:
@@ -84,13 +119,16 @@ class WitnessPredictions:
           of `armed_witnesses` (the far pairs' first when armed; inf when far pairs are sought
           at the step's start before their clearance is used up: ``target`` stands for it);
         - ``d``: g' = v_n for the gap witnesses of the tracked couples while the gap is
-          positive, NaN elsewhere;
+          positive; the domain-end margin's rate for the regular witnesses where the margin
+          is the least (`witness_values.regular_rates`); NaN elsewhere;
         - ``target``: when a far pair is due a seek at a step's start (`_on_step`) at the
           present rate of its travel bound; a step that ends there leaves the seek to the
           next step's start, and no witness needs isolating."""
-        E = self._cache.Eval(context)
         modes = self.get_modes(context)
-        a = self._armed_of(modes, context)
+        return self._witness_now_of(self._cache.Eval(context), modes,
+                                    self._armed_of(modes, context))
+
+    def _witness_now_of(self, E, modes, a) -> WitnessNow:
         w = E.wv.ravel().take(a.flat)
         d = a.no_rates.copy()
         if a.g_flat.size:
@@ -98,6 +136,16 @@ class WitnessPredictions:
             out = E.out.ravel()
             g, vn = out.take(a.g_flat), out.take(a.gap_flat)
             d[a.gap] = np.where(g > 0.0, vn, np.nan)
+            # While the gap is not positive (just after an impact) the witness is v_n: its
+            # rate g'' (a couple turning back within a few microseconds is predicted from
+            # the first point after the impact).
+            turning = np.flatnonzero(a.gap)[g <= 0.0]
+            if turning.size:
+                d[turning] = self._gap_second_rates(E, a, turning.tolist())
+        if a.regular_pair.size:
+            rates = np.empty(a.regular_pair.size)
+            regular_rates(self.engine.packed, E.out, a.regular_pair, a.regular_slot, rates)
+            d[a.regular] = rates
         if a.far:
             far = E.far_witness if self.options.reseek_early <= 0 else math.inf
             w, d = np.concatenate([[far], w]), np.concatenate([[np.nan], d])
@@ -107,16 +155,28 @@ class WitnessPredictions:
         """Second time derivatives of the witnesses of `WitnessNow.w` in ``mask`` (gap
         witnesses of tracked couples), g'' = W^3 . v' + b_n (Eq. 52) at the evaluation's
         accelerations: a couple leaving an impact has no history in the new epoch from which
-        `WitnessApproach` could predict its landing. NaN elsewhere."""
-        E = self._cache.Eval(context)
-        a = self.armed_witnesses(context)
-        kin = self.engine.kinematics(E.q, E.v)
+        `WitnessApproach` could predict its landing. NaN elsewhere (the other witnesses with
+        rates)."""
+        return self._second_rates_of(self._cache.Eval(context), self.armed_witnesses(context),
+                                     mask)
+
+    def _second_rates_of(self, E, a, mask) -> np.ndarray:
         out = np.full(len(mask), np.nan)
         off = 1 if a.far else 0
-        for j in np.flatnonzero(mask).tolist():
-            i = int(a.pair[j - off])
+        js = [j - off for j in np.flatnonzero(mask).tolist() if a.gap[j - off]]
+        if js:
+            out[np.array(js) + off] = self._gap_second_rates(E, a, js)
+        return out
+
+    def _gap_second_rates(self, E, a, js) -> np.ndarray:
+        """g'' = W^3 . v' + b_n (Eq. 52) of the gap witnesses at the places ``js`` among the
+        pairs' armed witnesses (`ArmedWitnesses.pair`), at the evaluation E."""
+        kin = self.engine.kinematics(E.q, E.v)
+        out = np.empty(len(js))
+        for k, j in enumerate(js):
+            i = int(a.pair[j])
             row = self.engine.row(i, E.evals[i], kin)
-            out[j] = float(row.Wn @ E.vdot + row.bn)
+            out[k] = float(row.Wn @ E.vdot + row.bn)
         return out
 
     def witness_values(self, context) -> dict:

@@ -120,3 +120,55 @@ def test_the_joint_value_is_the_least_armed_one_and_steps_aside_at_a_zero():
     assert min(values.values()) < 0
     assert sc.system._joint_value(ctx) == min(values.values())
     assert len(sc.system.GetWitnessFunctions(ctx)) == len(values)
+
+
+def test_the_domain_end_witness_rate_is_the_couples_rate_over_its_span():
+    """A disk gliding at v_x towards the end of the plane patch (x = 1, the patch's span along
+    x 51 m): its regular witness is the couple's margin to that end, (1 - x) / 51, and the rate
+    `WitnessApproach` predicts with is -v_x / 51 (closed form)."""
+    sc = disk_on_incline(0.0, plane_end=1.0)
+    r = sc.params["radius"]
+    sim = make_simulator(sc.system, CONFIG, lambda ctx: sc.set_state(
+        ctx, (np.eye(3), np.array([0.9, 0.0, r + 0.01])),
+        (np.zeros(3), np.array([0.3, 0.0, 0.0]))))
+    ctx = sim.get_mutable_context()
+    sim.Initialize()
+    name = f"{sc.system.pairs[0].name} domain end or Eq. 39"
+    assert sc.system.witness_values(ctx)[name] == pytest.approx(0.1 / 51.0, rel=1e-9)
+    assert sc.system.witness_rates(ctx)[name] == pytest.approx(-0.3 / 51.0, rel=1e-9)
+
+
+def test_the_step_after_an_impact_is_predicted_from_the_state_it_leaves():
+    """Drake calls the monitor before it applies an event, so `WitnessApproach` also listens to
+    the events (`add_event_listener`): at each impact of the bouncing disk the witnesses it
+    predicts with are those of the state the impact leaves. There the gap is not positive (the
+    impact is isolated just past its zero), the gap witness is the couple's separating speed,
+    e times the closing speed, and its rate the normal acceleration, -g (closed form)."""
+    seen = []
+
+    class Listener:
+        def __call__(self, source, context, t, x, modes):
+            now, _ = source.witness_now_after(context, t, x, modes)
+            seen.append((t, dict(zip(now.layout, now.w.tolist())),
+                         dict(zip(now.layout, now.d.tolist()))))
+
+    listener = Listener()
+    sc = disk_on_incline(0.0, mu=0.3, restitution=E, options=ContactOptions(zeno_speed=1e-2))
+    sc.system.add_event_listener(listener.__call__)
+    r = sc.params["radius"]
+    sim = make_simulator(sc.system, CONFIG, lambda ctx: sc.set_state(
+        ctx, (np.eye(3), np.array([0, 0, r + H])), (np.zeros(3), np.zeros(3))))
+    sim.Initialize()
+    wa = make_witness_approach(sim, [sc.system], CONFIG)
+    sim.set_monitor(lambda c: wa(c))
+    v1, t1 = math.sqrt(2 * G * H), math.sqrt(2 * H / G)
+    sim.AdvanceTo(t1 + 0.01)
+    name = f"{sc.system.pairs[0].name} gap"
+    after = [(t, w, d) for t, w, d in seen if abs(t - t1) < 1e-6 and name in w]
+    assert after, seen
+    for _, w, d in after:
+        assert w[name] == pytest.approx(E * v1, rel=1e-6)
+        assert d[name] == pytest.approx(-G, rel=1e-9)
+    # One impact by then: the next one is 2 e v1 / g = 0.1 s later.
+    assert len(sc.system.get_modes(sim.get_context()).impacts) == 1
+    wa.close()

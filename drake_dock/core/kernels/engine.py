@@ -272,7 +272,7 @@ def toy_model():
 def warm():
     """Compiles or loads the engine's kernels: one evaluation of `toy_model`, and its far pass."""
     from drake_dock.core.kernels.records import pack
-    from drake_dock.core.kernels.witness_values import due_far, far_witness
+    from drake_dock.core.kernels.witness_values import due_far, far_witness, regular_rates
     m, s, x = toy_model()
     mp, sp = pack(m), pack(s)
     nbush, k, F = m.bush_frames.shape[0], s.code.shape[0], m.frame_body.shape[0]
@@ -281,3 +281,6 @@ def warm():
     evaluate(mp, sp, x, np.zeros(int(m.sizes[Z_NV])), buf)
     far_witness(mp, sp, buf)
     due_far(mp, sp, buf)
+    n_near = s.near.shape[0]
+    regular_rates(mp, buf[int(m.sizes[Z_NX]):int(m.sizes[Z_NX]) + n_near * K.ROW].reshape(
+        (n_near, K.ROW)), s.near, np.arange(n_near), np.empty(n_near))

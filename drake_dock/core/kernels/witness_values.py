@@ -10,7 +10,9 @@ from numba import njit
 
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.jets import jet
-from drake_dock.core.kernels.model import (AFFINE, FAR, O_EARLY, O_HORIZON, S_DUE, S_FAR,
+from drake_dock.core.kernels.model import (AFFINE, FAR, O_COND_MIN, O_EARLY, O_FLOOR,
+                                           O_HORIZON, S_DUE,
+                                           S_FAR,
                                            S_FAR_EARLY, Z_NV, Z_NX,
                                            layout, unpack_model, unpack_modes)
 from drake_dock.core.kernels.jets import position
@@ -72,6 +74,37 @@ def end_margin(m, i, row):
             span = hi - lo
             w = min(w, min((row[K.U + j] - lo) / span, (hi - row[K.U + j]) / span))
     return w
+
+
+@njit(cache=True)
+def end_margin_rate(m, i, row):
+    """The rate (1/s) of `end_margin`: that of the margin it takes, from the couple's rate
+    (Eq. 47, row UDOT); NaN when no parameter is bounded."""
+    w, r = math.inf, math.nan
+    for j in range(m.uoff[i + 1] - m.uoff[i]):
+        if m.bounded[i, j]:
+            lo, hi = m.lower[i, j], m.upper[i, j]
+            span = hi - lo
+            if (row[K.U + j] - lo) / span < w:
+                w, r = (row[K.U + j] - lo) / span, row[K.UDOT + j] / span
+            if (hi - row[K.U + j]) / span < w:
+                w, r = (hi - row[K.U + j]) / span, -row[K.UDOT + j] / span
+    return r
+
+
+@njit(cache=True)
+def regular_rates(mp, rows, pairs, slots, out):
+    """Into ``out``: the rates of the regular witnesses (W_REGULAR, min(`end_margin`,
+    conditioning - conditioning_min)) of ``pairs``, their couple rows at ``slots`` of an
+    evaluation's ``rows`` (n_near, ROW): the end margin's rate where it is the least, NaN where
+    the conditioning is (its rate is not computed)."""
+    m = unpack_model(mp)
+    for k in range(pairs.shape[0]):
+        i, row = pairs[k], rows[slots[k]]
+        if end_margin(m, i, row) <= row[K.COND] - m.options[O_COND_MIN]:
+            out[k] = end_margin_rate(m, i, row)
+        else:
+            out[k] = math.nan
 
 
 @njit(cache=True)
@@ -143,6 +176,20 @@ def due_in(m, s, i, R, o, w, vf, bound):
 
 
 @njit(cache=True)
+def due_after_seek(m, s, i, R, o, w, vf, bound):
+    """A lower bound of the time before far pair i, sought at this step's start, is due again:
+    reseek_early x the least clearance the seek leaves it over the rate of its travel bound
+    (`bound_rate`; inf at rest). The clearance after a seek is at least reseek_floor and half
+    the pair's distance (`hybrid.after_seek`), and the distance at least the last seek's less
+    the travel bound since."""
+    rate = bound_rate(m, i, R, o, w, vf)
+    if rate <= 0.0:
+        return math.inf
+    least = max(m.options[O_FLOOR], 0.5 * (s.distance[i] - bound[i]))
+    return m.options[O_EARLY] * least / rate
+
+
+@njit(cache=True)
 def _far_views(m, s, buf):
     """The far pass's views of an evaluation's result buffer (`layout`): the travel bounds,
     the frames' rotations, origins, angular and linear velocities, and the scalars."""
@@ -158,9 +205,10 @@ def far_witness(mp, sp, buf):
     """Into an evaluation's result buffer (`layout`): the far pairs' travel bounds (BOUND;
     NaN for the pairs not far), their witness, the smallest clearance left, min (clearance -
     bound) (1 if no pair is far; scalar S_FAR), whether a pair sought before is due a seek at
-    this step's start, its `due_in` within the reseek horizon (S_DUE), and the time before the
-    next of the others is (inf for none; S_FAR_EARLY). Asked by the witnesses and the step's
-    start, not by every evaluation."""
+    this step's start, its `due_in` within the reseek horizon (S_DUE), and the step-end target
+    (S_FAR_EARLY; inf for none): the time before the next of the others is due, or before one
+    due now may be due again after its seek (`due_after_seek`), whichever is first. Asked by
+    the witnesses and the step's start, not by every evaluation."""
     m = unpack_model(mp)
     s = unpack_modes(sp)
     k = s.code.shape[0]
@@ -176,7 +224,10 @@ def far_witness(mp, sp, buf):
             if s.sought[i] and early > 0.0:
                 t_due = due_in(m, s, i, R, o, w, vf, bound)
                 if t_due <= horizon:
+                    # Sought at this step's start, before the step control reads this: the
+                    # step ends where it may be due again, not where its clearance is used.
                     due = 1.0
+                    lead = min(lead, due_after_seek(m, s, i, R, o, w, vf, bound))
                 else:
                     lead = min(lead, t_due)
     scalars[S_FAR] = 1.0 if wfar == math.inf else wfar

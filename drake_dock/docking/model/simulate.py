@@ -384,6 +384,8 @@ def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
             # The monitor refers to the simulator (the step control): a cycle through Drake's
             # C++ that Python's collector cannot see would keep the run's record alive.
             sim.clear_monitor()
+            if approach is not None:
+                approach.close()
     wall = _time.perf_counter() - wall0
     rec.sample(root, last=True)
     terminated = status.reason() == SimulatorStatus.ReturnReason.kReachedTerminationCondition
