@@ -79,7 +79,9 @@ class WitnessApproach:
         self.window = float(window)
         self._hist = {}
         self._shortened = 0
-        self._short = False
+        self._short = False            # whether the last step capped was shortened
+        self._before = 0               # consecutive shortened steps before it
+        self._last_event = None
         self.shortened_steps = 0
         for s in self.sources:
             if hasattr(s, "add_event_listener"):
@@ -135,6 +137,10 @@ class WitnessApproach:
         handles the events at a step's end, so the step after an event would be capped from
         the witnesses before it; this caps it again from those at the state the event leaves
         (a new epoch, whose first point predicts with the rates it has)."""
+        key = (t, modes.mode_changes, modes.reseeks)
+        if key == self._last_event:         # the same event, told once per triggered witness
+            return
+        self._last_event = key
         now, second_rates = source.witness_now_after(context, t, x, modes)
         self._hist[id(source)] = self._point(None, t, now, second_rates)
         self._set_step(t, *self._earliest(), again=True)
@@ -145,6 +151,11 @@ class WitnessApproach:
     def _set_step(self, t, t_zero, t_target, again=False):
         """Caps the next step (the module docstring) from the earliest predicted zero and
         target; ``again``: the same step's cap set anew (after an event)."""
+        if again:       # the monitor's count of this step undone, then counted as capped now
+            self._shortened = self._before
+            self.shortened_steps -= self._short
+        else:
+            self._before = self._shortened
         lead = t_zero - t
         step = self.max_step
         if lead < self.max_step + self.window and self._shortened < self.max_shortened:
@@ -152,13 +163,10 @@ class WitnessApproach:
             step = lead - 0.5 * self.window if lead > self.window else cross
             step = max(step, cross)
         short = step < self.max_step
-        if again and self._short:           # the step was counted when first capped
-            self._shortened -= 1
-            self.shortened_steps -= 1
         if short:
             self._shortened += 1
             self.shortened_steps += 1
-        elif not again:
+        else:
             self._shortened = 0
         self._short = short
         # A step-end target: the step ends just past it (its transition is taken at the next

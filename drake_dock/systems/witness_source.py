@@ -25,7 +25,8 @@ class ArmedWitnesses:
     values and couple rows (those of the pairs not far, by their place among them)."""
 
     __slots__ = ("names", "pair", "code", "far", "gap", "flat", "flat_list", "gap_flat",
-                 "g_flat", "no_rates", "regular", "regular_pair", "regular_slot")
+                 "g_flat", "no_rates", "regular", "regular_pair", "regular_slot",
+                 "pair_gap_flat")
 
     def __init__(self, names, pair, code, far, gap, slot):
         self.names, self.pair, self.code, self.far, self.gap = names, pair, code, far, gap
@@ -34,6 +35,8 @@ class ArmedWitnesses:
         self.gap_flat = slot[gap] * C.ROW + C.VN        # the gaps' v_n in its couple rows
         self.g_flat = slot[gap] * C.ROW + C.GAP         # and the gaps
         self.no_rates = np.full(len(pair), np.nan)
+        # per witness of a pair: its gap's place in the couple rows (raveled), -1 but for gaps
+        self.pair_gap_flat = np.where(gap, slot * C.ROW + C.GAP, -1)
         self.regular = code == K.W_REGULAR              # the domain-end witnesses
         self.regular_pair = pair[self.regular].astype(np.int64)
         self.regular_slot = slot[self.regular].astype(np.int64)
@@ -87,8 +90,10 @@ class WitnessPredictions:
     def add_event_listener(self, listener):
         """``listener(source, context, t, x, modes)`` is called after each event with the
         state it leaves (the context still holds the one it found: Drake applies the event
-        after its handler returns); kept by a weak reference to a bound method (a
-        `WitnessApproach` no longer used drops out)."""
+        after its handler returns), once per handler call (Drake calls the handler once per
+        triggered witness). ``listener`` must be a bound method: it is kept by a weak
+        reference, so that a `WitnessApproach` no longer used drops out (`remove_event_listener`
+        takes it out at once, as `simulate` does at a run's end)."""
         self.__dict__.setdefault("_event_listeners", []).append(weakref.WeakMethod(listener))
 
     def remove_event_listener(self, listener):
@@ -105,7 +110,9 @@ class WitnessPredictions:
     def witness_now_after(self, context, t, x, modes) -> tuple:
         """(`WitnessNow`, its second rates as ``f(mask)``, `witness_second_rate_array`) at
         the state (t, x, modes) that an event handled at ``context`` leaves, from the
-        evaluation Drake asks for there next (kept in the memo)."""
+        evaluation Drake asks for there next (kept in the memo). The inputs are read at
+        ``context``: an input that depends on the state (a controller) gives the value before
+        the event, and this evaluation is then not the one Drake reuses."""
         E = self._evaluation_at(t, x, modes, self.input_force(context, x, modes))
         a = self._armed_modes(modes)
         return self._witness_now_of(E, modes, a), lambda mask: self._second_rates_of(E, a,
@@ -113,14 +120,16 @@ class WitnessPredictions:
 
     def witness_now(self, context) -> WitnessNow:
         """`WitnessNow` at the context, from its one evaluation:
-        - ``epoch``: the modes' mode changes (every event changes it);
+        - ``epoch``: the modes' mode changes (every event changes it), with the gap
+          witnesses whose gap is not positive (their witness is v_n, not the gap);
         - ``layout``: the armed witnesses' names (it changes whenever their set changes);
         - ``w``: the values of the witnesses `DoGetWitnessFunctions` returns now, in the order
           of `armed_witnesses` (the far pairs' first when armed; inf when far pairs are sought
           at the step's start before their clearance is used up: ``target`` stands for it);
-        - ``d``: g' = v_n for the gap witnesses of the tracked couples while the gap is
-          positive; the domain-end margin's rate for the regular witnesses where the margin
-          is the least (`witness_values.regular_rates`); NaN elsewhere;
+        - ``d``: for the gap witnesses of the tracked couples g' = v_n while the gap is
+          positive, and g'' = W^3 . v' + b_n while it is not (the witness is then v_n); the
+          domain-end margin's rate for the regular witnesses where the margin is the least
+          (`witness_values.regular_rates`); NaN elsewhere;
         - ``target``: when a far pair is due a seek at a step's start (`_on_step`) at the
           present rate of its travel bound; a step that ends there leaves the seek to the
           next step's start, and no witness needs isolating."""
@@ -131,17 +140,20 @@ class WitnessPredictions:
     def _witness_now_of(self, E, modes, a) -> WitnessNow:
         w = E.wv.ravel().take(a.flat)
         d = a.no_rates.copy()
+        epoch = modes.mode_changes
         if a.g_flat.size:
-            # The impact witness is the gap while positive: its rate v_n; otherwise unknown.
+            # The impact witness is the gap while positive, its rate v_n.
             out = E.out.ravel()
             g, vn = out.take(a.g_flat), out.take(a.gap_flat)
             d[a.gap] = np.where(g > 0.0, vn, np.nan)
-            # While the gap is not positive (just after an impact) the witness is v_n: its
+            # While the gap is not positive (just after an impact) the witness is v_n, its
             # rate g'' (a couple turning back within a few microseconds is predicted from
-            # the first point after the impact).
+            # the first point after the impact). The witness changes meaning (m/s to m) where
+            # the gap turns positive: a new epoch, so that no secant joins the two.
             turning = np.flatnonzero(a.gap)[g <= 0.0]
             if turning.size:
                 d[turning] = self._gap_second_rates(E, a, turning.tolist())
+                epoch = (epoch, turning.tobytes())
         if a.regular_pair.size:
             rates = np.empty(a.regular_pair.size)
             regular_rates(self.engine.packed, E.out, a.regular_pair, a.regular_slot, rates)
@@ -149,21 +161,23 @@ class WitnessPredictions:
         if a.far:
             far = E.far_witness if self.options.reseek_early <= 0 else math.inf
             w, d = np.concatenate([[far], w]), np.concatenate([[np.nan], d])
-        return WitnessNow(modes.mode_changes, a.names, w, d, E.far_early)
+        return WitnessNow(epoch, a.names, w, d, E.far_early)
 
     def witness_second_rate_array(self, context, mask) -> np.ndarray:
         """Second time derivatives of the witnesses of `WitnessNow.w` in ``mask`` (gap
-        witnesses of tracked couples), g'' = W^3 . v' + b_n (Eq. 52) at the evaluation's
-        accelerations: a couple leaving an impact has no history in the new epoch from which
-        `WitnessApproach` could predict its landing. NaN elsewhere (the other witnesses with
-        rates)."""
+        witnesses of tracked couples while the gap is positive), g'' = W^3 . v' + b_n
+        (Eq. 52) at the evaluation's accelerations: a couple leaving an impact has no history
+        in the new epoch from which `WitnessApproach` could predict its landing. NaN elsewhere
+        (the other witnesses with rates, the gap witnesses in their v_n form)."""
         return self._second_rates_of(self._cache.Eval(context), self.armed_witnesses(context),
                                      mask)
 
     def _second_rates_of(self, E, a, mask) -> np.ndarray:
         out = np.full(len(mask), np.nan)
         off = 1 if a.far else 0
-        js = [j - off for j in np.flatnonzero(mask).tolist() if a.gap[j - off]]
+        gap = E.out.ravel()
+        js = [j - off for j in np.flatnonzero(mask).tolist()
+              if a.gap[j - off] and gap[a.pair_gap_flat[j - off]] > 0.0]
         if js:
             out[np.array(js) + off] = self._gap_second_rates(E, a, js)
         return out

@@ -177,11 +177,14 @@ def due_in(m, s, i, R, o, w, vf, bound):
 
 @njit(cache=True)
 def due_after_seek(m, s, i, R, o, w, vf, bound):
-    """A lower bound of the time before far pair i, sought at this step's start, is due again:
-    reseek_early x the least clearance the seek leaves it over the rate of its travel bound
-    (`bound_rate`; inf at rest). The clearance after a seek is at least reseek_floor and half
-    the pair's distance (`hybrid.after_seek`), and the distance at least the last seek's less
-    the travel bound since."""
+    """An estimate from below of the time before far pair i, sought at this step's start, is
+    due again: reseek_early x the clearance the seek usually leaves it at least over the rate
+    of its travel bound (`bound_rate`; inf at rest). A seek that leaves the pair far gives it
+    at least reseek_floor and half its distance (`hybrid.after_seek`), and the distance is at
+    least the last seek's less the travel bound since. Not a bound in every case (a screened
+    pair keeps its covers' gap; a pair whose seek is overridden by an event is not sought);
+    where the step runs past the clearance the far witness still stops it, isolated as
+    without the target."""
     rate = bound_rate(m, i, R, o, w, vf)
     if rate <= 0.0:
         return math.inf
