@@ -195,11 +195,10 @@ class Engine:
         opt = options
         options_arr = np.zeros(E.N_OPTIONS)
         options_arr[[E.O_MU, E.O_MU_S, E.O_OMEGA, E.O_V_SLIP, E.O_DRIFT_FB, E.O_DRIFT_TOL,
-                     E.O_COND_MIN, E.O_ENERGY, E.O_GUARD, E.O_EARLY, E.O_HORIZON,
-                     E.O_FLOOR]] = (
+                     E.O_COND_MIN, E.O_ENERGY, E.O_GUARD, E.O_EARLY, E.O_HORIZON]] = (
             law.mu, law.static_mu, opt.baumgarte, opt.v_slip, opt.drift_feedback,
             opt.drift_tol, opt.conditioning_min, self.energy_scale, GUARD_BAND,
-            opt.reseek_early, opt.reseek_horizon, opt.reseek_floor)
+            opt.reseek_early, opt.reseek_horizon)
         sizes = np.zeros(E.N_SIZES, np.int64)
         sizes[[E.Z_NQ, E.Z_NV, E.Z_NU, E.Z_IE, E.Z_NX]] = (self.nq, self.nv, self.nu, self.ie,
                                                            self.nx)

@@ -225,10 +225,8 @@ class Evaluation:
 
     @property
     def far_early(self) -> float:
-        """The far pairs' step-end target (`witness_values.far_witness`): the time before the
-        next far pair not `due` now is due a seek at a step's start, or before one due now may
-        be due again after that seek, at the present rate of its travel bound; inf without
-        one."""
+        """The time before the next far pair not `due` now is due a seek at a step's start, at
+        the present rate of its travel bound, inf without one."""
         self._far_pass()
         return float(self.sc[E.S_FAR_EARLY])
 

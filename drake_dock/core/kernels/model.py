@@ -28,8 +28,8 @@ NW = 7
 AFFINE, COMPONENT = 0, 1
 # Options (`Model.options`).
 O_MU, O_MU_S, O_OMEGA, O_V_SLIP, O_DRIFT_FB, O_DRIFT_TOL, O_COND_MIN, O_ENERGY, O_GUARD, \
-    O_EARLY, O_HORIZON, O_FLOOR = range(12)
-N_OPTIONS = 12
+    O_EARLY, O_HORIZON = range(11)
+N_OPTIONS = 11
 # Sizes (`Model.sizes`).
 Z_NQ, Z_NV, Z_NU, Z_IE, Z_NX = range(5)
 N_SIZES = 5

@@ -10,8 +10,8 @@ from numba import njit
 
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.jets import jet
-from drake_dock.core.kernels.model import (AFFINE, FAR, O_COND_MIN, O_EARLY, O_FLOOR,
-                                           O_HORIZON, S_DUE,
+from drake_dock.core.kernels.model import (AFFINE, FAR, O_COND_MIN, O_EARLY, O_HORIZON,
+                                           S_DUE,
                                            S_FAR,
                                            S_FAR_EARLY, Z_NV, Z_NX,
                                            layout, unpack_model, unpack_modes)
@@ -176,23 +176,6 @@ def due_in(m, s, i, R, o, w, vf, bound):
 
 
 @njit(cache=True)
-def due_after_seek(m, s, i, R, o, w, vf, bound):
-    """An estimate from below of the time before far pair i, sought at this step's start, is
-    due again: reseek_early x the clearance the seek usually leaves it at least over the rate
-    of its travel bound (`bound_rate`; inf at rest). A seek that leaves the pair far gives it
-    at least reseek_floor and half its distance (`hybrid.after_seek`), and the distance is at
-    least the last seek's less the travel bound since. Not a bound in every case (a screened
-    pair keeps its covers' gap; a pair whose seek is overridden by an event is not sought);
-    where the step runs past the clearance the far witness still stops it, isolated as
-    without the target."""
-    rate = bound_rate(m, i, R, o, w, vf)
-    if rate <= 0.0:
-        return math.inf
-    least = max(m.options[O_FLOOR], 0.5 * (s.distance[i] - bound[i]))
-    return m.options[O_EARLY] * least / rate
-
-
-@njit(cache=True)
 def _far_views(m, s, buf):
     """The far pass's views of an evaluation's result buffer (`layout`): the travel bounds,
     the frames' rotations, origins, angular and linear velocities, and the scalars."""
@@ -208,10 +191,9 @@ def far_witness(mp, sp, buf):
     """Into an evaluation's result buffer (`layout`): the far pairs' travel bounds (BOUND;
     NaN for the pairs not far), their witness, the smallest clearance left, min (clearance -
     bound) (1 if no pair is far; scalar S_FAR), whether a pair sought before is due a seek at
-    this step's start, its `due_in` within the reseek horizon (S_DUE), and the step-end target
-    (S_FAR_EARLY; inf for none): the time before the next of the others is due, or before one
-    due now may be due again after its seek (`due_after_seek`), whichever is first. Asked by
-    the witnesses and the step's start, not by every evaluation."""
+    this step's start, its `due_in` within the reseek horizon (S_DUE), and the time before the
+    next of the others is (inf for none; S_FAR_EARLY). Asked by the witnesses and the step's
+    start, not by every evaluation."""
     m = unpack_model(mp)
     s = unpack_modes(sp)
     k = s.code.shape[0]
@@ -227,10 +209,7 @@ def far_witness(mp, sp, buf):
             if s.sought[i] and early > 0.0:
                 t_due = due_in(m, s, i, R, o, w, vf, bound)
                 if t_due <= horizon:
-                    # Sought at this step's start, before the step control reads this: the
-                    # step ends where it may be due again, not where its clearance is used.
                     due = 1.0
-                    lead = min(lead, due_after_seek(m, s, i, R, o, w, vf, bound))
                 else:
                     lead = min(lead, t_due)
     scalars[S_FAR] = 1.0 if wfar == math.inf else wfar
