@@ -69,7 +69,9 @@ docs: $(BIN)/.installed
 	$(BIN)/python -m drake_dock.studies.funnel --shipped $(DOCS_OUT)/funnel_shipped
 	cp $(DOCS_OUT)/funnel_shipped/funnel.png $(DOCS_OUT)/funnel_shipped/funnel.csv docs/
 	$(DD) study conditions models/apds_funnel.yaml --out $(DOCS_OUT)/conditions_funnel
-	cp $(DOCS_OUT)/conditions_funnel/conditions.png docs/
+	cp $(DOCS_OUT)/conditions_funnel/conditions.png $(DOCS_OUT)/conditions_funnel/conditions.csv docs/
+	$(DD) study examples --out $(DOCS_OUT)/examples
+	cp $(DOCS_OUT)/examples/examples.csv docs/
 	$(DD) study roll --out $(DOCS_OUT)/roll
 	cp $(DOCS_OUT)/roll/roll.png $(DOCS_OUT)/roll/roll.csv docs/
 	$(DD) study crosscheck --out $(DOCS_OUT)/crosscheck

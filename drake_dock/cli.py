@@ -66,6 +66,9 @@ STUDIES = {
     "conditions": "60 seeded conditions and 16 corners of the IDSS initial-contact box, each "
                   "run to its outcome and checked for interpenetration",
     "roll": "the coaxial approach over the whole relative-roll range, each run to its outcome",
+    "examples": "the named off-axis scenarios of models/ and the base scenario in free drift "
+                "at slow closing rates, each run to its outcome and checked for "
+                "interpenetration",
     "funnel": "the capture range (the largest lateral offset that captures) over the petal "
               "tips' clearance and the post-contact thrust (default scenario: "
               "models/apds_funnel.yaml)",
@@ -313,6 +316,11 @@ def _study(args) -> int:
         from drake_dock.studies.roll import run_rolls as run_plan
         from drake_dock.studies.roll import summary_lines as lines
         from drake_dock.studies.roll import write_rolls as write
+    elif args.which == "examples":
+        from drake_dock.studies.examples import ExamplesPlan as Plan
+        from drake_dock.studies.examples import run_examples as run_plan
+        from drake_dock.studies.examples import summary_lines as lines
+        from drake_dock.studies.examples import write_examples as write
     elif args.which == "funnel":
         from drake_dock.studies.funnel import FunnelPlan as Plan
         from drake_dock.studies.funnel import run_funnel as run_plan

@@ -15,6 +15,7 @@ tests/docking/test_doc_counts.py). Nothing here needs Drake: the files are read 
 paper example's geometry with yaml."""
 import ast
 import csv
+import json
 import re
 from pathlib import Path
 
@@ -443,3 +444,87 @@ def test_roll_numbers_are_the_roll_csv():
         assert m["outcome"] == r["outcome"]
         if r["outcome"] == "captured":
             assert m["capture_time_s"] == pytest.approx(r["capture_time_s"], rel=1e-6)
+
+
+# 6. The named examples and the free drift: docs/examples.csv ---------------------------------
+def test_example_numbers_are_the_examples_csv():
+    by = {r["name"]: r for r in read_csv("examples.csv")}
+    mm = 1e3
+    x = Quotes("The named off-axis examples")
+    box, lat, tilt = by["idss_box_corner"], by["idss_lateral"], by["idss_tilted"]
+    x.check("`idss_box_corner` ends `jammed` at {} s after {} impacts, the rings {} m apart "
+            "axially", box["end_time_s"], box["impacts"], box["final_axial_m"])
+    x.check("momentum kept to {} (linear) and {} (angular) and the energy ledger closed to {}.",
+            box["momentum_drift_linear"], box["momentum_drift_angular"], box["energy_closure"])
+    x.check("`idss_lateral` after {} impacts at {} s ({} m), `idss_tilted` after {} impacts at "
+            "{} s ({} m); their ledgers close to {} and {}.", lat["impacts"], lat["end_time_s"],
+            lat["final_axial_m"], tilt["impacts"], tilt["end_time_s"], tilt["final_axial_m"],
+            lat["energy_closure"], tilt["energy_closure"])
+    by_couple = json.loads(box["impacts_by_couple"])
+    x.check("`cc_Cring_Ttip3`, the chaser's ring on target tip arc 3, takes part in {} of the {} "
+            "and `cc_T2_C4` in {}, and {} land", by_couple["cc_Cring_Ttip3"], box["impacts"],
+            by_couple["cc_T2_C4"], by_couple["pc_Tcorner6_Cring"])
+    x.check("about H = {} m apart", yaml.safe_load(
+        (ROOT / "drake_dock/models/idss_lateral.yaml").read_text())["geometry"]["H"])
+    x.done()
+    # What the prose says without a number: the three jam, neither check finds a crossing,
+    # and the two at the tip arcs stop within a centimetre of H.
+    assert all(r["outcome"] == "jammed" and r["penetration_m"] == 0 for r in (box, lat, tilt))
+    assert abs(lat["final_axial_m"] - 0.2) < 0.01 and abs(tilt["final_axial_m"] - 0.2) < 0.01
+    d = Quotes("Free drift at the IDSS box's slowest closing rate")
+    slow, slow1, mid = (by["slow 0.05 m/s"], by["slow 0.05 m/s, roll 1 deg"],
+                        by["slow 0.08 m/s"])
+    d.check("the rings stall at an axial ring distance of {} mm", mm * slow["final_axial_m"])
+    d.check("ends `jammed` at {} s", slow["end_time_s"])
+    d.check("At 1 deg roll the same rate is captured, at {} s, and so is {} m/s at 5 deg, at {} s",
+            slow1["capture_time_s"], mid["chaser_speed"], mid["capture_time_s"])
+    d.done()
+    assert (slow["outcome"], slow1["outcome"], mid["outcome"]) == ("jammed", "captured",
+                                                                   "captured")
+    assert slow["chaser_speed"] == slow1["chaser_speed"] == 0.05
+    assert (slow["target_yaw_deg"], slow1["target_yaw_deg"], mid["target_yaw_deg"]) == (5, 1, 5)
+
+
+# 7. The working conditions: docs/conditions.csv ----------------------------------------------
+def test_conditions_numbers_are_the_conditions_csv():
+    rows = read_csv("conditions.csv")
+    cap = [r for r in rows if r["outcome"] == "captured"]
+    mm, um = 1e3, 1e6
+
+    def span(key, scale=1.0):
+        v = [scale * r[key] for r in cap]
+        return min(v), max(v), float(np.median(v))
+    tilt = [r["final_tilt_deg"] for r in cap]
+    c = Quotes("Working conditions: the IDSS initial-contact box")
+    c.check("The conditions study runs {} seeded random conditions inside",
+            sum(r["name"].startswith("random") for r in rows))
+    c.check("and {} of its corners", sum(r["name"].startswith("corner") for r in rows))
+    c.check("All {} runs are captured", len(cap))
+    assert len(cap) == len(rows), "the prose says every run is captured"
+    lo, hi, med = span("capture_time_s")
+    c.check("Capture comes {} to {} s after the start (median {} s)", lo, hi, med)
+    lo, hi, med = span("impacts")
+    c.check("after {} to {} impacts (median {})", lo, hi, med)
+    lo, hi, med = span("final_lateral_m", mm)
+    c.check("with the rings {} to {} mm off the axis (median {} mm)", lo, hi, med)
+    c.check("and {} to {} deg tilted", min(tilt), max(tilt))
+    lo, hi, med = span("peak_contact_force_N")
+    c.check("The peak contact force is {} to {} N (median {} N)", lo, hi, med)
+    deep = max(rows, key=lambda r: r["penetration_m"])
+    c.check("the deepest crossing is {} mm (random {}", mm * deep["penetration_m"],
+            int(deep["name"].split()[1]) if deep["name"].startswith("random") else None)
+    c.check("at {} s; both checks agree)", float(re.search(r"t = (\S+) s", deep["penetration"])
+                                                 .group(1)))
+    assert deep["name"].startswith("random")
+    assert (abs(deep["penetration_analytic_m"] - deep["penetration_mesh_m"])
+            < 0.05 * deep["penetration_m"]), "the prose says both checks agree"
+    rest = [r["penetration_m"] for r in rows if r is not deep]
+    c.check("{} of them at 0.", sum(p == 0 for p in rest))
+    quoted = float(re.search(r"every other run stays\s+below (\S+) um", c.text).group(1))
+    assert max(rest) * um < quoted, f"a run other than the deepest crosses {max(rest) * um} um"
+    c.check("drifts by at most {} and the angular momentum by {} (relative)",
+            max(r["momentum_drift_linear"] for r in rows),
+            max(r["momentum_drift_angular"] for r in rows))
+    closure = [abs(r["energy_closure"]) for r in rows]
+    c.check("closes to {} at worst (median {})", max(closure), float(np.median(closure)))
+    c.done()

@@ -147,8 +147,18 @@ def run_condition(scenario, name: str, condition: dict) -> dict:
                energy_closure=summ["energy_ledger"]["closure_error_relative"],
                **pen,
                final_lateral_m=summ["final_misalignment"]["lateral_m"],
-               final_tilt_deg=summ["final_misalignment"]["tilt_deg"], wall_time_s=wall)
+               final_tilt_deg=summ["final_misalignment"]["tilt_deg"],
+               final_axial_m=summ["final_misalignment"]["axial_m"],
+               end_time_s=summ["end_time_s"], impacts_by_couple=impacts_by_couple(ts),
+               wall_time_s=wall)
     return row
+
+
+def impacts_by_couple(ts) -> str:
+    """JSON {couple: the number of impacts it takes part in}, by the couples' order."""
+    names, taken = ts["couple_names"].tolist(), np.asarray(ts["impact_couples"], bool)
+    count = taken.sum(axis=0) if taken.size else np.zeros(len(names), int)
+    return json.dumps({n: int(k) for n, k in zip(names, count) if k})
 
 
 def run_rows(scenario, plan, todo, log=print) -> dict:
@@ -156,13 +166,19 @@ def run_rows(scenario, plan, todo, log=print) -> dict:
     set (``plan.pairs``), logging each outcome: {"plan", "rows"}."""
     scenario = copy.deepcopy(scenario)
     scenario.contact.pairs = plan.pairs
+    return run_each(plan, [(scenario, name, cond) for name, cond in todo], log,
+                    lambda r: f", deepest interpenetration {r['penetration_m'] * 1e3:.3g} mm")
+
+
+def run_each(plan, todo, log, finished) -> dict:
+    """Runs ``todo`` [(scenario, name, condition)] by `run_condition`, logging each outcome
+    with ``finished(row)`` after it, or the reason of a typed error: {"plan", "rows"}."""
     rows = []
-    for k, (name, cond) in enumerate(todo, 1):
+    for k, (scenario, name, cond) in enumerate(todo, 1):
         row = run_condition(scenario, name, cond)
         rows.append(row)
         log(f"[{k}/{len(todo)}] {name}: {row['outcome']}"
-            + (f", deepest interpenetration {row['penetration_m'] * 1e3:.3g} mm"
-               if "penetration_m" in row else f" ({row['reason']})"))
+            + (finished(row) if "penetration_m" in row else f" ({row['reason']})"))
     return {"plan": dataclasses.asdict(plan), "rows": rows}
 
 
@@ -217,12 +233,12 @@ FIELDS = ("name", "chaser_speed", "lateral_offset", "lateral_velocity", "tilt_de
           "final_tilt_deg", "wall_time_s")
 
 
-def rows_csv(rows) -> str:
+def rows_csv(rows, fields=FIELDS) -> str:
     buf = io.StringIO()
-    w = csv.DictWriter(buf, FIELDS, lineterminator="\n")
+    w = csv.DictWriter(buf, fields, lineterminator="\n")
     w.writeheader()
     for r in rows:
-        w.writerow({k: r.get(k, "") for k in FIELDS})
+        w.writerow({k: r.get(k, "") for k in fields})
     return buf.getvalue()
 
 

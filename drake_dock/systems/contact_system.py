@@ -342,7 +342,7 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     def _joint_value(self, context):
         """The least value of the armed witnesses (`witnesses.JOINT_WITNESS`)."""
         E = self._cache.Eval(context)
-        return E.least_witness(self._armed_of(E.modes, context))
+        return E.least_witness(self._armed_modes(E.modes))
 
     def _far_value(self, context):
         return self._cache.Eval(context).far_witness

@@ -74,10 +74,7 @@ class WitnessPredictions:
     def armed_witnesses(self, context) -> "ArmedWitnesses":
         """The witnesses `DoGetWitnessFunctions` returns now as arrays (`ArmedWitnesses`),
         kept on the modes' index."""
-        return self._armed_of(self.get_modes(context), context)
-
-    def _armed_of(self, modes, context) -> "ArmedWitnesses":
-        return self._armed_modes(modes)
+        return self._armed_modes(self.get_modes(context))
 
     def _armed_modes(self, modes) -> "ArmedWitnesses":
         derived = modes.index().derived
@@ -135,7 +132,7 @@ class WitnessPredictions:
           next step's start, and no witness needs isolating."""
         modes = self.get_modes(context)
         return self._witness_now_of(self._cache.Eval(context), modes,
-                                    self._armed_of(modes, context))
+                                    self._armed_modes(modes))
 
     def _witness_now_of(self, E, modes, a) -> WitnessNow:
         w = E.wv.ravel().take(a.flat)
