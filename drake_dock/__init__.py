@@ -8,8 +8,9 @@ Layers, each importing only the ones below it:
   control).
 - `drake_dock.docking`: the docking scene, in wings (scenario, geometry, checks, model,
   placement, report: its docstring gives their order).
-- `drake_dock.studies`: small scenes, the compliant baseline, the speed-accuracy and stability
-  studies.
+- `drake_dock.studies`: small scenes, the compliant baseline and the studies (`drake-dock
+  study`).
+- `drake_dock.campaign`: seeded campaigns on Dask.
 - `drake_dock.run` and `drake_dock.cli` on top.
 """
 __version__ = "0.1.0"

@@ -146,11 +146,12 @@ def test_module_names_are_unique():
 
 def _stem(name: str) -> str:
     """A module name without its inflection: "handovers" and "handover", "tracking" and
-    "tracked", "loads" and "loading" share a stem."""
+    "tracked", "loads" and "loading", "sample" and "sampling" share a stem."""
     for suffix in ("ing", "ed", "s"):
         if name.endswith(suffix) and len(name) - len(suffix) >= 4:
-            return name[:-len(suffix)]
-    return name
+            name = name[:-len(suffix)]
+            break
+    return name[:-1] if name.endswith("e") and len(name) >= 5 else name
 
 
 # A compiled kernel and the pure-Python reference it compiles: one thing twice, by design.
@@ -174,7 +175,8 @@ def test_no_two_modules_are_inflections_of_one_name():
 def test_an_impact_is_made_in_one_place_and_no_caller_writes_a_system_s_private_fields():
     """`Impact` records are constructed only in systems/impacts.py; no module reaches into
     another object's private attributes of the contact system's state (``x._mode_index`` for
-    an ``x`` other than ``self``)."""
+    an ``x`` other than ``self``), and none writes a private attribute of an object other
+    than ``self`` or ``cls``."""
     made, reached = [], []
     for name, path in _modules().items():
         for node in ast.walk(ast.parse(path.read_text())):
@@ -186,6 +188,13 @@ def test_an_impact_is_made_in_one_place_and_no_caller_writes_a_system_s_private_
             if isinstance(node, ast.Attribute) and node.attr == "_mode_index" and not (
                     isinstance(node.value, ast.Name) and node.value.id == "self"):
                 reached.append(name)
+            # nor writes another object's private attribute (``E._table = ...``)
+            targets = (node.targets if isinstance(node, ast.Assign) else [node.target]
+                       if isinstance(node, (ast.AugAssign, ast.AnnAssign)) else [])
+            reached += [f"{name}:{node.lineno}" for t in targets for a in ast.walk(t)
+                        if isinstance(a, ast.Attribute) and a.attr.startswith("_")
+                        and not a.attr.startswith("__")
+                        and not (isinstance(a.value, ast.Name) and a.value.id in ("self", "cls"))]
     assert not made and not reached, (made, reached)
 
 

@@ -15,7 +15,7 @@ from drake_dock.campaign.plan import figure_axes, load_plan
 from drake_dock.campaign.progress import CampaignProgress
 from drake_dock.campaign.report import summarize
 from drake_dock.campaign.sample import run_batch
-from drake_dock.campaign.sampling import sample_specs
+from drake_dock.campaign.points import sample_specs
 from drake_dock.campaign.store import CampaignStore, atomic_write
 from drake_dock.errors import InputError
 

@@ -20,6 +20,7 @@ import numpy as np
 
 from drake_dock.campaign.plan import set_field
 from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
+from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import PlacementCache, place
 from drake_dock.docking.report.results import (energy_ledger, final_misalignment, momenta,
@@ -37,16 +38,30 @@ RESULT_COLUMNS = {
 ERROR = "error"
 CACHE_SIZE = 4
 _DIAGRAMS: collections.OrderedDict = collections.OrderedDict()
+_SCENES: collections.OrderedDict = collections.OrderedDict()
+
+
+def _kept(cache: collections.OrderedDict, key, make):
+    """``cache[key]``, made by ``make()`` where missing; the last CACHE_SIZE keys stay."""
+    value = cache.pop(key, None) or make()
+    cache[key] = value
+    while len(cache) > CACHE_SIZE:
+        cache.popitem(last=False)
+    return value
 
 
 def diagram_for(spec: DiagramSpec):
     """This process's Diagram of ``spec``: built once per spec, kept for the last CACHE_SIZE
     specs."""
-    dd = _DIAGRAMS.pop(spec, None) or build_docking_diagram(spec)
-    _DIAGRAMS[spec] = dd
-    while len(_DIAGRAMS) > CACHE_SIZE:
-        _DIAGRAMS.popitem(last=False)
-    return dd
+    return _kept(_DIAGRAMS, spec, lambda: build_docking_diagram(spec))
+
+
+def scene_for(scenario) -> DockingScene:
+    """This process's `DockingScene` of ``scenario`` (its geometry and contact set): made once
+    per key, kept for the last CACHE_SIZE keys, so that a sample's `DiagramSpec` finds its
+    cached Diagram without making a scene of its own."""
+    key = DockingScene.key_of(scenario.geometry, scenario.contact.pairs)
+    return _kept(_SCENES, key, lambda: DockingScene.of(scenario))
 
 
 def sample_scenario(base, values: dict):
@@ -119,7 +134,7 @@ def scenario_row(scenario, *, reuse: bool = True) -> dict:
     """The result columns (`measure`) of a run of ``scenario``: on this process's cached
     Diagram of its `DiagramSpec` (``reuse``, `diagram_for`) or a fresh one, placed on that
     Diagram's scene."""
-    spec = DiagramSpec.of(scenario)
+    spec = DiagramSpec.of(scenario, scene=scene_for(scenario) if reuse else None)
     dd = diagram_for(spec) if reuse else build_docking_diagram(spec)
     return measure(simulate(scenario, place(scenario, PlacementCache(dd.scene)), dd=dd))
 
@@ -135,9 +150,11 @@ def run_sample(base, spec, *, reuse: bool = True) -> dict:
         row.update(scenario_row(sample_scenario(base, values), reuse=reuse))
     except DrakeDockError as e:
         _DIAGRAMS.clear()            # nothing of a failed run is kept
+        _SCENES.clear()
         row.update(failed(str(e), f"{type(e).__name__}"))
     except Exception as e:  # noqa: BLE001 - a sample's failure is its row, never the campaign's
         _DIAGRAMS.clear()
+        _SCENES.clear()
         row.update(failed(f"internal error ({type(e).__name__}): {e}"[:2000],
                           f"{type(e).__name__}"))
     row["wall_time"] = time.perf_counter() - t0

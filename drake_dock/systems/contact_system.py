@@ -77,7 +77,6 @@ from drake_dock.systems.evaluation import Evaluation
 from drake_dock.systems.far_pairs import FarPairs
 from drake_dock.systems.handover_links import HandoverLinks
 from drake_dock.systems.memo import Memo
-from drake_dock.systems.couple_ports import CoupleRows
 from drake_dock.systems.profiling import Timing
 from drake_dock.systems.reseek import reseek_far
 from drake_dock.systems.transitions import Transitions
@@ -154,7 +153,6 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
                                     if relation(p.kind).along_d)
         self.timing = Timing([p.name for p in pairs])
         self.transitions = Transitions(self, self.timing)
-        self._rows = CoupleRows(self)
 
         # State: x = [q, v, u*, friction loss, work of plant forces, work of inputs,
         #             work of each damper].
@@ -307,11 +305,11 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     def couple_table(self, context) -> np.ndarray:
         """All couples' outputs at once, row i the value of port ``couple_<pairs[i].name>``
         (for loggers: one call instead of one port evaluation per couple)."""
-        return self._rows.table(self._cache.Eval(context))
+        return self._cache.Eval(context).couple_table
 
     def couple_table_of(self, E) -> np.ndarray:
         """`couple_table` of the evaluation E."""
-        return self._rows.table(E)
+        return E.couple_table
 
     # ------------------------------------------------------------------ witnesses
     def DoGetWitnessFunctions(self, context):

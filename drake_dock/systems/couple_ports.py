@@ -14,20 +14,10 @@ _COLS = np.array([_S[name].start for name in ("status", "gap", "vn", "lambda_n",
                                               "vt", "u", "p1", "p2", "frame")], dtype=np.int64)
 
 
-class CoupleRows:
-    """The couple table of a `RigidContactSystem` ``system``: row i the value of port
-    ``couple_<pairs[i].name>`` (`engine.couple_table`)."""
-
-    def __init__(self, system):
-        self.system = system
-
-    def table(self, E) -> np.ndarray:
-        """The table at the evaluation E (kept on E: outputs and loggers ask for it at the
-        same context)."""
-        Y = getattr(E, "_table", None)
-        if Y is None:
-            eng = self.system.engine
-            E._far_pass()
-            Y = E._table = np.empty((eng.k, COUPLE_OUTPUT_SIZE))
-            KE.couple_table(eng.packed, eng.mode_arrays(E.modes), E.x, E.buf, _COLS, Y)
-        return Y
+def couple_rows(engine, E) -> np.ndarray:
+    """The couple table of the evaluation ``E`` of ``engine``, row i the value of port
+    ``couple_<pairs[i].name>`` (`engine.couple_table`); the far pass of E done
+    (`Evaluation.couple_table` keeps it)."""
+    Y = np.empty((engine.k, COUPLE_OUTPUT_SIZE))
+    KE.couple_table(engine.packed, engine.mode_arrays(E.modes), E.x, E.buf, _COLS, Y)
+    return Y

@@ -11,6 +11,7 @@ from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels import model as E
 from drake_dock.core.kernels.couple_row import CoupleRow
 from drake_dock.core.kernels.witness_values import due_far, far_witness
+from drake_dock.systems.couple_ports import couple_rows
 
 
 class Kinematics:
@@ -175,6 +176,13 @@ class Evaluation:
         for j, i in enumerate(self.modes.index().near):
             ev[i] = CoupleRow(out[j], int(eng.uoff[i + 1] - eng.uoff[i]))
         return ev
+
+    @functools.cached_property
+    def couple_table(self) -> np.ndarray:
+        """The couple output ports' values, all pairs at once (`couple_ports.couple_rows`),
+        kept: outputs and loggers ask for them at the same context."""
+        self._far_pass()
+        return couple_rows(self.engine, self)
 
     def _far_pass(self):
         if not self._far:

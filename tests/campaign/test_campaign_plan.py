@@ -91,7 +91,7 @@ def test_set_values_reach_every_sample(tmp_path):
 
 
 def test_edges_sampler_follows_the_arcsine_law_and_sobol_points_keep_their_index():
-    from drake_dock.campaign.sampling import unit_points
+    from drake_dock.campaign.points import unit_points
     u = unit_points("edges", 3, 2, list(range(1024)), 1024)
     # The arcsine law: P(u < a) = (2 / pi) asin(sqrt(a)); Sobol' points match it closely.
     for a in (0.05, 0.1, 0.5):

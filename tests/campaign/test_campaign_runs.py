@@ -68,7 +68,7 @@ def test_two_workers_equal_the_serial_run_row_for_row(tmp_path):
     from drake_dock.campaign.campaign import run_campaign
     from drake_dock.campaign.plan import load_plan
     from drake_dock.campaign.sample import run_sample, sample_scenario
-    from drake_dock.campaign.sampling import sample_specs
+    from drake_dock.campaign.points import sample_specs
     from drake_dock.docking.scenario.loading import load_scenario
     plan_file = write_plan(tmp_path, SAMPLES, batch=3)
     out = tmp_path / "out"

@@ -119,8 +119,10 @@ def test_every_leaf_a_plan_can_change_is_walked(bases):
 def test_a_cached_diagram_gives_the_row_a_fresh_one_gives(bases, name):
     base = bases[name]
     sample._DIAGRAMS.clear()
+    sample._SCENES.clear()
     row = scenario_row(base)                                   # the cache holds the base's
     cached = next(reversed(sample._DIAGRAMS.values()))
+    assert cached.scene is next(reversed(sample._SCENES.values()))
     assert row["outcome"] == ("captured" if name == "captured" else "timeout")
     assert (row["impacts"] == 0) == (name == "captured")
     spec = DiagramSpec.of(base)
@@ -133,6 +135,7 @@ def test_a_cached_diagram_gives_the_row_a_fresh_one_gives(bases, name):
             continue                                           # the cache builds another
         got = scenario_row(s)
         assert next(reversed(sample._DIAGRAMS.values())) is cached, path
+        assert len(sample._SCENES) == 1, path                 # its scene made once too
         fresh = scenario_row(s, reuse=False)
         diff = {k: (got[k], fresh[k]) for k in got if got[k] != fresh[k]
                 and not (isinstance(got[k], float) and math.isnan(got[k])

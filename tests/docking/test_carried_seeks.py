@@ -10,7 +10,7 @@ import pytest
 
 from drake_dock.campaign.plan import load_plan
 from drake_dock.campaign.sample import sample_scenario
-from drake_dock.campaign.sampling import sample_specs
+from drake_dock.campaign.points import sample_specs
 from drake_dock.core import handover
 from drake_dock.core.hybrid import Mode
 from drake_dock.docking.model.simulate import simulate

@@ -54,7 +54,7 @@ def test_idss_sample_139_lifts_off_and_runs_to_a_named_outcome():
     import numpy as np
     from drake_dock.campaign.plan import load_plan
     from drake_dock.campaign.sample import sample_scenario
-    from drake_dock.campaign.sampling import sample_specs
+    from drake_dock.campaign.points import sample_specs
     from drake_dock.docking.model.outcome import OUTCOMES
     from drake_dock.docking.report.results import (IN_CONTACT, final_misalignment, summary,
                                                    timeseries)

@@ -207,7 +207,7 @@ def _idss_sample(k):
     from pathlib import Path
     from drake_dock.campaign.plan import load_plan
     from drake_dock.campaign.sample import sample_scenario
-    from drake_dock.campaign.sampling import sample_specs
+    from drake_dock.campaign.points import sample_specs
     models = Path(__file__).resolve().parents[2] / "models"
     plan, base, fields = load_plan(models / "idss_envelope.yaml")
     (_, _, values), = sample_specs(plan, fields, [k])
