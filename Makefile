@@ -72,6 +72,8 @@ docs: $(BIN)/.installed
 	cp $(DOCS_OUT)/conditions_funnel/conditions.png $(DOCS_OUT)/conditions_funnel/conditions.csv docs/
 	$(DD) study examples --out $(DOCS_OUT)/examples
 	cp $(DOCS_OUT)/examples/examples.csv docs/
+	$(BIN)/python bench/edge_reach.py > $(DOCS_OUT)/edge_reach.txt
+	cp $(DOCS_OUT)/edge_reach.txt docs/
 	$(DD) study roll --out $(DOCS_OUT)/roll
 	cp $(DOCS_OUT)/roll/roll.png $(DOCS_OUT)/roll/roll.csv docs/
 	$(DD) study crosscheck --out $(DOCS_OUT)/crosscheck

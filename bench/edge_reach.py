@@ -7,10 +7,11 @@ least interior distance found; and whether `contact.pairs: complete` declares th
 tip arcs are swept too (`tip_tip_pairs`).
 
     python bench/edge_reach.py [N]        (default 20000 poses)
+
+It prints no wall time: `make docs` keeps its output as docs/edge_reach.txt.
 """
 import math
 import sys
-import time
 
 from drake_dock.docking.geometry.reach import reach_sweep, side_candidates, tip_candidates
 from drake_dock.docking.geometry.scene import DockingScene
@@ -19,9 +20,8 @@ from drake_dock.docking.scenario.dimensions import ApdsGeometry
 n = int(sys.argv[1]) if len(sys.argv) > 1 else 20000
 g = ApdsGeometry()
 declared = {p.name for p in DockingScene(g, "complete").pairs}
-t0 = time.perf_counter()
 rows = reach_sweep(g, side_candidates(g) + tip_candidates(g), n)
-print(f"{n} poses, {len(rows)} candidate pairs, {time.perf_counter() - t0:.1f} s")
+print(f"{n} poses, {len(rows)} candidate pairs")
 for name, (hits, least, (lo, hi)) in sorted(rows.items(), key=lambda r: (-r[1][0], r[0])):
     rolls = f"roll {lo:6.1f} .. {hi:6.1f} deg" if hits else " " * 25
     least = f"{least * 1e3:7.2f} mm" if math.isfinite(least) else "   never interior"

@@ -528,3 +528,48 @@ def test_conditions_numbers_are_the_conditions_csv():
     closure = [abs(r["energy_closure"]) for r in rows]
     c.check("closes to {} at worst (median {})", max(closure), float(np.median(closure)))
     c.done()
+
+
+# 8. The edge reach sweep: docs/edge_reach.txt -----------------------------------------------
+def reach_rows() -> dict:
+    """{pair: (declared, poses within 2 cm, (least, greatest) roll or None, least interior
+    distance in mm or None)} of `bench/edge_reach.py`'s lines."""
+    rows = {}
+    for line in (DOCS / "edge_reach.txt").read_text().splitlines()[1:-1]:
+        m = re.match(r"(\S+)\s+(declared)?\s+(\d+) within 2 cm,\s*(?:roll\s+(\S+) \.\.\s+(\S+) "
+                     r"deg)?\s*, least interior distance\s+(\S+)", line)
+        assert m, f"docs/edge_reach.txt: unread line {line!r}"
+        name, declared, hits, lo, hi, least = m.groups()
+        rows[name] = (bool(declared), int(hits), None if lo is None else (float(lo), float(hi)),
+                      None if least == "never" else float(least))
+    return rows
+
+
+def test_edge_reach_numbers_are_the_sweeps_lines():
+    rows = reach_rows()
+    text = (DOCS / "edge_reach.txt").read_text()
+    declared = {k: v for k, v in rows.items() if v[0]}
+    assert all(v[1] > 0 for v in declared.values()), "a declared pair is not reached"
+    assert not any(v[1] for v in rows.values() if not v[0]), "a pair reached, not declared"
+    assert text.rstrip().endswith("reached but not declared: none; declared but not reached: "
+                                  "none")
+
+    def inner(names):      # the least |roll| at which each of the pairs is reached
+        return sorted(min(abs(r) for r in declared[k][2]) for k in names)
+    side_side = [k for k in declared if re.fullmatch(r"cc_T\d_C\d", k)]
+    tip_tip = [k for k in declared if re.fullmatch(r"cc_Ctip\d_Ttip\d", k)]
+    side_tip = sorted(set(declared) - set(side_side) - set(tip_tip))
+    ends = inner(side_tip)             # two groups: 30 deg and 90 deg from the side
+    split = max(range(1, len(ends)), key=lambda i: ends[i] - ends[i - 1])
+    x = Quotes("The edge reach sweep")
+    x.check("It reaches each of the {} edge pairs the `complete` set declares ({} side-edge, {} "
+            "tip-tip) and none of the {} others", len(declared), len(side_side) + len(side_tip),
+            len(tip_tip), len(rows) - len(declared))
+    x.check("meet at rolls beyond about {} deg", inner(side_side)[0])
+    x.check("tip arcs 30 deg from a side from about {} deg of roll, those 90 deg away beyond "
+            "about {} deg", ends[0], ends[split])
+    x.check("the tip arcs each other's beyond about {} deg", inner(tip_tip)[0])
+    x.check("stays {} mm away", min(v[3] for v in rows.values() if not v[0] and v[3] is not None))
+    x.done()
+    assert split == len(ends) // 2, "the side-tip pairs are not two groups of equal size"
+    assert text.startswith("20000 poses")
