@@ -573,3 +573,71 @@ def test_edge_reach_numbers_are_the_sweeps_lines():
     x.done()
     assert split == len(ends) // 2, "the side-tip pairs are not two groups of equal size"
     assert text.startswith("20000 poses")
+
+
+# 9. Speed against accuracy: docs/speed_accuracy_points.csv and _speedups.txt -----------------
+SPEED = "Speed against accuracy: drake_dock and Drake's compliant contact"
+METRICS = ("capture_time", "apds_spin_rate", "chaser_axial_velocity", "peak_contact_force",
+           "peak_stewart_stroke", "chaser_impulse")
+
+
+def _worst(row) -> float:
+    return max(row[f"error_{m}"] for m in METRICS)
+
+
+def test_speed_accuracy_numbers_are_the_studys_files():
+    points = read_csv("speed_accuracy_points.csv")
+    scenes = ("paper_example", "idss_slow_roll")
+    rigid = {s: [r for r in points if r["scene"] == s and r["method"] == "drake_dock"
+                 and r["role"] not in ("reference", "self-convergence")] for s in scenes}
+    compliant = {s: [r for r in points if r["scene"] == s and r["method"] != "drake_dock"]
+                 for s in scenes}
+
+    def worst(scene, acc, caps, schemes=("runge_kutta5", "bogacki_shampine3")):
+        return [_worst(r) for r in rigid[scene] if r["accuracy"] == acc and r["step"] in caps
+                and r["scheme"] in schemes]
+    coarse = (0.01, 0.02)
+    x = Quotes(SPEED)
+    x.check("metrics is {} of the contact's effect on the paper example and {} on "
+            "`idss_slow_roll` with the 0.002 s cap, and at most {} with the coarser caps",
+            max(worst("paper_example", 1e-3, (0.002,))),
+            max(worst("idss_slow_roll", 1e-3, (0.002,))),
+            max(w for s in scenes for w in worst(s, 1e-3, coarse)))
+    x.check("accuracy, to {} and {} at 1e-8;", *(max(worst(s, 1e-8, (0.002,), ("runge_kutta5",)))
+                                                  for s in scenes))
+    at_1e8 = [w for s in scenes for w in worst(s, 1e-8, coarse)]
+    x.check("to between {} and {} at 1e-8.", min(at_1e8), max(at_1e8))
+    selfc = {r["scene"]: _worst(r) for r in points if r["role"] == "self-convergence"}
+    x.check("is {} on the paper example and {} on `idss_slow_roll`.", selfc["paper_example"],
+            selfc["idss_slow_roll"])
+    captured = [r for r in compliant["paper_example"] if r["captured"] == 1]
+    x.check("on the paper example between {} and {} of the contact's effect on the capture time "
+            "and between {} and {} on the spin rate",
+            min(r["error_capture_time"] for r in captured),
+            max(r["error_capture_time"] for r in captured),
+            min(r["error_apds_spin_rate"] for r in captured),
+            max(r["error_apds_spin_rate"] for r in captured))
+    force = [r["error_peak_contact_force"] for s in scenes for r in compliant[s]
+             if r["captured"] == 1]
+    x.check("(relative errors {} to {}).", min(force), max(force))
+    # The speed-ups file: which metrics no compliant family converges on, and the best errors.
+    lines = (DOCS / "speed_accuracy_speedups.txt").read_text().split("scene ")[1:]
+    none = {}
+    for block in lines:
+        scene = block.split(":")[0]
+        none[scene] = {m: float(e) for m, e in re.findall(
+            r"converged speed-up (\w+): none: no converged compliant configuration \(best "
+            r"compliant error (\S+);", block)}
+    assert set(none) == set(scenes)
+    assert set(none["paper_example"]) == {"apds_spin_rate", "peak_contact_force",
+                                          "chaser_axial_velocity", "chaser_impulse"}
+    assert set(none["idss_slow_roll"]) == {"apds_spin_rate", "peak_contact_force"}
+    others = [e for s in scenes for m, e in none[s].items() if m != "peak_contact_force"]
+    peaks = [none[s]["peak_contact_force"] for s in scenes]
+    x.check("The best compliant errors there are {} to {} of the contact's effect",
+            min(others), max(others))
+    x.check("and {} to {} times the reference peak force.", min(peaks), max(peaks))
+    x.done()
+    # Hydroelastic contact with thin pieces never captures, on either scene.
+    assert not any(r["captured"] == 1 for s in scenes for r in compliant[s]
+                   if r["model"] == "hydroelastic")
