@@ -2,7 +2,10 @@
 those outputs: the stability study's `docs/stability_summary.txt`, the funnel study's
 `docs/funnel.csv` (with the shipped plan read from `drake_dock/studies/funnel.py`'s source),
 the two campaigns' `docs/campaign_paper.csv` and `docs/campaign_funnel.csv`, the
-crosscheck's `docs/crosscheck.csv` and the roll study's `docs/roll.csv`.
+crosscheck's `docs/crosscheck.csv`, the roll study's `docs/roll.csv`, the examples study's
+`docs/examples.csv`, the conditions sweep's `docs/conditions.csv`, the edge reach sweep's
+`docs/edge_reach.txt` and the speed-accuracy study's `docs/speed_accuracy_points.csv` and
+`docs/speed_accuracy_speedups.txt`.
 
 `make docs` rewrites those files; the prose around them is copied by hand. Each quoted number
 is found by a short literal phrase of its section (`{}` a number, `{w}` a name), which must
@@ -464,17 +467,20 @@ def test_example_numbers_are_the_examples_csv():
     x.check("`cc_Cring_Ttip3`, the chaser's ring on target tip arc 3, takes part in {} of the {} "
             "and `cc_T2_C4` in {}, and {} land", by_couple["cc_Cring_Ttip3"], box["impacts"],
             by_couple["cc_T2_C4"], by_couple["pc_Tcorner6_Cring"])
-    x.check("about H = {} m apart", yaml.safe_load(
-        (ROOT / "drake_dock/models/idss_lateral.yaml").read_text())["geometry"]["H"])
+    H = yaml.safe_load((ROOT / "drake_dock/models/idss_lateral.yaml").read_text())["geometry"]["H"]
+    x.check("about H = {} m apart", H)
     x.done()
     # What the prose says without a number: the three jam, neither check finds a crossing,
     # and the two at the tip arcs stop within a centimetre of H.
     assert all(r["outcome"] == "jammed" and r["penetration_m"] == 0 for r in (box, lat, tilt))
-    assert abs(lat["final_axial_m"] - 0.2) < 0.01 and abs(tilt["final_axial_m"] - 0.2) < 0.01
+    assert abs(lat["final_axial_m"] - H) < 0.01 and abs(tilt["final_axial_m"] - H) < 0.01
     d = Quotes("Free drift at the IDSS box's slowest closing rate")
     slow, slow1, mid = (by["slow 0.05 m/s"], by["slow 0.05 m/s, roll 1 deg"],
                         by["slow 0.08 m/s"])
-    d.check("the rings stall at an axial ring distance of {} mm", mm * slow["final_axial_m"])
+    d.check("the rings stall at an axial ring distance of {} mm (capture: {} mm)",
+            mm * slow["final_axial_m"], mm * yaml.safe_load(
+                (ROOT / "drake_dock/models/paper_example.yaml").read_text()
+            )["simulation"]["capture_distance"])
     d.check("ends `jammed` at {} s", slow["end_time_s"])
     d.check("At 1 deg roll the same rate is captured, at {} s, and so is {} m/s at 5 deg, at {} s",
             slow1["capture_time_s"], mid["chaser_speed"], mid["capture_time_s"])
@@ -555,6 +561,8 @@ def test_edge_reach_numbers_are_the_sweeps_lines():
                                   "none")
 
     def inner(names):      # the least |roll| at which each of the pairs is reached
+        assert all(declared[k][2][0] * declared[k][2][1] > 0 for k in names), \
+            "a pair reached on both sides of roll 0"
         return sorted(min(abs(r) for r in declared[k][2]) for k in names)
     side_side = [k for k in declared if re.fullmatch(r"cc_T\d_C\d", k)]
     tip_tip = [k for k in declared if re.fullmatch(r"cc_Ctip\d_Ttip\d", k)]
@@ -569,7 +577,10 @@ def test_edge_reach_numbers_are_the_sweeps_lines():
     x.check("tip arcs 30 deg from a side from about {} deg of roll, those 90 deg away beyond "
             "about {} deg", ends[0], ends[split])
     x.check("the tip arcs each other's beyond about {} deg", inner(tip_tip)[0])
-    x.check("stays {} mm away", min(v[3] for v in rows.values() if not v[0] and v[3] is not None))
+    rest = {k: v[3] for k, v in rows.items() if not v[0] and v[3] is not None}
+    nearest = min(rest, key=rest.get)
+    x.check("stays {} mm away", rest[nearest])
+    assert re.fullmatch(r"cc_T\d_C\d", nearest), f"the nearest undeclared pair is {nearest}"
     x.done()
     assert split == len(ends) // 2, "the side-tip pairs are not two groups of equal size"
     assert text.startswith("20000 poses")
@@ -608,7 +619,7 @@ def test_speed_accuracy_numbers_are_the_studys_files():
     at_1e8 = [w for s in scenes for w in worst(s, 1e-8, coarse)]
     x.check("to between {} and {} at 1e-8.", min(at_1e8), max(at_1e8))
     selfc = {r["scene"]: _worst(r) for r in points if r["role"] == "self-convergence"}
-    x.check("is {} on the paper example and {} on `idss_slow_roll`.", selfc["paper_example"],
+    x.check("is {} on the paper example and {} on `idss_slow_roll`:", selfc["paper_example"],
             selfc["idss_slow_roll"])
     captured = [r for r in compliant["paper_example"] if r["captured"] == 1]
     x.check("on the paper example between {} and {} of the contact's effect on the capture time "

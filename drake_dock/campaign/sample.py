@@ -3,11 +3,11 @@ reduced to a plain row (a dict of numbers and strings, which pickles; Drake's Di
 Simulators and Contexts do not).
 
 A process keeps the last few Diagrams it built (`diagram_for`), each under its `DiagramSpec`
-(exactly what the Diagram reads of a scenario), and reuses one for every sample of the same spec,
-its scene serving the sample's placement too; a run on a reused Diagram gives bitwise the same row
-as on a fresh one (tests/campaign). Any failure of a sample (a typed error of drake_dock, a value
-out of range, anything else) is its row's ``outcome: error`` with the message in ``error``; it never
-stops the campaign.
+(exactly what the Diagram reads of a scenario), and the scenes of those specs (`scene_for`); it
+reuses one for every sample of the same spec, its scene serving the sample's placement too; a
+run on a reused Diagram gives bitwise the same row as on a fresh one (tests/campaign). Any
+failure of a sample (a typed error of drake_dock, a value out of range, anything else) is its
+row's ``outcome: error`` with the message in ``error``; it never stops the campaign.
 """
 from __future__ import annotations
 
@@ -19,8 +19,8 @@ import time
 import numpy as np
 
 from drake_dock.campaign.plan import set_field
-from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
 from drake_dock.docking.geometry.scene import DockingScene
+from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import PlacementCache, place
 from drake_dock.docking.report.results import (energy_ledger, final_misalignment, momenta,

@@ -15,7 +15,9 @@ corners off-axis approaches reach); the base scenario gives everything else.
 One row per run: the inputs, the outcome (captured, rebound, jammed, timeout, or `error` with
 the typed error's class and message), capture time, impacts, peak contact force, momentum drift,
 the energy ledger's closure, the deepest interpenetration (the deeper of the two checks', each
-also in a column of its own) with where and when it was found, and the wall time.
+also in a column of its own) with where and when it was found, and the wall time; a row also
+holds the end time, the axial ring distance at the end and the impacts per couple
+(`impacts_by_couple`), which `drake_dock.studies.examples` writes.
 """
 from __future__ import annotations
 

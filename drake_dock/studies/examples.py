@@ -18,6 +18,7 @@ from drake_dock.docking.report.out_dir import atomic_directory
 from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
 from drake_dock.studies.conditions import FIELDS, IDSS_BOX, counts, rows_csv, run_each
 
+assert FIELDS[-1] == "wall_time_s"
 EXAMPLE_FIELDS = FIELDS[:-1] + ("end_time_s", "final_axial_m", "impacts_by_couple",
                                 "wall_time_s")
 
@@ -47,7 +48,7 @@ def run_examples(scenario, plan: ExamplesPlan, log=print) -> dict:
     {"plan", "rows"}."""
     todo = [(stem, load_scenario(MODELS_DIR / f"{stem}.yaml"), ()) for stem in plan.files]
     todo += [(name, scenario, fields) for name, fields in plan.drifts]
-    # each row's inputs: the box's fields as its scenario gives them, a drift's changed
+    # each row's inputs: the box's fields as its scenario gives them, with a drift's own
     return run_each(plan, [(base, name, {f: _plain(getattr(base.initial, f)) for f in IDSS_BOX}
                             | dict(fields)) for name, base, fields in todo], log,
                     lambda r: f" at {r['end_time_s']:.3g} s after {r['impacts']} impacts")
@@ -62,7 +63,7 @@ def summary_lines(result) -> list:
             + (f" at {r['end_time_s']:.4g} s, {r['impacts']} impacts, axial ring distance "
                f"{r['final_axial_m']:.3g} m, deepest interpenetration "
                f"{r['penetration_m'] * 1e3:.3g} mm" if "end_time_s" in r else
-               f": {r['reason']}") for r in result["rows"]]
+               f" ({r['reason']})") for r in result["rows"]]
 
 
 def write_examples(result, out_dir):

@@ -6,6 +6,7 @@ base's Diagram, its row on that Diagram equals its row on a fresh one. Two short
 captured before contact (the capture tolerances decide), one that reaches contact and an
 impact. A stale Diagram, built for the base, gives another row where a capture tolerance
 changes: a key without them would fail here."""
+import copy
 import dataclasses
 import math
 import typing
@@ -15,6 +16,7 @@ import pytest
 from drake_dock.campaign import sample
 from drake_dock.campaign.sample import diagram_for, sample_scenario, scenario_row
 from drake_dock.core.lzb.solve import LAWS
+from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.model.diagram import DiagramSpec
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import PlacementCache, place
@@ -162,3 +164,19 @@ def test_a_stale_diagram_would_give_another_row(bases, path):
     state = place(s, PlacementCache(stale.scene))
     fresh = scenario_row(s, reuse=False)
     assert simulate(s, state, dd=stale).outcome == "captured" != fresh["outcome"]
+
+
+def test_a_scene_is_shared_exactly_by_the_scenarios_of_its_key(bases):
+    """`scene_for` serves one `DockingScene` to every scenario of equal geometry and contact
+    set, and a new one for another geometry or set (its key, `DockingScene.key_of`)."""
+    base = bases["captured"]
+    sample._SCENES.clear()
+    scene = sample.scene_for(base)
+    assert sample.scene_for(sample_scenario(base, {"initial.target_yaw_deg": 1.0})) is scene
+    other_set = copy.deepcopy(base)
+    other_set.contact.pairs = "complete" if base.contact.pairs != "complete" else "paper"
+    wider = sample_scenario(base, {"geometry.R": base.geometry.R * 1.01})
+    for s in (other_set, wider):
+        got = sample.scene_for(s)
+        assert got is not scene and got.key == DockingScene.key_of(s.geometry, s.contact.pairs)
+    assert sample.scene_for(base) is scene and len(sample._SCENES) == 3

@@ -16,9 +16,9 @@ from drake_dock.studies.examples import (EXAMPLE_FIELDS, ExamplesPlan, run_examp
 def test_a_drift_and_a_shipped_scenario_run_to_their_outcomes(paper_scenario, tmp_path):
     """Roll 0: the petals pass between each other, so the chaser flies free to capture at
     (H + approach_travel - capture_distance) / chaser_speed (with the `complete` set, whose
-tip-arc pairs close at ring distance H, as the roll study's). `idss_lateral` keeps the inputs of
-    its file and jams with the ring faces about H apart, where its tip arcs stand on the other
-    ring's inside circle (docs/model.md)."""
+    tip-arc pairs close at ring distance H, as the roll study's). `idss_lateral` keeps the
+    inputs of its file and jams with the ring faces about H apart, where its tip arcs stand on
+    the other ring's inside circle (docs/model.md)."""
     plan = ExamplesPlan(files=("idss_lateral",),
                         drifts=(("coaxial", (("target_yaw_deg", 0.0),)),))
     base = copy.deepcopy(paper_scenario)
@@ -48,7 +48,8 @@ tip-arc pairs close at ring distance H, as the roll study's). `idss_lateral` kee
         assert max(r["momentum_drift_linear"], r["momentum_drift_angular"]) < 1e-9
 
     write_examples(result, tmp_path / "examples")
-    back = list(csv.DictReader(open(tmp_path / "examples" / "examples.csv")))
+    with open(tmp_path / "examples" / "examples.csv", newline="") as f:
+        back = list(csv.DictReader(f))
     assert [r["name"] for r in back] == ["idss_lateral", "coaxial"]
     assert list(back[0]) == list(EXAMPLE_FIELDS)
     assert float(back[1]["capture_time_s"]) == coaxial["capture_time_s"]

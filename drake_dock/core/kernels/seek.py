@@ -11,8 +11,8 @@
   the nearest point of a grid finished by Newton on F = t2 . d (Eq. 37 for a point), clipped
   to the domain; and the curve's side the point lies on.
 
-docs/model.md, "Degenerate couples", gives the rules for flat valleys, domain ends and
-creeping iterations that `newton` follows.
+docs/algorithms.md, "The seek's Newton finish", gives the rules for flat valleys, domain ends
+and creeping iterations that `newton` follows.
 """
 from __future__ import annotations
 
