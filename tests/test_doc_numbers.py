@@ -314,10 +314,8 @@ def test_campaign_bullets_are_the_campaigns_rows():
     assert all("held by no couple" in r["reason"] for r in jam)
     c.check("held by no couple, with {} to {} J of relative kinetic energy left after the "
             "thrust has ended", min(_kinetic(jam)), max(_kinetic(jam)))
-    err = [r for r in rows if r["outcome"] == "error"]
-    (t, couples), = _error_times_couples(err)
-    c.check("one ({}) stops in a typed `{w}` at {} s", err[0]["sample"], err[0]["reason"], t)
-    c.check("(`{w}`, `{w}`). The loads", *couples)
+    assert not any(r["outcome"] == "error" for r in rows), "the prose says none is an error"
+    c.check("thrust has ended; none stops in an error. The loads")
     force = [r["peak_contact_force"] for r in rows if r["peak_contact_force"] is not None]
     c.check("the peak contact force is {} N at the median and {} N at most",
             np.median(force), max(force))
