@@ -277,12 +277,15 @@ def test_campaign_bullets_are_the_campaigns_rows():
     c.check("{} samples ({} %) stop in a typed `PainleveInconsistency`",
             len(err), 100 * len(err) / n)
     assert {r["reason"] for r in err} == {"PainleveInconsistency"}
-    times = [t for t, _ in _error_times_couples(err)]
-    for _, couples in _error_times_couples(err):
-        assert sorted(re.sub(r"\d+$", "*", x) for x in couples) == [
-            "cc_Cring_Ttip*", "cc_Tring_Ctip*"], couples
-    c.check("`cc_Cring_Ttip*` with `cc_Tring_Ctip*`, at {} to {} s)", min(times), max(times))
-    c.check("No error is untyped.")
+    found = list(zip(err, _error_times_couples(err)))
+    lips = [t for _, (t, couples) in found if sorted(re.sub(r"\d+$", "*", x) for x in couples)
+            == ["cc_Cring_Ttip*", "cc_Tring_Ctip*"]]
+    rest = [(r, t, couples) for r, (t, couples) in found if t not in lips]
+    c.check("{} with the tips of both APDS on both lips at once", len(lips))
+    c.check("`cc_Cring_Ttip*` with `cc_Tring_Ctip*`, at {} to {} s), and one (sample {}, at {} s)",
+            min(lips), max(lips), rest[0][0]["sample"], rest[0][1])
+    c.check("(`{w}`, `{w}`, `{w}`). No error is untyped.", *rest[0][2])
+    assert len(rest) == 1, "the prose names one error off the lips"
     assert not any(r["error"] and r["error"].startswith("internal error") for r in rows)
     force = [r for r in rows if r["peak_contact_force"] is not None]
     top = max(force, key=lambda r: r["peak_contact_force"])
@@ -295,10 +298,12 @@ def test_campaign_bullets_are_the_campaigns_rows():
     ledger = sorted((r for r in rows if r["energy_closure"] is not None),
                     key=lambda r: r["energy_closure"])
     worst = ledger[-1]
-    c.check("closes to {} or better but in one sample, {}, a jam after {} impacts, at {}.",
-            ledger[-2]["energy_closure"], worst["sample"], worst["impacts"],
-            worst["energy_closure"])
-    assert worst["outcome"] == "jammed"
+    second = ledger[-2]
+    c.check("closes to {} or better but in two samples: {}, a jam after {} impacts, at {}, and "
+            "{}, a miss after {} impacts, at {}.", ledger[-3]["energy_closure"],
+            worst["sample"], worst["impacts"], worst["energy_closure"], second["sample"],
+            second["impacts"], second["energy_closure"])
+    assert (worst["outcome"], second["outcome"]) == ("jammed", "missed")
 
     rows = read_csv("campaign_funnel.csv")
     n, cap = len(rows), [r for r in rows if r["outcome"] == "captured"]
