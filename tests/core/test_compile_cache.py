@@ -229,3 +229,20 @@ def test_a_kernel_of_the_package_is_compiled_once_per_argument_types_not_per_con
         ("float64", "Literal[int](2)"), ("float64", "Literal[int](3)")]
     # A kernel of the package: one, for the constants' type.
     assert _callee_called_with_two_constants(f"{cc.PACKAGE}.probe") == [("float64", "int64")]
+
+
+def test_a_kernel_that_numba_cannot_cache_is_warned_of_by_its_file_not_raised():
+    # numba's check before it saves a machine code: one with dynamic globals (as NUMBA_OPT=0
+    # leaves some) is not saved, and numba warns naming the kernel's file from its locator.
+    import types as pytypes
+    import warnings
+    from numba.core.errors import NumbaWarning
+    from drake_dock.core.kernels import couples
+    impl = couples.evaluate_one._cache._impl
+    cres = pytypes.SimpleNamespace(lifted=(), library=pytypes.SimpleNamespace(
+        has_dynamic_globals=True), fndesc=pytypes.SimpleNamespace(qualname="evaluate_one"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert impl.check_cachable(cres) is False
+    assert [w.filename for w in caught if issubclass(w.category, NumbaWarning)] == [
+        couples.__file__]

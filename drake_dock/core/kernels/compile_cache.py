@@ -176,6 +176,7 @@ class KeyedLocator(_CacheLocator):
     directory `module_cache_dir`, its key as the source stamp."""
 
     def __init__(self, py_func, path: pathlib.Path):
+        self._py_file = str(path)            # numba's warning of a kernel it cannot cache
         self._lineno = py_func.__code__.co_firstlineno
         self._stamp = _key(f"{PACKAGE}.{path.stem}")
         self._path = str(module_cache_dir(path.stem))
