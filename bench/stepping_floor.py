@@ -13,9 +13,11 @@ Measured in one run, on one sample of the IDSS envelope plan (models/idss_envelo
    for ``--seconds`` of simulated time: no witnesses, no events, no recording. The motion so
    integrated is not the run's (modes held); only its cost per evaluation is read.
 
-It prints each one's microseconds per evaluation, the ratio of (1) to (3) (what compiled
-stepping could gain per evaluation at most, with events and witnesses as cheap as an
-evaluation) and the kernel's share of (1). No target: the floor of a design not built.
+It prints the run's wall time by part (seeking, contact dynamics, impacts and the rest:
+Drake's integrator, the witnesses, the step control and the recording), then each one's
+microseconds per evaluation, the ratio of (1) to (3) (what compiled stepping could gain per
+evaluation at most, with events and witnesses as cheap as an evaluation) and the kernel's
+share of (1). No target: the floor of a design not built.
 
     python bench/stepping_floor.py [--sample 6] [--seconds 0.1] [--repeats 3]
 """
@@ -138,6 +140,8 @@ def main():
     print(f"sample {args.sample}: {run.outcome} at {run.end_time:.3f} s simulated, "
           f"{run.evaluations} evaluations, wall {statistics.median(r.wall_time for r in runs):.3f}"
           f" s (median of {args.repeats})")
+    shares = ", ".join(f"{k.replace('_', ' ')} {v:.0%}" for k, v in run.timing["shares"].items())
+    print(f"the run's wall time by part (`RigidContactSystem.timing`): {shares}")
 
     rec, contact = run.record, dd.contact
     in_contact = [sum(m.pairs[i].mode.in_contact for i in m.index().near) for m in rec.modes]
