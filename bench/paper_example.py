@@ -187,7 +187,7 @@ def main():
           + ("met" + (" (and the aim)" if ratio <= 5 else " (not the aim of 5x)")
              if ratio <= 10 else f"NOT met ({ratio / 10:.1f}x over)"))
     print(f"target: set-up <= 0.02 s: "
-          + ("met" if t_state <= 0.02 else f"NOT met ({t_state / 0.02:.0f}x over)"))
+          + ("met" if t_state <= 0.02 else f"NOT met ({t_state / 0.02:.1f}x over)"))
     print(f"target: under 0.5 s of wall time: "
           + ("met" if wall < 0.5 else f"NOT met ({wall / 0.5:.2f}x over)"))
 
