@@ -224,12 +224,25 @@ def _present(schema):
     return schema
 
 
+def _has_field(node, name: str) -> bool:
+    """Whether ``name`` is a field of the scenario node (a dataclass would take any name)."""
+    if dataclasses.is_dataclass(node):
+        return name in {f.name for f in dataclasses.fields(node)}
+    return not name.startswith("_") and hasattr(node, name)     # a Drake config struct
+
+
 def set_field(scenario: Scenario, path: str, value):
     """Sets the dotted field ``path`` of ``scenario`` (in place) to ``value``; an optional
-    section the scenario leaves out (``thrust``) is added with its defaults first."""
+    section the scenario leaves out (``thrust``) is added with its defaults first. A path
+    through no field raises `InputError`."""
     *parents, last = path.split(".")
     node = scenario
-    for p in parents:
+    for k, p in enumerate(parents + [last]):
+        if not _has_field(node, p):
+            raise InputError(path, value, "the dotted path of a scenario field",
+                             f"no field '{p}' in {type(node).__name__}")
+        if k == len(parents):
+            break
         child = getattr(node, p)
         if child is None:
             kind = _present(typing.get_type_hints(type(node))[p])
