@@ -224,25 +224,34 @@ def _present(schema):
     return schema
 
 
-def _has_field(node, name: str) -> bool:
-    """Whether ``name`` is a field of the scenario node (a dataclass would take any name)."""
-    if dataclasses.is_dataclass(node):
-        return name in {f.name for f in dataclasses.fields(node)}
-    return not name.startswith("_") and hasattr(node, name)     # a Drake config struct
+def _field_names(kind) -> set:
+    """The field names of a scenario section's type: a dataclass, or a Drake config struct
+    (its ``__fields__``); none for a value's type."""
+    if dataclasses.is_dataclass(kind):
+        return {f.name for f in dataclasses.fields(kind)}
+    return {f.name for f in getattr(kind, "__fields__", ())}
+
+
+def _check_path(path: str, value) -> None:
+    """Raises `InputError` unless ``path`` runs through fields of the scenario's schema (by
+    the types, so that an optional section the scenario leaves out is checked too)."""
+    kind = Scenario
+    for p in path.split("."):
+        if p not in _field_names(kind):
+            raise InputError(path, value, "the dotted path of a scenario field",
+                             f"no field '{p}' in {getattr(kind, '__name__', kind)}")
+        kind = (_present(typing.get_type_hints(kind)[p]) if dataclasses.is_dataclass(kind)
+                else None)                  # a Drake struct's fields are values here
 
 
 def set_field(scenario: Scenario, path: str, value):
     """Sets the dotted field ``path`` of ``scenario`` (in place) to ``value``; an optional
     section the scenario leaves out (``thrust``) is added with its defaults first. A path
-    through no field raises `InputError`."""
+    through no field raises `InputError` and leaves the scenario as it was."""
+    _check_path(path, value)
     *parents, last = path.split(".")
     node = scenario
-    for k, p in enumerate(parents + [last]):
-        if not _has_field(node, p):
-            raise InputError(path, value, "the dotted path of a scenario field",
-                             f"no field '{p}' in {type(node).__name__}")
-        if k == len(parents):
-            break
+    for p in parents:
         child = getattr(node, p)
         if child is None:
             kind = _present(typing.get_type_hints(type(node))[p])

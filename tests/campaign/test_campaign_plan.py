@@ -155,14 +155,20 @@ def test_the_diagram_key_holds_what_the_diagram_reads():
 
 def test_a_field_path_through_no_field_is_refused_by_name():
     """`set_field` names a path that no scenario field holds instead of adding an attribute
-    to a section (a dataclass takes any name), in a section and in Drake's SimulatorConfig."""
+    to a section (a dataclass takes any name): in a section, in an optional section the
+    scenario leaves out (left out still), in Drake's SimulatorConfig and below a value."""
     from drake_dock.campaign.plan import set_field
     from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
     from drake_dock.errors import InputError
     s = load_scenario(PAPER_EXAMPLE)
-    for path in ("simulation.max_step_size", "simulator_config.max_step", "initial.tilt"):
-        with pytest.raises(InputError, match=path.split(".")[-1]):
+    assert s.thrust is None
+    for path, bad in (("simulation.max_step_size", "max_step_size"),
+                      ("simulator_config.max_step", "max_step"), ("initial.tilt", "tilt"),
+                      ("thrust.forse", "forse"), ("contact.mu.real", "real"),
+                      ("simulator_config.max_step_size.real", "real")):
+        with pytest.raises(InputError, match=f"no field '{bad}'"):
             set_field(s, path, 0.01)
     assert s == load_scenario(PAPER_EXAMPLE)
     set_field(s, "simulator_config.max_step_size", 0.01)
-    assert s.simulator_config.max_step_size == 0.01
+    set_field(s, "thrust.force", 250.0)
+    assert s.simulator_config.max_step_size == 0.01 and s.thrust.force == 250.0
