@@ -81,7 +81,7 @@ from drake_dock.systems.profiling import Timing
 from drake_dock.systems.reseek import reseek_far
 from drake_dock.systems.transitions import Transitions
 from drake_dock.systems.witness_source import WitnessPredictions
-from drake_dock.systems.witnesses import FAR_WITNESS
+from drake_dock.systems.witnesses import FAR_WITNESS, WitnessFunctions
 
 __all__ = ["COUPLE_FIELDS", "COUPLE_OUTPUT_SIZE", "COUPLE_SLICES", "FAR_WITNESS", "ContactLaw",
            "ContactModes", "ContactOptions", "ContactPair", "DriftError", "Handover", "Mode",
@@ -112,7 +112,7 @@ def check_pairs(plant, pairs, energy_scale):
                              "None or +1 (a point-curve couple's n is along d = p - c(s))")
 
 
-class RigidContactSystem(WitnessPredictions, LeafSystem):
+class RigidContactSystem(WitnessFunctions, WitnessPredictions, LeafSystem):
     """See the module docstring. ``plant`` is a finalized continuous-time MultibodyPlant of free
     bodies (it need not be part of the diagram; `drake_dock.systems.engine` says what it may
     hold); ``pairs`` the declared `ContactPair`s; ``wrench_bodies`` names bodies that get an
@@ -186,6 +186,7 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
             lambda context, state: self._on_event(context, None, state))
         if options.reseek_early > 0:
             self.DeclarePerStepUnrestrictedUpdateEvent(self._on_step)
+        self._rest = {}                 # held armed witnesses -> their joint rest (`_rest_witness`)
         self._w, self._w_far, self._w_joint = witnesses.declare(
             self, pairs, self._witness_value, self._far_value, self._joint_value,
             UnrestrictedUpdateEvent(self._on_event))
@@ -310,40 +311,6 @@ class RigidContactSystem(WitnessPredictions, LeafSystem):
     def couple_table_of(self, E) -> np.ndarray:
         """`couple_table` of the evaluation E."""
         return E.couple_table
-
-    # ------------------------------------------------------------------ witnesses
-    def DoGetWitnessFunctions(self, context):
-        """The armed witnesses, or the one joint witness where they are all positive
-        (`witnesses`: Drake asks after every event, at the state it left)."""
-        armed = self._armed(context)
-        if armed and self.options.joint_witness and self._joint_value(context) > 0.0:
-            return [self._w_joint]
-        return [self._w_far if i is None else self._w[i][kind] for i, kind in armed]
-
-    def _armed(self, context) -> list:
-        """`witnesses.armed` for the context's modes, kept on their index when sealed."""
-        return self._armed_list(self.get_modes(context))
-
-    def _armed_list(self, modes) -> list:
-        derived = modes.index().derived
-        hit = derived.get("armed")
-        if hit is None:
-            hit = derived["armed"] = witnesses.armed(modes.pairs, self.links.of_edge,
-                                                     self.side_pairs)
-        return hit
-
-    def _witness_value(self, context, i, code):
-        """The value of pair i's witness of kind ``code`` (`engine.W_GAP` ...), computed by
-        the evaluation (Drake evaluates every witness at both ends of every step)."""
-        return self._cache.Eval(context).witness_table[i][code]
-
-    def _joint_value(self, context):
-        """The least value of the armed witnesses (`witnesses.JOINT_WITNESS`)."""
-        E = self._cache.Eval(context)
-        return E.least_witness(self._armed_modes(E.modes))
-
-    def _far_value(self, context):
-        return self._cache.Eval(context).far_witness
 
     # ------------------------------------------------------------------ events
     def _on_step(self, context, state):

@@ -93,8 +93,9 @@ class ContactOptions:
                                      # compiled; False: scipy's DOP853, the reference;
                                      # docs/performance.md, "The compiled LZB")
     joint_witness: bool = True       # Drake is given one witness, the least of the armed
-                                     # ones, where all are positive after an event (False:
-                                     # one witness function per transition; `witnesses`)
+                                     # ones positive after an event, beside each of the others
+                                     # (False: one witness function per transition;
+                                     # `witnesses`)
     broad_phase: bool | None = None  # a far pair whose covers are at least track_distance
                                      # apart is not sought (`Transitions.screen`). None: the
                                      # scene's policy (`docking.diagram.contact_options`: on

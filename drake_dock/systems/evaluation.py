@@ -116,16 +116,24 @@ class Evaluation:
         rows = self.wv.tolist()
         return [None if j < 0 else rows[j] for j in self.slot.tolist()]
 
-    def least_witness(self, armed) -> float:
+    def least_witness(self, armed, rest=None) -> float:
         """The least value of the `ArmedWitnesses` ``armed`` of this evaluation's modes (the far
-        pairs' witness among them when armed; inf for none), computed once."""
-        least = self.__dict__.get("_least")
+        pairs' witness among them when armed; inf for none), computed once; with ``rest``
+        (places in ``armed.flat_list``, whether the far pairs' witness counts), of those only."""
+        key = "_least" if rest is None else ("_least", id(rest))
+        least = self.__dict__.get(key)
         if least is None:
             values = self._section(WITNESS).tolist()
-            least = min((values[j] for j in armed.flat_list), default=math.inf)
-            if armed.far:
+            flat = armed.flat_list
+            if rest is None:
+                least = min((values[j] for j in flat), default=math.inf)
+                far = armed.far
+            else:
+                least = min((values[flat[j]] for j in rest[0]), default=math.inf)
+                far = rest[1]
+            if far:
                 least = min(least, self.far_witness)
-            self._least = least
+            self.__dict__[key] = least
         return least
 
     @property

@@ -36,13 +36,16 @@ transition due at once: Drake is therefore given one witness, the least value of
 ones (`JOINT_WITNESS`), wherever they are all positive just after an event (when Drake asks
 which witnesses are active). It triggers where the first of them reaches zero, as that one
 would, and Drake calls one function at both ends of a step instead of one per transition.
-Where an armed witness is not positive after an event (a transition left at its zero), the
-witnesses are given one by one, so that it does not hold back the others
-(`ContactOptions.joint_witness` False gives them one by one throughout).
+Where some armed witnesses are not positive after an event (a transition left at its zero, a
+hand-over guard below zero whose hand-over is not made), each of those is given on its own and
+the others are given as one, the least of them (`declare_rest`), so that a held one does not
+hold back the others: a witness positive at the event is positive at every step's start until
+it triggers, so their least triggers in the same steps and at the same bisection points as the
+first of them would (`ContactOptions.joint_witness` False gives them one by one throughout).
 """
 from __future__ import annotations
 
-from pydrake.systems.framework import WitnessFunctionDirection
+from pydrake.systems.framework import UnrestrictedUpdateEvent, WitnessFunctionDirection
 
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import model as K
@@ -81,6 +84,13 @@ def declare(system, pairs, value_at, far_value, joint_value, event):
     return per_pair, far, joint
 
 
+def declare_rest(system, held, value, event):
+    """The joint witness of the armed witnesses but ``held`` ((pair or None, kind), the ones
+    not positive where it is given; module docstring), ``value(context)`` its value."""
+    return system.MakeWitnessFunction(f"{JOINT_WITNESS} but {len(held)}", DIRECTION, value,
+                                      event)
+
+
 def armed(states, edge_pairs=(), side_pairs=()) -> list:
     """(pair index or None, kind) of every witness armed for the pairs' `PairState`s: the far
     pairs' clearance when a pair is far, then each pair's witnesses of its mode, the
@@ -94,3 +104,87 @@ def armed(states, edge_pairs=(), side_pairs=()) -> list:
         if st.mode != Mode.FAR and i in side_pairs:
             out.append((i, "side"))
     return out
+
+
+class WitnessFunctions:
+    """The witness functions a `RigidContactSystem` gives Drake (`DoGetWitnessFunctions`) and
+    their values, read from the context's evaluation (module docstring)."""
+
+    def DoGetWitnessFunctions(self, context):
+        """The armed witnesses, or the one joint witness of those positive here beside each
+        of the others (module docstring: Drake asks after every event, at the state it left)."""
+        armed = self._armed(context)
+        if not (armed and self.options.joint_witness):
+            return [self._individual(w) for w in armed]
+        if self._joint_value(context) > 0.0:
+            return [self._w_joint]
+        E = self._cache.Eval(context)
+        values = E.wv.ravel().take(self._armed_modes(E.modes).flat).tolist()
+        if self._far_armed(armed):
+            values.insert(0, E.far_witness)
+        held = tuple(w for w, v in zip(armed, values) if not v > 0.0)
+        if len(held) == len(armed):
+            return [self._individual(w) for w in armed]
+        return [self._rest_witness(held)] + [self._individual(w) for w in held]
+
+    def _individual(self, armed_witness):
+        i, kind = armed_witness
+        return self._w_far if i is None else self._w[i][kind]
+
+    @staticmethod
+    def _far_armed(armed) -> bool:
+        return armed[0][0] is None            # `armed` puts the far pairs' first
+
+    def _rest_witness(self, held):
+        """The joint witness of the armed witnesses but ``held`` (`declare_rest`),
+        one per held set, kept."""
+        w = self._rest.get(held)
+        if w is None:
+            w = self._rest[held] = declare_rest(
+                self, held, lambda c, held=held: self._rest_value(c, held),
+                UnrestrictedUpdateEvent(self._on_event))
+        return w
+
+    def _armed(self, context) -> list:
+        """`armed` for the context's modes, kept on their index when sealed."""
+        return self._armed_list(self.get_modes(context))
+
+    def _armed_list(self, modes) -> list:
+        derived = modes.index().derived
+        hit = derived.get("armed")
+        if hit is None:
+            hit = derived["armed"] = armed(modes.pairs, self.links.of_edge,
+                                                     self.side_pairs)
+        return hit
+
+    def _witness_value(self, context, i, code):
+        """The value of pair i's witness of kind ``code`` (`engine.W_GAP` ...), computed by
+        the evaluation (Drake evaluates every witness at both ends of every step)."""
+        return self._cache.Eval(context).witness_table[i][code]
+
+    def _joint_value(self, context):
+        """The least value of the armed witnesses (`JOINT_WITNESS`)."""
+        E = self._cache.Eval(context)
+        return E.least_witness(self._armed_modes(E.modes))
+
+    def _rest_value(self, context, held):
+        """The least value of the armed witnesses but ``held`` (`_rest_witness`)."""
+        E = self._cache.Eval(context)
+        return E.least_witness(self._armed_modes(E.modes), self._rest_slots(E.modes, held))
+
+    def _rest_slots(self, modes, held):
+        """(the places in `ArmedWitnesses.flat_list` of the armed pair witnesses but
+        ``held``, whether the far pairs' one is among them), kept on the modes' index."""
+        derived = modes.index().derived
+        hit = derived.get(("rest", held))
+        if hit is None:
+            armed = self._armed_list(modes)
+            far = self._far_armed(armed) if armed else False
+            per = armed[1:] if far else armed
+            hit = derived[("rest", held)] = (
+                [j for j, w in enumerate(per) if w not in held],
+                far and armed[0] not in held)
+        return hit
+
+    def _far_value(self, context):
+        return self._cache.Eval(context).far_witness
