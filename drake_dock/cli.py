@@ -37,7 +37,7 @@ import warnings
 from pathlib import Path
 
 from drake_dock import __version__
-from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE
+from drake_dock.docking.scenario.models_dir import MODELS_DIR, PAPER_EXAMPLE
 from drake_dock.errors import MISSING, DrakeDockError, InputError
 
 FUNNEL = MODELS_DIR / "apds_funnel.yaml"
@@ -206,13 +206,15 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def prepare_kernels(stream=None) -> float:
-    """Compiles the numba kernels that their cache lacks (a first run after an install or an
-    update: in parallel, with a line per module on ``stream``, stderr by default) and loads
-    them all (`drake_dock.core.kernels.prepare`), before a run, so that the run's wall time and
-    its progress bar are the simulation's. Returns the seconds it took."""
-    from drake_dock.core.kernels.prepare import prepare
-    return prepare(stream or sys.stderr)
+def start_kernels(stream=None):
+    """Starts compiling the numba kernels that their cache lacks (a first run after an install
+    or an update: in parallel worker processes, with a line per module on ``stream``, stderr by
+    default) while the run imports the simulation and reads its scenario; its ``finish()``
+    loads them all, before the simulation, so that the run's wall time and its progress bar
+    are the simulation's, and returns the seconds the kernels held the run up
+    (`drake_dock.core.kernels.prepare.Preparation`)."""
+    from drake_dock.core.kernels.prepare import Preparation
+    return Preparation.start(stream or sys.stderr)
 
 
 def _need_out(out, what):
@@ -230,6 +232,15 @@ def main(argv=None) -> int:
         return _study(args)
     if args.command == "campaign":
         return _campaign(args)
+    kernels = None if args.print_scenario or args.out is None else start_kernels()
+    try:
+        return _run_command(args, kernels)
+    finally:
+        if kernels is not None:
+            kernels.cancel()            # a run that failed before it needed them
+
+
+def _run_command(args, kernels) -> int:
     # Imported here so that `--help` stays fast.
     from drake_dock.docking.report.out_dir import check_destination
     from drake_dock.docking.scenario.loading import load_scenario
@@ -253,12 +264,12 @@ def main(argv=None) -> int:
         _need_out(args.out, "the run's outputs")
         check_destination(args.out)
         scenario_ = scenario()
-        kernels = prepare_kernels()
+        seconds = kernels.finish()
         t0 = time.perf_counter()
         out = run(scenario_, args.out, progress=bar, full=True, name=Path(args.scenario).stem)
         outputs = time.perf_counter() - t0 - out.cost["wall_time_s"]
         return [format_summary(out.summary, out.cost),
-                f"wall time: kernels {kernels:.1f} s (compiled after an install or an update, "
+                f"wall time: kernels {seconds:.1f} s (compiled after an install or an update, "
                 f"loaded from the cache after), simulation {out.cost['wall_time_s']:.1f} s, "
                 f"outputs {outputs:.1f} s"]
     return _guarded(work, args.out, None if bar is None else bar.close)

@@ -160,6 +160,23 @@ def test_input_errors_lead_with_their_reason(tmp_path):
     assert "NoneType" not in msg and not (tmp_path / "out").exists()
 
 
+def test_a_run_that_fails_on_its_input_stops_the_compile(tmp_path):
+    """With an empty kernel cache a run starts compiling before it reads its scenario; a bad
+    scenario ends the run (exit 2) and its workers with it: no unit is marked compiled then,
+    nor a few seconds later (the first units take about 4 s)."""
+    import os
+    import time
+    empty = tmp_path / "empty.yaml"
+    empty.write_text("# nothing yet\n")
+    cache = tmp_path / "numba"
+    r = _run(["run", str(empty), "--out", str(tmp_path / "out"), "--no-progress"],
+             env=dict(os.environ, NUMBA_CACHE_DIR=str(cache)))
+    assert r.returncode == 2 and "compiling the numba kernels" in r.stderr
+    assert "holds no YAML content" in " ".join(r.stderr.split())
+    time.sleep(6.0)
+    assert not list(cache.rglob("warm.done"))
+
+
 def test_kernels_prepared_with_a_line_per_module_when_they_compile(monkeypatch):
     """The kernels are compiled (or loaded) before the run; when their cache lacks some (a
     first run after an install) a note and a line per module say so, and nothing otherwise."""
@@ -169,15 +186,16 @@ def test_kernels_prepared_with_a_line_per_module_when_they_compile(monkeypatch):
     from drake_dock.core.kernels import prepare
     monkeypatch.setattr(prepare, "warm", lambda names=None, stream=None: None)
     monkeypatch.setattr(prepare, "compile_parallel",
-                        lambda names, jobs, stream: [stream.write(f"  {n}: 1.0 s\n")
-                                                     for n in names])
+                        lambda names, jobs, stream, *rest: [stream.write(f"  {n}: 1.0 s\n")
+                                                            for n in names])
     monkeypatch.setattr(prepare, "cores", lambda: 2)
+    monkeypatch.setattr(prepare, "_workers", lambda jobs: [])
     monkeypatch.setattr(prepare, "missing", lambda names=None: ["lzb", "seek"])
     cold = io.StringIO()
-    cli.prepare_kernels(cold)
+    cli.start_kernels(cold).finish()
     assert "compiling the numba kernels, 2 modules in 2 processes" in cold.getvalue()
     assert "  lzb: 1.0 s\n  seek: 1.0 s\n" in cold.getvalue()
     monkeypatch.setattr(prepare, "missing", lambda names=None: [])
     warm = io.StringIO()
-    cli.prepare_kernels(warm)
+    cli.start_kernels(warm).finish()
     assert warm.getvalue() == ""

@@ -130,13 +130,33 @@ def test_the_parallel_compile_caches_its_units_and_another_process_loads_them(tm
         assert prepare.missing({SUBSET}) == {SUBSET}
         prepare.prepare(sys.stdout, jobs=2, names={SUBSET})
         assert prepare.missing({SUBSET}) == []
-    """), tmp_path).stdout
+    """) + textwrap.dedent(STATS), tmp_path).stdout
     assert f"compiling the numba kernels, {len(SUBSET)} modules in 2 processes" in out
     assert all(f"  {u}: " in out for u in SUBSET)
+    hits, misses = map(int, out.split()[-2:])    # this process loaded each as it was done
+    assert hits > 0 and misses == 0
     out = _python(f"from drake_dock.core.kernels import prepare\nprepare.warm({SUBSET})\n"
                   + textwrap.dedent(STATS), tmp_path).stdout
     hits, misses = map(int, out.split()[-2:])
     assert hits > 0 and misses == 0
+
+
+def test_a_cancelled_preparation_stops_its_workers_and_marks_nothing(tmp_path):
+    """`Preparation.cancel` (a run that fails on its input while the kernels compile) kills
+    the workers at once: the units they were compiling stay missing."""
+    out = _python("""
+        import time
+        from drake_dock.core.kernels import prepare
+        names = ["engine", "seek"]                   # each takes more than 10 s
+        p = prepare.Preparation.start(None, 2, names)
+        time.sleep(1.0)
+        workers = list(p._workers)
+        t0 = time.perf_counter()
+        p.cancel()
+        print(len(workers), all(w.poll() is not None for w in workers),
+              time.perf_counter() - t0 < 5.0, *sorted(prepare.missing(names)))
+    """, tmp_path).stdout
+    assert out.split() == ["2", "True", "True", "engine", "seek"]
 
 
 def test_every_kernel_is_compiled_by_some_warm():

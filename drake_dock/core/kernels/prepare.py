@@ -14,9 +14,15 @@ Order (`schedule`): each kernel module is owned by the unit with the fewest kern
 holds it, and a unit starts after the owners of the modules it holds (`engine` after `solve`,
 which owns the constraint solve that `constraints` calls too): common callees are then compiled
 once, by their owner, and loaded by the others, and two units that share only an owner's
-modules compile side by side. Among the units free to
-start, the one heading the longest chain of waiting units goes first, a unit's length being the
-kernel source lines it compiles itself (a rough measure of its compile time).
+modules compile side by side. Among the units free to start, the one heading the longest chain
+of waiting units goes first, a unit's length being the kernel source lines of every module it
+holds (a rough measure of its compile time: numba links a callee's code into each caller's
+and optimises the whole, so a unit's compile grows with what it calls, compiled or loaded).
+
+`Preparation` splits `prepare` in two around the caller's own start-up: `Preparation.start` sets
+the missing units compiling in the workers (a thread here feeds them), `Preparation.finish`
+loads each unit here as soon as it is compiled (while the others compile), then the rest.
+``drake-dock run`` starts it before it imports the simulation and reads its scenario.
 """
 from __future__ import annotations
 
@@ -24,9 +30,11 @@ import ast
 import contextlib
 import importlib
 import os
+import queue
 import select
 import subprocess
 import sys
+import threading
 import time
 
 from drake_dock.core.kernels import compile_cache as cc
@@ -70,12 +78,11 @@ def schedule(names: list[str], package=cc._PACKAGE):
     after = {a: {owner[d] for d in deps[a]} - {a} for a in names}
     here = package / "core" / "kernels"
 
-    def own(n):     # the kernel source lines that unit n compiles itself
-        mine = deps[n] - set().union(*(deps[b] for b in after[n]))
-        return sum((here / f"{m}.py").read_bytes().count(b"\n") for m in mine)
+    def length(n):  # the kernel source lines of the modules unit n holds
+        return sum((here / f"{m}.py").read_bytes().count(b"\n") for m in deps[n])
 
-    def path(n):    # its own lines and those of the longest chain of units waiting for it
-        return own(n) + max((path(a) for a in names if n in after[a]), default=0)
+    def path(n):    # its length and that of the longest chain of units waiting for it
+        return length(n) + max((path(a) for a in names if n in after[a]), default=0)
     return sorted(names, key=lambda n: (-path(n), n)), after
 
 
@@ -136,12 +143,16 @@ def serve(lines, out) -> None:
         out.flush()
 
 
-def compile_parallel(names: list[str], jobs: int, stream=None) -> None:
+def compile_parallel(names: list[str], jobs: int, stream=None, compiled=None,
+                     workers: list | None = None) -> None:
     """Compiles the units ``names`` in ``jobs`` worker processes, in `schedule` order, with a
-    line per unit on ``stream`` as each one finishes. A failed unit raises RuntimeError (the
-    worker's traceback is on stderr); the workers end with this call."""
+    line per unit on ``stream`` as each one finishes, and ``compiled(name)`` called then if
+    given. A failed unit raises RuntimeError (the worker's traceback is on stderr); the workers
+    (``workers`` if given, else `_workers` started here) end with this call (killing one ends
+    it with that RuntimeError)."""
     order, after = schedule(names)
-    idle, busy, done, t0 = _workers(jobs), {}, set(), time.perf_counter()
+    idle = list(workers) if workers is not None else _workers(jobs)
+    busy, done, t0 = {}, set(), time.perf_counter()
     try:
         while order or busy:
             for name in [n for n in order if not after[n] - done][:len(idle)]:
@@ -161,6 +172,8 @@ def compile_parallel(names: list[str], jobs: int, stream=None) -> None:
                 done.add(name)
                 _say(stream, f"  {name}: {float(answer[1]):.1f} s ({len(done)} of "
                              f"{len(names)}, {time.perf_counter() - t0:.0f} s so far)")
+                if compiled is not None:
+                    compiled(name)
     finally:
         for proc in idle + list(busy):
             with contextlib.suppress(OSError):
@@ -168,6 +181,7 @@ def compile_parallel(names: list[str], jobs: int, stream=None) -> None:
             if proc in busy:
                 proc.kill()
             proc.wait()
+            proc.stdout.close()
 
 
 def cores() -> int:
@@ -182,19 +196,77 @@ def prepare(stream=None, jobs: int | None = None, names: list[str] | None = None
     """Compiles the missing units of ``names`` (default all) in up to ``jobs`` processes
     (default `cores`; in this process when one, or one unit, is missing), saying so on
     ``stream`` with a line per unit, then loads every unit here. Returns the seconds taken."""
-    t0 = time.perf_counter()
-    todo = missing(names)
-    if todo:
-        jobs = max(1, min(jobs or cores(), len(todo)))
-        _say(stream, f"drake-dock: compiling the numba kernels, {len(todo)} module"
-                     f"{'s' if len(todo) > 1 else ''} in {jobs} process"
-                     f"{'es' if jobs > 1 else ''} (after an install or an update only; later "
-                     f"runs load them from the cache)")
-        if jobs > 1:
-            compile_parallel(todo, jobs, stream)
-        else:
-            warm(todo, stream)
-    warm(names)
-    if todo:
-        _say(stream, f"drake-dock: kernels compiled in {time.perf_counter() - t0:.0f} s")
-    return time.perf_counter() - t0
+    return Preparation.start(stream, jobs, names).finish()
+
+
+class Preparation:
+    """`prepare` begun (`start`) and ended (`finish`) apart, so that the caller's own start-up
+    runs while the workers compile (module docstring); `cancel` stops them."""
+
+    def __init__(self, stream, jobs, names):
+        self.stream, self.names, self.t0 = stream, names, time.perf_counter()
+        self.todo = missing(names)
+        self.jobs = max(1, min(jobs or cores(), len(self.todo))) if self.todo else 0
+        self._compiled = queue.Queue()       # units compiled by the workers, then None
+        self._failure = None
+        self._workers = []
+        self._thread = None
+        self._waited = 0.0                   # s the caller spent in `start`
+
+    @classmethod
+    def start(cls, stream=None, jobs: int | None = None,
+              names: list[str] | None = None) -> "Preparation":
+        """Says what compiles (on ``stream``) and starts the workers on the missing units of
+        ``names`` (default all) when more than one process compiles them."""
+        self = cls(stream, jobs, names)
+        t0 = self.t0
+        if self.todo:
+            n, j = len(self.todo), self.jobs
+            _say(stream, f"drake-dock: compiling the numba kernels, {n} module"
+                         f"{'s' if n > 1 else ''} in {j} process{'es' if j > 1 else ''} "
+                         f"(after an install or an update only; later runs load them from "
+                         f"the cache)")
+        if self.jobs > 1:
+            self._workers = _workers(self.jobs)
+            self._thread = threading.Thread(target=self._compile, daemon=True,
+                                            name="drake-dock kernels")
+            self._thread.start()
+        self._waited = time.perf_counter() - t0
+        return self
+
+    def _compile(self):
+        try:
+            compile_parallel(self.todo, self.jobs, self.stream, self._compiled.put,
+                             self._workers)
+        except BaseException as e:  # noqa: BLE001 - re-raised by `finish`
+            self._failure = e
+        finally:
+            self._compiled.put(None)
+
+    def finish(self) -> float:
+        """Loads every unit here (each compiled one as soon as a worker is done with it, one
+        process compiling: all here, a line per unit) and returns the seconds the caller
+        spent in `start` and here (what the kernels held it up); a unit that failed to
+        compile raises RuntimeError."""
+        t0 = time.perf_counter()
+        if self._thread is not None:
+            for name in iter(self._compiled.get, None):
+                importlib.import_module(f"{cc.PACKAGE}.{name}").warm()
+            self._thread.join()
+            if self._failure is not None:
+                raise self._failure
+        elif self.todo:
+            warm(self.todo, self.stream)
+        warm(self.names)
+        if self.todo:
+            _say(self.stream, f"drake-dock: kernels compiled in "
+                              f"{time.perf_counter() - self.t0:.0f} s")
+        return self._waited + time.perf_counter() - t0
+
+    def cancel(self) -> None:
+        """Stops the workers (their units left unmarked compile again next time)."""
+        for proc in list(self._workers):
+            with contextlib.suppress(OSError):
+                proc.kill()
+        if self._thread is not None:
+            self._thread.join()

@@ -14,12 +14,10 @@ from pathlib import Path
 import yaml
 from pydrake.common.yaml import yaml_load_typed
 
+from drake_dock.docking.scenario.models_dir import MODELS_DIR, PAPER_EXAMPLE  # noqa: F401
 from drake_dock.docking.scenario.schema import Scenario
 from drake_dock.docking.scenario.validation import validate
 from drake_dock.errors import InputError
-
-MODELS_DIR = Path(__file__).resolve().parents[2] / "models"   # package data; ./models links here
-PAPER_EXAMPLE = MODELS_DIR / "paper_example.yaml"
 
 
 # Raw checks ------------------------------------------------------------------------------------
