@@ -23,7 +23,7 @@ import yaml
 
 from drake_dock.campaign.campaign import run_campaign
 from drake_dock.campaign.progress import CampaignProgress, duration_text
-from drake_dock.docking.scenario.loading import MODELS_DIR
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 
 PLAN = MODELS_DIR / "idss_envelope.yaml"
 

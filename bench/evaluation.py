@@ -23,7 +23,8 @@ from drake_dock.core.kernels.prepare import warm
 from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import PlacementCache, place
-from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import MODELS_DIR, PAPER_EXAMPLE
 from drake_dock.systems.contact_system import RigidContactSystem
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))

@@ -141,7 +141,8 @@ def paper_example_impacts():
     from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
     from drake_dock.docking.model.simulate import simulate
     from drake_dock.docking.placement.place import place
-    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario.loading import load_scenario
+    from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
     from drake_dock.systems import transitions
     scenario = load_scenario(PAPER_EXAMPLE)
     state = place(scenario)

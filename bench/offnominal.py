@@ -20,7 +20,8 @@ import numpy as np
 from drake_dock.core.kernels.prepare import warm
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import place
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.errors import DrakeDockError
 from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
 

@@ -24,7 +24,8 @@ from drake_dock.docking.geometry import pairs as pair_sets
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import place
 from drake_dock.docking.report.cost import cost_by_pair_type
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
 
 LEFT_OUT = ("petal corner / guide surface", "tip arc / tip arc", "petal corner / tip land")

@@ -38,7 +38,8 @@ from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import PlacementCache, contact_approach, place
 from drake_dock.docking.placement.search import first_contact
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from floors import empty_leaf_cost, free_flight  # noqa: E402  (a sibling bench module)

@@ -23,7 +23,8 @@ from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.placement import aim, path_check, search
 from drake_dock.docking.placement.place import PlacementCache, contact_approach, place
 from drake_dock.docking.placement.search import first_contact
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.studies.conditions import ConditionsPlan, conditions, with_condition
 
 

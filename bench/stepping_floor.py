@@ -43,7 +43,7 @@ from drake_dock.core.kernels.prepare import warm
 from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import PlacementCache, place
-from drake_dock.docking.scenario.loading import MODELS_DIR
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 from drake_dock.systems.evaluation import SCALARS, XDOT
 
 PLAN = MODELS_DIR / "idss_envelope.yaml"

@@ -26,7 +26,8 @@ import numpy as np
 
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import place
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.studies.compliant import (CompliantConfig, hunt_crossley_dissipation,
                                           run_compliant)
 from drake_dock.studies.docking_metrics import (METRICS, compliant_metrics, contact_effect,

@@ -42,7 +42,7 @@ def docking(name, path, pairs):
 
 def main(argv=None):
     import argparse
-    from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE
+    from drake_dock.docking.scenario.models_dir import MODELS_DIR, PAPER_EXAMPLE
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--quick", action="store_true", help="the paper example only")
     args = ap.parse_args(argv)

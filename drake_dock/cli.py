@@ -232,7 +232,12 @@ def main(argv=None) -> int:
         return _study(args)
     if args.command == "campaign":
         return _campaign(args)
-    kernels = None if args.print_scenario or args.out is None else start_kernels()
+    kernels = None
+    if not args.print_scenario and args.out is not None:
+        try:
+            kernels = start_kernels()
+        except Exception:  # noqa: BLE001 - started again in the run, which reports the error
+            kernels = None
     try:
         return _run_command(args, kernels)
     finally:
@@ -264,7 +269,7 @@ def _run_command(args, kernels) -> int:
         _need_out(args.out, "the run's outputs")
         check_destination(args.out)
         scenario_ = scenario()
-        seconds = kernels.finish()
+        seconds = (kernels or start_kernels()).finish()
         t0 = time.perf_counter()
         out = run(scenario_, args.out, progress=bar, full=True, name=Path(args.scenario).stem)
         outputs = time.perf_counter() - t0 - out.cost["wall_time_s"]

@@ -22,7 +22,8 @@ def box_corner(tmp_path_factory):
     """The off-axis corner of the IDSS box (`models/idss_box_corner.yaml`), its first
     BOX_CORNER_SECONDS run once for the session with `drake_dock.run.run`: (the full namespace,
     the output directory)."""
-    from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
+    from drake_dock.docking.scenario.loading import load_scenario
+    from drake_dock.docking.scenario.models_dir import MODELS_DIR
     from drake_dock.run import run
     scenario = load_scenario(MODELS_DIR / "idss_box_corner.yaml")
     scenario.simulation.duration = BOX_CORNER_SECONDS

@@ -20,7 +20,8 @@ from hypothesis import strategies as st
 
 from drake_dock.cli import main
 from drake_dock.docking.report.out_dir import MARKER
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.errors import InputError
 
 PAPER = yaml.safe_load(PAPER_EXAMPLE.read_text())

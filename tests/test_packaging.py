@@ -9,7 +9,8 @@ from pathlib import Path
 import yaml
 
 import drake_dock
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 
 ROOT = Path(__file__).resolve().parent.parent
 

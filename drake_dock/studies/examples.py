@@ -15,7 +15,8 @@ import dataclasses
 import json
 
 from drake_dock.docking.report.out_dir import atomic_directory
-from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 from drake_dock.studies.conditions import FIELDS, IDSS_BOX, counts, rows_csv, run_each
 
 assert FIELDS[-1] == "wall_time_s"

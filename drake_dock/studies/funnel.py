@@ -277,7 +277,8 @@ def main(argv=None) -> int:
     """``python -m drake_dock.studies.funnel --shipped DIR``: the shipped plan
     (`FunnelPlan.shipped`) on models/apds_funnel.yaml, written into DIR."""
     import argparse
-    from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
+    from drake_dock.docking.scenario.loading import load_scenario
+    from drake_dock.docking.scenario.models_dir import MODELS_DIR
     parser = argparse.ArgumentParser(prog="python -m drake_dock.studies.funnel")
     parser.add_argument("--shipped", metavar="DIR", required=True,
                         help="run the shipped plan and write its files into DIR")

@@ -28,7 +28,8 @@ from pathlib import Path
 
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import place
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.errors import DrakeDockError
 from drake_dock.studies.compliant import (CompliantConfig, build_compliant_diagram,
                                           hunt_crossley_dissipation, run_compliant)

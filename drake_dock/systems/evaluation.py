@@ -120,7 +120,7 @@ class Evaluation:
         """The least value of the `ArmedWitnesses` ``armed`` of this evaluation's modes (the far
         pairs' witness among them when armed; inf for none), computed once; with ``rest``
         (places in ``armed.flat_list``, whether the far pairs' witness counts), of those only."""
-        key = "_least" if rest is None else ("_least", id(rest))
+        key = "_least" if rest is None else ("_least", rest)
         least = self.__dict__.get(key)
         if least is None:
             values = self._section(WITNESS).tolist()

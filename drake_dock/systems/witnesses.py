@@ -153,8 +153,7 @@ class WitnessFunctions:
         derived = modes.index().derived
         hit = derived.get("armed")
         if hit is None:
-            hit = derived["armed"] = armed(modes.pairs, self.links.of_edge,
-                                                     self.side_pairs)
+            hit = derived["armed"] = armed(modes.pairs, self.links.of_edge, self.side_pairs)
         return hit
 
     def _witness_value(self, context, i, code):
@@ -182,7 +181,7 @@ class WitnessFunctions:
             far = self._far_armed(armed) if armed else False
             per = armed[1:] if far else armed
             hit = derived[("rest", held)] = (
-                [j for j, w in enumerate(per) if w not in held],
+                tuple(j for j, w in enumerate(per) if w not in held),
                 far and armed[0] not in held)
         return hit
 

@@ -29,7 +29,7 @@ vary:
     (("normal: [5.0, 0.5]", "lognormal: [5.0, 0.5]"), "vary.initial.target_yaw_deg"),
 ])
 def test_a_bad_plan_exits_2_naming_the_field(tmp_path, capsys, change, field):
-    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE
+    from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE).replace(*change))
     out = tmp_path / "out"
@@ -41,7 +41,8 @@ def test_a_bad_plan_exits_2_naming_the_field(tmp_path, capsys, change, field):
 
 def test_the_good_plan_and_the_shipped_idss_plan_load(tmp_path):
     from drake_dock.campaign.plan import load_plan
-    from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario.loading import load_scenario
+    from drake_dock.docking.scenario.models_dir import MODELS_DIR, PAPER_EXAMPLE
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE))
     assert [f.path for f in load_plan(plan)[2]] == ["initial.lateral_offset",
@@ -71,7 +72,7 @@ def test_a_bad_set_is_named_before_anything_runs(tmp_path, set_, field, named):
     """A plan's `set` writes values into the base scenario: a path that is not a scenario
     field, or a value the scenario refuses, is an InputError naming `set` and the field."""
     from drake_dock.campaign.plan import load_plan
-    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE
+    from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
     from drake_dock.errors import InputError
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE) + f"set: {set_}\n")
@@ -82,7 +83,7 @@ def test_a_bad_set_is_named_before_anything_runs(tmp_path, set_, field, named):
 
 def test_set_values_reach_every_sample(tmp_path):
     from drake_dock.campaign.plan import load_plan
-    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE
+    from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE)
                     + "set: {contact.mu: 0.05, simulation.capture_tilt_deg: null}\n")
@@ -106,7 +107,7 @@ def test_edges_sampler_follows_the_arcsine_law_and_sobol_points_keep_their_index
 @pytest.mark.parametrize("extra, field", [(["--workers", "0"], "--workers"),
                                           (["--resume"], "--resume")])
 def test_bad_options_exit_2_naming_them(tmp_path, capsys, extra, field):
-    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE
+    from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE))
     out = tmp_path / "out"
@@ -119,7 +120,8 @@ def test_a_plan_varies_the_thrust_of_a_base_without_one(tmp_path):
     """A plan may vary the keys of the optional `thrust` section on a base scenario that has
     none: the section is added with its defaults, then the sampled key is set."""
     from drake_dock.campaign.plan import load_plan, set_field
-    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario.loading import load_scenario
+    from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
     plan = tmp_path / "plan.yaml"
     plan.write_text(GOOD.format(scenario=PAPER_EXAMPLE)
                     + "  thrust.force: {uniform: [100.0, 400.0]}\n")
@@ -137,7 +139,8 @@ def test_the_diagram_key_holds_what_the_diagram_reads():
     walks every field)."""
     from drake_dock.campaign.plan import set_field
     from drake_dock.docking.model.diagram import DiagramSpec
-    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario.loading import load_scenario
+    from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
     base = DiagramSpec.of(load_scenario(PAPER_EXAMPLE))
     for path, value in (("simulation.capture_lateral", 0.02),
                         ("simulation.capture_tilt_deg", 1.0),
@@ -158,7 +161,8 @@ def test_a_field_path_through_no_field_is_refused_by_name():
     to a section (a dataclass takes any name): in a section, in an optional section the
     scenario leaves out (left out still), in Drake's SimulatorConfig and below a value."""
     from drake_dock.campaign.plan import set_field
-    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario.loading import load_scenario
+    from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
     from drake_dock.errors import InputError
     s = load_scenario(PAPER_EXAMPLE)
     assert s.thrust is None

@@ -133,7 +133,7 @@ def test_the_parallel_compile_caches_its_units_and_another_process_loads_them(tm
     """) + textwrap.dedent(STATS), tmp_path).stdout
     assert f"compiling the numba kernels, {len(SUBSET)} modules in 2 processes" in out
     assert all(f"  {u}: " in out for u in SUBSET)
-    hits, misses = map(int, out.split()[-2:])    # this process loaded each as it was done
+    hits, misses = map(int, out.split()[-2:])    # this process loaded them, compiled none
     assert hits > 0 and misses == 0
     out = _python(f"from drake_dock.core.kernels import prepare\nprepare.warm({SUBSET})\n"
                   + textwrap.dedent(STATS), tmp_path).stdout
@@ -147,7 +147,7 @@ def test_a_cancelled_preparation_stops_its_workers_and_marks_nothing(tmp_path):
     out = _python("""
         import time
         from drake_dock.core.kernels import prepare
-        names = ["engine", "seek"]                   # each takes more than 10 s
+        names = ["engine", "seek"]     # seek first (engine waits for it): more than 10 s
         p = prepare.Preparation.start(None, 2, names)
         time.sleep(1.0)
         workers = list(p._workers)

@@ -17,7 +17,8 @@ from drake_dock.cli import main
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import place
 from drake_dock.docking.report.results import summary, timeseries
-from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 
 
 def _run(tmp_path, data: dict, name: str, *extra) -> dict:

@@ -12,7 +12,8 @@ import pytest
 
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import place
-from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 
 CAP = 0.05
 

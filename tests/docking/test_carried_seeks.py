@@ -15,7 +15,7 @@ from drake_dock.core import handover
 from drake_dock.core.hybrid import Mode
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import place
-from drake_dock.docking.scenario.loading import MODELS_DIR
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 
 EDGE, SURFACE, T_END = "cc_Tring_C6", "cs_Tring_C3", 1.45
 

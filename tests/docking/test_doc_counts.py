@@ -10,7 +10,8 @@ import pytest
 from drake_dock.docking.geometry import pairs as P
 from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.scenario.dimensions import ApdsGeometry
-from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -16,7 +16,8 @@ def axisymmetric_scenario():
     chaser, I = (40211, 6402, 40242), is not: see docs/model.md). Only then are the three
     couples' forces equal by symmetry."""
     import yaml
-    from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+    from drake_dock.docking.scenario.loading import load_scenario
+    from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
     data = yaml.safe_load(PAPER_EXAMPLE.read_text())
     data["bodies"]["target"]["inertia"] = [778.0, 778.0, 829.0]
     data["bodies"]["chaser"]["inertia"] = [40226.5, 40226.5, 6402.0]

@@ -10,7 +10,8 @@ from drake_dock.docking.geometry.pairs import CHASER_APDS, TARGET_APDS
 from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.placement.place import contact_approach, place
 from drake_dock.docking.placement.search import pair_couples
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.errors import InputError
 
 OFF_AXIS = dict(lateral_offset=[0.02, -0.01], tilt_deg=[1.0, 0.5], lateral_velocity=[0.01, 0.0],

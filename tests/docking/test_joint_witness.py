@@ -13,7 +13,7 @@ from drake_dock.campaign.sample import sample_scenario
 from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import PlacementCache, place
-from drake_dock.docking.scenario.loading import MODELS_DIR
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 
 SAMPLE, DURATION = 6, 1.0      # its cc_Cring_T6 hand-over guard is below zero from 0.79 s
 

@@ -11,7 +11,7 @@ import yaml
 from drake_dock.cli import main
 from drake_dock.docking.model.outcome import (JAM_DISTANCE, CaptureRule, OutcomeWatch,
                                               misalignment, progress_fraction)
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 
 
 def feed(watch, ts, ds, driven=None, lateral=None):

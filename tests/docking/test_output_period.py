@@ -10,7 +10,8 @@ import pytest
 
 from drake_dock.docking.model.simulate import POST_IMPACT, PRE_IMPACT, STEP, simulate
 from drake_dock.docking.placement.place import place
-from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 
 PERIOD, CAP = 0.002, 0.01
 

@@ -16,7 +16,8 @@ from drake_dock.core.patches import posed
 from drake_dock.docking.checks.penetration import deepest_penetration
 from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.report.headline import headline_table
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 EXE = [sys.executable, "-m", "drake_dock.cli", "run", "--no-progress"]

@@ -11,7 +11,8 @@ import gc
 from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import place
-from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 from drake_dock.systems.contact_types import ModesIndex
 
 

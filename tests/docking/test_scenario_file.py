@@ -10,8 +10,8 @@ import pytest
 import yaml
 
 from drake_dock.cli import main
-from drake_dock.docking.scenario.loading import (MODELS_DIR, load_scenario, scenario_dict,
-                                                 scenario_yaml)
+from drake_dock.docking.scenario.loading import load_scenario, scenario_dict, scenario_yaml
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 from drake_dock.docking.scenario.schema import Scenario, ThrustParams
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "scenario.md"

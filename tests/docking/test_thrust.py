@@ -10,7 +10,8 @@ from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.model.thrust import ThrustSchedule
 from drake_dock.docking.placement.place import place
 from drake_dock.docking.report.results import summary, timeseries
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.docking.scenario.schema import ThrustParams
 from drake_dock.errors import InputError
 

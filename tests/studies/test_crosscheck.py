@@ -15,7 +15,8 @@ from pydrake.systems.analysis import Simulator
 
 from drake_dock.docking.model.plant import set_initial_state
 from drake_dock.docking.placement.place import place
-from drake_dock.docking.scenario.loading import MODELS_DIR, PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import MODELS_DIR, PAPER_EXAMPLE
 from drake_dock.docking.scenario.validation import validate
 from drake_dock.errors import InputError
 from drake_dock.studies.compliant import (CompliantConfig, apds_pieces, build_compliant_diagram,

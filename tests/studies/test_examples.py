@@ -8,7 +8,7 @@ import json
 import pytest
 import yaml
 
-from drake_dock.docking.scenario.loading import MODELS_DIR
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 from drake_dock.studies.examples import (EXAMPLE_FIELDS, ExamplesPlan, run_examples,
                                          summary_lines, write_examples)
 

@@ -5,7 +5,8 @@ import math
 
 import pytest
 
-from drake_dock.docking.scenario.loading import MODELS_DIR, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import MODELS_DIR
 from drake_dock.studies.funnel import (FunnelPlan, capture_range, clearance, geometries,
                                        probe)
 

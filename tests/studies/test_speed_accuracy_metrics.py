@@ -11,7 +11,8 @@ from drake_dock.docking.geometry.scene import DockingScene
 from drake_dock.docking.model.simulate import simulate
 from drake_dock.docking.placement.place import place
 from drake_dock.docking.report.results import rigid_chaser_force, timeseries
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.studies.docking_metrics import (METRICS, SceneStart, contact_effect, errors,
                                                 rigid_metrics, sampled_peak, scene_start)
 from drake_dock.studies.work_precision import Point, converged_points, converged_speedups

@@ -8,7 +8,8 @@ import sys
 import numpy as np
 import pytest
 
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.errors import ZenoError
 from drake_dock.studies import stability as S
 from drake_dock.studies.small_scenes import G, painleve_rod, stool

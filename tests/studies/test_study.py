@@ -13,7 +13,8 @@ from scipy.integrate import solve_ivp
 
 from drake_dock.docking.model.plant import set_initial_state
 from drake_dock.docking.placement.place import place
-from drake_dock.docking.scenario.loading import PAPER_EXAMPLE, load_scenario
+from drake_dock.docking.scenario.loading import load_scenario
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.studies.compliant import (CompliantConfig, build_compliant_diagram,
                                           hunt_crossley_dissipation)
 from drake_dock.studies.docking_metrics import METRICS

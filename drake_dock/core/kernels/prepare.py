@@ -3,8 +3,9 @@
 A unit is a module of this package with a top-level ``warm()`` (found in the sources: there is
 no list to keep up to date). Its ``warm()`` compiles or loads the module's kernels, and those of
 the kernel modules it calls, by evaluating them once on a small case with the argument types of
-a run. `warm` runs every unit in this process. `prepare` (``drake-dock run`` and
-``python -m drake_dock.core.kernels``) first compiles the units whose cache is missing (no
+a run. `warm` runs every unit in this process. `prepare` (``python -m drake_dock.core.kernels``;
+``drake-dock run`` takes it in two halves, `Preparation`) first compiles the units whose cache
+is missing (no
 ``warm.done`` in their module's cache directory, `compile_cache.module_cache_dir`, whose key
 covers everything the unit compiles) in up to ``jobs`` worker processes
 (``python -m drake_dock.core.kernels --worker``, each taking one unit after another), a line per
@@ -150,17 +151,21 @@ def compile_parallel(names: list[str], jobs: int, stream=None, compiled=None,
     given. A failed unit raises RuntimeError (the worker's traceback is on stderr); the workers
     (``workers`` if given, else `_workers` started here) end with this call (killing one ends
     it with that RuntimeError)."""
-    order, after = schedule(names)
     idle = list(workers) if workers is not None else _workers(jobs)
     busy, done, t0 = {}, set(), time.perf_counter()
     try:
+        order, after = schedule(names)
         while order or busy:
             for name in [n for n in order if not after[n] - done][:len(idle)]:
                 order.remove(name)
                 proc = idle.pop()
                 busy[proc] = name
-                proc.stdin.write(name + "\n")
-                proc.stdin.flush()
+                try:
+                    proc.stdin.write(name + "\n")
+                    proc.stdin.flush()
+                except OSError:             # the worker is gone (killed)
+                    raise RuntimeError(f"compiling the kernels of {cc.PACKAGE}.{name} "
+                                       f"failed: its worker process ended") from None
             ready, _, _ = select.select([p.stdout for p in busy], [], [])
             for proc in [p for p in busy if p.stdout in ready]:
                 answer = proc.stdout.readline().split()
@@ -196,7 +201,12 @@ def prepare(stream=None, jobs: int | None = None, names: list[str] | None = None
     """Compiles the missing units of ``names`` (default all) in up to ``jobs`` processes
     (default `cores`; in this process when one, or one unit, is missing), saying so on
     ``stream`` with a line per unit, then loads every unit here. Returns the seconds taken."""
-    return Preparation.start(stream, jobs, names).finish()
+    preparation = Preparation.start(stream, jobs, names)
+    try:
+        return preparation.finish()
+    except BaseException:
+        preparation.cancel()                # no worker outlives a failure or Ctrl-C
+        raise
 
 
 class Preparation:
@@ -264,9 +274,15 @@ class Preparation:
         return self._waited + time.perf_counter() - t0
 
     def cancel(self) -> None:
-        """Stops the workers (their units left unmarked compile again next time)."""
+        """Stops the workers (their units left unmarked compile again next time) and waits for
+        them and for the thread that fed them."""
         for proc in list(self._workers):
             with contextlib.suppress(OSError):
                 proc.kill()
         if self._thread is not None:
             self._thread.join()
+        for proc in self._workers:          # reaped by the thread's call, unless it never ran
+            proc.wait()
+            for pipe in (proc.stdin, proc.stdout):
+                with contextlib.suppress(OSError):
+                    pipe.close()

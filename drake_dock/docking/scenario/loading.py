@@ -14,7 +14,7 @@ from pathlib import Path
 import yaml
 from pydrake.common.yaml import yaml_load_typed
 
-from drake_dock.docking.scenario.models_dir import MODELS_DIR, PAPER_EXAMPLE  # noqa: F401
+from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
 from drake_dock.docking.scenario.schema import Scenario
 from drake_dock.docking.scenario.validation import validate
 from drake_dock.errors import InputError
