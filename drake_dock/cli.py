@@ -19,7 +19,8 @@ exit codes:
   2    bad input: the message gives the field, the value, the reason and what is allowed;
        found before anything is simulated (--out included)
   3    numerical failure: the message names the time and the couples
-  130  campaign stopped by Ctrl-C: the finished samples are kept; the same command runs the rest
+  130  stopped by Ctrl-C: a run writes nothing; a campaign keeps its finished samples and the
+       same command runs the rest
 On failure nothing is written at --out (a previous output there is left as it was).
 
 examples:
@@ -240,9 +241,13 @@ def main(argv=None) -> int:
             kernels = None
     try:
         return _run_command(args, kernels)
+    except KeyboardInterrupt:           # the output directory is written whole or not at all
+        print(_error("interrupted", f"stopped by Ctrl-C; nothing written to {args.out}"
+                     if args.out else "stopped by Ctrl-C"), file=sys.stderr)
+        return 130
     finally:
         if kernels is not None:
-            kernels.cancel()            # a run that failed before it needed them
+            kernels.cancel()            # a run that failed or stopped before it needed them
 
 
 def _run_command(args, kernels) -> int:
@@ -277,7 +282,12 @@ def _run_command(args, kernels) -> int:
                 f"wall time: kernels {seconds:.1f} s (compiled after an install or an update, "
                 f"loaded from the cache after), simulation {out.cost['wall_time_s']:.1f} s, "
                 f"outputs {outputs:.1f} s"]
-    return _guarded(work, args.out, None if bar is None else bar.close)
+    try:
+        return _guarded(work, args.out, None if bar is None else bar.close)
+    except KeyboardInterrupt:
+        if bar is not None:
+            bar.close()
+        raise                           # `main` says so
 
 
 def _guarded(work, out, finish=None) -> int:

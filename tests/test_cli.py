@@ -182,6 +182,32 @@ def test_a_run_that_fails_on_its_input_stops_the_compile(tmp_path):
     assert sorted(cache.rglob("warm.done")) == marked
 
 
+def test_ctrl_c_during_the_compile_stops_the_run_and_its_workers(tmp_path):
+    """Ctrl-C (SIGINT to the run's process group, as a terminal sends it) while the kernels
+    compile: exit 130 with one line and no traceback from the run or its workers, nothing
+    written, and no unit marked compiled after the run has returned."""
+    import signal
+    import time
+
+    from drake_dock.core.kernels import prepare
+    if prepare.cores() < 2:
+        pytest.skip("one core: the kernels compile in the run's own process, no workers")
+    cache, out = tmp_path / "numba", tmp_path / "out"
+    proc = subprocess.Popen(EXE + ["run", "--out", str(out), "--no-progress"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=dict(os.environ, NUMBA_CACHE_DIR=str(cache)),
+                            start_new_session=True)
+    time.sleep(3.0)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "compiling the numba kernels" in err and "stopped by Ctrl-C" in err
+    assert "Traceback" not in err and not out.exists()
+    marked = sorted(cache.rglob("warm.done"))
+    time.sleep(6.0)
+    assert sorted(cache.rglob("warm.done")) == marked
+
+
 def test_kernels_prepared_with_a_line_per_module_when_they_compile(monkeypatch):
     """The kernels are compiled (or loaded) before the run; when their cache lacks some (a
     first run after an install) a note and a line per module say so, and nothing otherwise."""

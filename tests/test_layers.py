@@ -243,7 +243,7 @@ def test_core_modules_use_numpy_and_scipy_only(layer):
                "os", "pathlib", "hashlib", "importlib",   # the compile cache's directory
                "ast", "tempfile", "fcntl",                # its keys, its fallback, its lock
                "argparse", "select", "subprocess", "sys",  # the parallel compile
-               "queue", "threading"}                      # fed from a thread
+               "queue", "threading", "signal"}            # fed from a thread
     for name, path in _modules().items():
         if name.split(".")[1:2] == [layer]:
             package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]

@@ -33,6 +33,7 @@ import importlib
 import os
 import queue
 import select
+import signal
 import subprocess
 import sys
 import threading
@@ -138,10 +139,17 @@ def _workers(jobs: int) -> list[subprocess.Popen]:
 
 
 def serve(lines, out) -> None:
-    """A worker's loop: compiles each unit named in ``lines`` and writes "NAME SECONDS"."""
-    for line in lines:
-        out.write(f"{line.strip()} {compile_unit(line.strip()):.3f}\n")
-        out.flush()
+    """A worker's loop: compiles each unit named in ``lines`` and writes "NAME SECONDS". Its
+    parent owns it: Ctrl-C (which reaches the whole process group) is the parent's to handle,
+    and a parent gone (its pipe closed) ends the loop quietly."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        for line in lines:
+            out.write(f"{line.strip()} {compile_unit(line.strip()):.3f}\n")
+            out.flush()
+    except BrokenPipeError:
+        with contextlib.suppress(OSError, ValueError, AttributeError):   # no flush at exit
+            os.dup2(os.open(os.devnull, os.O_WRONLY), out.fileno())
 
 
 def compile_parallel(names: list[str], jobs: int, stream=None, compiled=None,
