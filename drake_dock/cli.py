@@ -210,9 +210,9 @@ def _parser() -> argparse.ArgumentParser:
 def start_kernels(stream=None):
     """Starts compiling the numba kernels that their cache lacks (a first run after an install
     or an update: in parallel worker processes, with a line per module on ``stream``, stderr by
-    default) while the run imports the simulation and reads its scenario; its ``finish()``
-    loads them all, before the simulation, so that the run's wall time and its progress bar
-    are the simulation's, and returns the seconds the kernels held the run up
+    default) while a run or a study imports the simulation and reads its input; its
+    ``finish()`` loads them all, before the simulation, so that a run's wall time and its
+    progress bar are the simulation's, and returns the seconds the kernels held it up
     (`drake_dock.core.kernels.prepare.Preparation`)."""
     from drake_dock.core.kernels.prepare import Preparation
     return Preparation.start(stream or sys.stderr)
@@ -230,24 +230,30 @@ def main(argv=None) -> int:
         if args.which is None:
             print(studies_text())
             return 0
-        return _study(args)
+        return _with_kernels(args, _study)
     if args.command == "campaign":
         return _campaign(args)
+    return _with_kernels(args, _run_command)
+
+
+def _with_kernels(args, command) -> int:
+    """``command(args, kernels)`` (a run or a study), the kernels compiling meanwhile where
+    it has outputs to write (`start_kernels`; None otherwise); Ctrl-C is exit 130."""
     kernels = None
-    if not args.print_scenario and args.out is not None:
+    if not getattr(args, "print_scenario", False) and args.out is not None:
         try:
             kernels = start_kernels()
-        except Exception:  # noqa: BLE001 - started again in the run, which reports the error
+        except Exception:  # noqa: BLE001 - started again in the command, which reports it
             kernels = None
     try:
-        return _run_command(args, kernels)
+        return command(args, kernels)
     except KeyboardInterrupt:           # the output directory is written whole or not at all
         print(_error("interrupted", f"stopped by Ctrl-C; nothing written to {args.out}"
                      if args.out else "stopped by Ctrl-C"), file=sys.stderr)
         return 130
     finally:
         if kernels is not None:
-            kernels.cancel()            # a run that failed or stopped before it needed them
+            kernels.cancel()            # a command that failed or stopped before it needed them
 
 
 def _run_command(args, kernels) -> int:
@@ -329,7 +335,7 @@ def _failed(code, kind, e, caught, finish) -> int:
     return code
 
 
-def _study(args) -> int:
+def _study(args, kernels) -> int:
     from drake_dock.docking.report.out_dir import check_destination
     from drake_dock.docking.scenario.loading import load_scenario
     if args.which == "conditions":
@@ -372,6 +378,7 @@ def _study(args) -> int:
         _need_out(args.out, f"the {args.which} study's files")
         check_destination(args.out)
         plan = Plan.quick() if args.quick else Plan.full()
+        (kernels or start_kernels()).finish()
 
         def log(s):
             print(s, flush=True)

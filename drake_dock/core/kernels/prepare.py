@@ -4,12 +4,11 @@ A unit is a module of this package with a top-level ``warm()`` (found in the sou
 no list to keep up to date). Its ``warm()`` compiles or loads the module's kernels, and those of
 the kernel modules it calls, by evaluating them once on a small case with the argument types of
 a run. `warm` runs every unit in this process. `prepare` (``python -m drake_dock.core.kernels``;
-``drake-dock run`` takes it in two halves, `Preparation`) first compiles the units whose cache
-is missing (no
-``warm.done`` in their module's cache directory, `compile_cache.module_cache_dir`, whose key
-covers everything the unit compiles) in up to ``jobs`` worker processes
-(``python -m drake_dock.core.kernels --worker``, each taking one unit after another), a line per
-unit with its time, then loads every unit here.
+``drake-dock run`` and ``study`` take it in two halves, `Preparation`) first compiles the units
+whose cache is missing (no ``warm.done`` in their module's cache directory,
+`compile_cache.module_cache_dir`, whose key covers everything the unit compiles) in up to
+``jobs`` worker processes (``python -m drake_dock.core.kernels --worker``, each taking one unit
+after another), a line per unit with its time, then loads every unit here.
 
 Order (`schedule`): each kernel module is owned by the unit with the fewest kernel modules that
 holds it, and a unit starts after the owners of the modules it holds (`engine` after `solve`,
@@ -23,7 +22,8 @@ and optimises the whole, so a unit's compile grows with what it calls, compiled 
 `Preparation` splits `prepare` in two around the caller's own start-up: `Preparation.start` sets
 the missing units compiling in the workers (a thread here feeds them), `Preparation.finish`
 loads each unit here as soon as it is compiled (while the others compile), then the rest.
-``drake-dock run`` starts it before it imports the simulation and reads its scenario.
+``drake-dock run`` and ``drake-dock study`` start it before they import the simulation and
+read their input.
 """
 from __future__ import annotations
 
