@@ -378,15 +378,18 @@ def _study(args, kernels) -> int:
         _need_out(args.out, f"the {args.which} study's files")
         check_destination(args.out)
         plan = Plan.quick() if args.quick else Plan.full()
-        (kernels or start_kernels()).finish()
 
         def log(s):
             print(s, flush=True)
         if args.which == "speed-accuracy":
-            result = run_study(study_scenes(args.scenario), plan, log)
+            scenes = study_scenes(args.scenario)
+            (kernels or start_kernels()).finish()
+            result = run_study(scenes, plan, log)
         else:
             default = FUNNEL if args.which in ("funnel", "crosscheck") else PAPER_EXAMPLE
-            result = run_plan(load_scenario(args.scenario or default), plan, log)
+            scenario = load_scenario(args.scenario or default)
+            (kernels or start_kernels()).finish()
+            result = run_plan(scenario, plan, log)
         write(result, args.out)
         return lines(result)
     return _guarded(work, args.out)

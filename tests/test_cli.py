@@ -160,10 +160,11 @@ def test_input_errors_lead_with_their_reason(tmp_path):
     assert "NoneType" not in msg and not (tmp_path / "out").exists()
 
 
-def test_a_run_that_fails_on_its_input_stops_the_compile(tmp_path):
-    """With an empty kernel cache a run starts compiling in worker processes before it reads
-    its scenario; a bad scenario ends the run (exit 2) and its workers with it: no unit is
-    marked compiled after the run has returned (the first units take about 4 s, the wait is
+@pytest.mark.parametrize("command", [["run"], ["study", "stability"]])
+def test_a_command_that_fails_on_its_input_stops_the_compile(tmp_path, command):
+    """With an empty kernel cache a run (or a study) starts compiling in worker processes
+    before it reads its scenario; a bad scenario ends it (exit 2) and its workers with it: no
+    unit is marked compiled after it has returned (the first units take about 4 s, the wait is
     6 s)."""
     import time
 
@@ -173,7 +174,8 @@ def test_a_run_that_fails_on_its_input_stops_the_compile(tmp_path):
     empty = tmp_path / "empty.yaml"
     empty.write_text("# nothing yet\n")
     cache = tmp_path / "numba"
-    r = _run(["run", str(empty), "--out", str(tmp_path / "out"), "--no-progress"],
+    r = _run(command + [str(empty), "--out", str(tmp_path / "out")]
+             + (["--no-progress"] if command == ["run"] else []),
              env=dict(os.environ, NUMBA_CACHE_DIR=str(cache)))
     assert r.returncode == 2 and "compiling the numba kernels" in r.stderr
     assert "holds no YAML content" in " ".join(r.stderr.split())
