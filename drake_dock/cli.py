@@ -236,15 +236,21 @@ def main(argv=None) -> int:
     return _with_kernels(args, _run_command)
 
 
+def _start_kernels_or_none():
+    """`start_kernels`, or None where they cannot start (the command starts them again, inside
+    its error mapping, or goes without)."""
+    try:
+        return start_kernels()
+    except Exception:  # noqa: BLE001 - reported where they are started again
+        return None
+
+
 def _with_kernels(args, command) -> int:
     """``command(args, kernels)`` (a run or a study), the kernels compiling meanwhile where
     it has outputs to write (`start_kernels`; None otherwise); Ctrl-C is exit 130."""
     kernels = None
     if not getattr(args, "print_scenario", False) and args.out is not None:
-        try:
-            kernels = start_kernels()
-        except Exception:  # noqa: BLE001 - started again in the command, which reports it
-            kernels = None
+        kernels = _start_kernels_or_none()
     try:
         return command(args, kernels)
     except KeyboardInterrupt:           # the output directory is written whole or not at all
@@ -401,16 +407,24 @@ def _campaign(args) -> int:
     from drake_dock.campaign.progress import CampaignProgress
     bar = CampaignProgress(io.StringIO() if args.no_progress else None)
 
+    # The local workers load the kernels that this process compiles while it reads the plan (a
+    # scheduler's workers are elsewhere, with their own caches).
+    kernels = None if args.scheduler else _start_kernels_or_none()
+
     def work():
         return summary_lines(run_campaign(args.plan, args.out, workers=args.workers,
                                           scheduler=args.scheduler, resume=args.resume,
-                                          progress=bar))
+                                          progress=bar,
+                                          ready=None if kernels is None else kernels.finish))
     try:
         return _guarded(work, args.out, bar.close)
     except KeyboardInterrupt:
         bar.close()
         print(_error("interrupted", interrupted_text(args.out)), file=sys.stderr)
         return 130
+    finally:
+        if kernels is not None:
+            kernels.cancel()
 
 
 if __name__ == "__main__":

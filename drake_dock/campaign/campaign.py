@@ -48,9 +48,12 @@ def _check_options(workers, scheduler):
 
 
 def run_campaign(plan_file, out, *, workers=None, scheduler=None, resume=False, progress=None,
-                 runner=run_batch, window=None) -> dict:
+                 runner=run_batch, window=None, ready=None) -> dict:
     """Runs (or resumes) the campaign of ``plan_file`` into ``out``; returns the summary.
-    ``runner(base, specs) -> rows`` is the Dask task (`run_batch`)."""
+    ``runner(base, specs) -> rows`` is the Dask task (`run_batch`); ``ready()``, if given, is
+    called once the plan and ``out`` are checked, before the cluster starts, when samples are
+    to run (the command line's: the kernels compiled meanwhile, loaded from the cache by the
+    local workers)."""
     _check_options(workers, scheduler)
     plan, base, fields = load_plan(plan_file)
     store = CampaignStore(out, plan_identity(plan, base),
@@ -62,6 +65,8 @@ def run_campaign(plan_file, out, *, workers=None, scheduler=None, resume=False, 
         store.create()
         progress.start(plan.samples, plan.samples)
     else:
+        if ready is not None:
+            ready()
         with dask_client(workers, scheduler) as client:    # connected before DIR is written
             store.create()
             progress.start(plan.samples, plan.samples - len(missing))

@@ -120,8 +120,10 @@ def test_an_interrupted_campaign_resumes_with_every_sample_once(tmp_path, schedu
     done = sorted(s for p in (out / "parts").glob("part-*.parquet")
                   for s in pq.read_table(p)["sample"].to_pylist())
     assert 2 <= len(done) < 6 and not (out / "results.parquet").exists()
-    again = StopAfter()
-    run_campaign(plan_file, out, scheduler=scheduler, resume=True, progress=again)
+    again, ready = StopAfter(), []
+    run_campaign(plan_file, out, scheduler=scheduler, resume=True, progress=again,
+                 ready=lambda: ready.append(again.run))
+    assert ready == [0]                   # once, before any sample ran
     assert (again.saved, again.run) == (len(done), 6 - len(done))
     parts = sorted((out / "parts").glob("part-*.parquet"))
     in_parts = sorted(s for p in parts for s in pq.read_table(p)["sample"].to_pylist())
@@ -130,8 +132,9 @@ def test_an_interrupted_campaign_resumes_with_every_sample_once(tmp_path, schedu
     assert all(p.read_bytes() == first[p.name] for p in parts if p.name in first)
     # A third run finds nothing missing and runs nothing.
     third = StopAfter()
-    run_campaign(plan_file, out, scheduler=scheduler, progress=third)
-    assert (third.saved, third.run) == (6, 0)
+    run_campaign(plan_file, out, scheduler=scheduler, progress=third,
+                 ready=lambda: ready.append("again"))
+    assert (third.saved, third.run) == (6, 0) and ready == [0]     # nothing to run, not called
 
 
 def dying_runner(base, specs):
