@@ -3,11 +3,13 @@ empty Python LeafSystem in Drake's simulator (the least any Python system costs 
 and with the plant's own evaluation, for the paper's example and the IDSS box corner
 (`models/idss_box_corner.yaml`), all in this run.
 
-Per scene it prints the evaluations, `us per evaluation: <U>` (the contact system's time in
-`RigidContactSystem._lookup`, the one path of its derivatives and of its cache entry: the
-compiled call with its Python around it, memo hits included, over the integrator's derivative
-evaluations; with the computed evaluations and the memo's share) and `ratio to an empty
-LeafSystem: <N>x`; then the whole run's wall
+Per scene it prints the integrator's derivative evaluations and how many of them the contact
+system computed (the rest came from its memo), `us per evaluation: <U>` (the contact system's
+time in `RigidContactSystem._lookup`, the one path of its derivatives and of its cache entry:
+the compiled call with its Python around it, memo hits and output evaluations included, over
+the evaluations it computed; over the integrator's derivative evaluations, which the empty
+LeafSystem's figure is per, it would be less) and `ratio to an empty LeafSystem: <N>x`; then
+the whole run's wall
 time per evaluation (witnesses, events, step control, recording and Drake's integrator
 included) and its ratio; and the outcome and capture time. The target (issue: N <= 10 for the
 evaluation) is checked on each scene's line.
@@ -35,10 +37,12 @@ TARGET = 10.0
 
 def timed_run(scenario, duration):
     """(the `RunResult`, seconds in the contact system's evaluation lookups, the number of
-    evaluations computed): the class's lookup and evaluation wrapped with a clock and a
-    counter for this run."""
-    spent, computed = [0.0], [0]
+    evaluations computed, the number of derivative evaluations the integrator asked for): the
+    class's lookup, evaluation and derivative wrapped with a clock and counters for this
+    run."""
+    spent, computed, asked = [0.0], [0], [0]
     lookup, evaluate = RigidContactSystem._lookup, RigidContactSystem._evaluate
+    derivatives = RigidContactSystem.DoCalcTimeDerivatives
 
     def clocked(self, context):
         t0 = time.perf_counter()
@@ -51,14 +55,20 @@ def timed_run(scenario, duration):
         computed[0] += 1
         return evaluate(self, *args)
 
+    def derivative(self, context, out):
+        asked[0] += 1
+        return derivatives(self, context, out)
+
     RigidContactSystem._lookup, RigidContactSystem._evaluate = clocked, counted
+    RigidContactSystem.DoCalcTimeDerivatives = derivative
     try:
         dd = build_docking_diagram(DiagramSpec.of(scenario))
         r = simulate(scenario, place(scenario, PlacementCache(dd.scene)), dd=dd,
                      duration=duration)
     finally:
         RigidContactSystem._lookup, RigidContactSystem._evaluate = lookup, evaluate
-    return r, spent[0], computed[0]
+        RigidContactSystem.DoCalcTimeDerivatives = derivatives
+    return r, spent[0], computed[0], asked[0]
 
 
 def main():
@@ -74,11 +84,12 @@ def main():
     print(f"empty Python LeafSystem: {empty * 1e6:.1f} us per evaluation")
     for name, scenario, duration in scenes:
         simulate(scenario, place(scenario), duration=0.01)   # every kernel and Drake's code
-        r, spent, computed = timed_run(scenario, duration)
+        r, spent, computed, asked = timed_run(scenario, duration)
         n = r.evaluations
         u = spent / n
         t_free, n_free = free_flight(scenario, r.initial, r.end_time)
-        print(f"{name}: {n} evaluations ({computed} computed, the rest from the memo); us per "
+        print(f"{name}: {asked} derivative evaluations ({computed} computed, the rest from the "
+              f"memo); us per "
               f"evaluation: {u * 1e6:.1f}; ratio to an empty LeafSystem: {u / empty:.1f}x; "
               f"the plant's own evaluation {t_free / n_free * 1e6:.1f} us "
               f"({u / (t_free / n_free):.1f}x)")

@@ -168,6 +168,7 @@ class RigidContactSystem(WitnessFunctions, WitnessPredictions, LeafSystem):
             body = plant.GetBodyByName(b)
             self._wrench_ports[name] = (int(body.floating_velocities_start_in_v()),
                                         self.DeclareVectorInputPort(name, 6))
+        self._wrenches = tuple(self._wrench_ports.values())
         self._cache = self.DeclareCacheEntry(
             "contact evaluation", ValueProducer(
                 allocate=lambda: AbstractValue.Make(None), calc=self._calc_eval),
@@ -235,9 +236,9 @@ class RigidContactSystem(WitnessFunctions, WitnessPredictions, LeafSystem):
         generalized force, plus the follower forces where they act (at the state ``x``, the
         context's continuous state when None, after the first impact of ``modes``, the
         context's modes when None)."""
-        tau = (self._gf_port.Eval(context).copy() if self._gf_port.HasValue(context)
-               else np.zeros(self.nv))
-        for j, port in self._wrench_ports.values():
+        gf = self._gf_port
+        tau = gf.Eval(context).copy() if gf.HasValue(context) else np.zeros(self.nv)
+        for j, port in self._wrenches:
             if port.HasValue(context):
                 tau[j:j + 6] += port.Eval(context)
         if self.followers:
@@ -257,9 +258,15 @@ class RigidContactSystem(WitnessFunctions, WitnessPredictions, LeafSystem):
         value.set_value(self._lookup(context))
 
     def _lookup(self, context) -> Evaluation:
-        t, modes = context.get_time(), self.get_modes(context)
+        """The evaluation at the context, from the memo when Drake asked for it before (the
+        path of every derivative: its steps inlined)."""
+        t = context.get_time()
+        modes = context.get_abstract_state(self._mode_index).get_value()
         x = context.get_continuous_state_vector().CopyToVector()
-        return self._evaluation_at(t, x, modes, self.input_force(context, x, modes))
+        tau = self.input_force(context, x, modes)
+        key = (t, x.tobytes(), modes_key(modes), tau.tobytes())
+        E = self._evaluations.find(key)
+        return self._evaluations.put(key, self._evaluate(t, x, modes, tau)) if E is None else E
 
     def _evaluation_at(self, t, x, modes, tau) -> Evaluation:
         """The evaluation at (t, x, modes, tau), from the memo when Drake asked for it before."""
@@ -276,7 +283,7 @@ class RigidContactSystem(WitnessFunctions, WitnessPredictions, LeafSystem):
         return E
 
     def DoCalcTimeDerivatives(self, context, derivatives):
-        derivatives.get_mutable_vector().SetFromVector(self._lookup(context).xdot)
+        derivatives.SetFromVector(self._lookup(context).xdot)
 
     # ------------------------------------------------------------------ outputs
     def _out_state(self, context, out):

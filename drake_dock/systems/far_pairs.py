@@ -62,11 +62,12 @@ class FarPairs:
         return [compiled_cover.patch_cover(p, *BROAD_CELLS[p.dim])
                 for p in (self.pairs[i].patch1, self.pairs[i].patch2)]
 
-    def cover_gap(self, i, poses):
+    def cover_gap(self, i, poses, below=-math.inf):
         """The least gap of pair i's covers at ``poses``, patch 1 placed in frame 2: a lower
-        bound of the pair's distance (`drake_dock.core.covers.cover_gap`)."""
+        bound of the pair's distance (`drake_dock.core.covers.cover_gap`); with ``below``, a
+        gap below it as soon as one is found."""
         c1, c2 = self.covers(i)
-        return compiled_cover.cover_gap(c1.posed(*self.reference(i, poses)), c2)
+        return compiled_cover.cover_gap(c1.posed(*self.reference(i, poses)), c2, below)
 
     def reference(self, i, poses):
         """The relative pose of pair i kept at a seek, read-only: `bounds` keeps it stacked by

@@ -53,5 +53,8 @@ class FollowerForce:
     def add_to(self, tau, q, since_contact: float) -> None:
         """Adds the wrench to the generalized force ``tau`` where it acts."""
         w = self.wrench(q, since_contact)
-        if w is not None:
-            tau[self.v_start:self.v_start + 6] += w
+        if w is not None:           # the force alone: the torque adds zeros
+            j = self.v_start + 3
+            tau[j] += w[3]
+            tau[j + 1] += w[4]
+            tau[j + 2] += w[5]

@@ -22,14 +22,21 @@ that depend on nothing outside its key (an evaluation's witness values)."""
     def clear(self):
         self._items.clear()
 
+    def find(self, key):
+        """The result kept for ``key``, None if none is."""
+        return self._items.get(key)
+
+    def put(self, key, value):
+        """Keeps ``value`` for ``key`` (a key not kept) and returns it."""
+        if len(self._items) >= self.size:
+            self._items.pop(next(iter(self._items)))
+        self._items[key] = value
+        return value
+
     def get(self, key, compute, refresh=None):
         hit = self._items.get(key)
         if hit is not None:
             if refresh is not None:
                 hit = self._items[key] = refresh(hit)
             return hit
-        value = compute()
-        if len(self._items) >= self.size:
-            self._items.pop(next(iter(self._items)))
-        self._items[key] = value
-        return value
+        return self.put(key, compute())

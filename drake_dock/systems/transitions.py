@@ -144,7 +144,7 @@ class Transitions:
         if not opt.broad_phase:
             return False
         with self.timing.measure("seeking", self.pairs[i].name):
-            gap = self.ev.far.cover_gap(i, poses)
+            gap = self.ev.far.cover_gap(i, poses, below=opt.track_distance)
             if not gap >= opt.track_distance:
                 return False
             st.ref_X21 = self.ev.far.reference(i, poses)

@@ -151,7 +151,8 @@ def test_bound_lies_below_the_seek_distance():
 
 def test_cover_gap_compiled_equals_reference_and_lies_below_the_seek():
     """`cover_gap` (block-pruned, compiled) equals the reference over every sphere pair to
-    1e-12, and lies below the seek's distance, for the complete set's pairs at random
+    1e-12 (given a threshold, a cell gap below it where the least gap is), and lies below the
+    seek's distance, for the complete set's pairs at random
     relative poses of the two APDS (tilt up to 10 deg, offset up to 0.15 m, ring distance -0.2
     to 0.5 m)."""
     from drake_dock.docking.geometry.pairs import R_MATCHED
@@ -168,6 +169,13 @@ def test_cover_gap_compiled_equals_reference_and_lies_below_the_seek():
             a, b = c1.posed(*X[pr.body1]), c2.posed(*X[pr.body2])
             got, ref = compiled.cover_gap(a, b), covers.cover_gap(a, b)
             assert got == pytest.approx(ref, rel=0, abs=1e-12), pr.name
+            # With a threshold: a gap below it when the least gap is, else the least gap.
+            for below in (ref - 0.01, ref + 1e-6, ref + 0.05):
+                early = compiled.cover_gap(a, b, below)
+                if ref < below:
+                    assert ref - 1e-12 <= early < below, (pr.name, below)
+                else:
+                    assert early == got, (pr.name, below)
             P1, P2 = posed(pr.patch1, *X[pr.body1]), posed(pr.patch2, *X[pr.body2])
             cp = seek_couple(P1, P2)
             assert got <= cp.distance + 1e-12, pr.name

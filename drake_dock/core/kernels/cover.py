@@ -125,10 +125,12 @@ def _sphere_gap(c1, r1, c2, r2):
 
 
 @njit(cache=True)
-def least_gap(ac, ar, abc, abr, ablocks, bc, br, bbc, bbr, bblocks):
+def least_gap(ac, ar, abc, abr, ablocks, bc, br, bbc, bbr, bblocks, below):
     """`covers.cover_gap` of the covers a (cells ac, ar; blocks abc, abr, ablocks) and b: the
     block pairs in increasing order of their spheres' gap, each one's cells only while that gap
-    is below the least cell gap found (a block's sphere holds its cells' spheres)."""
+    is below the least cell gap found (a block's sphere holds its cells' spheres). Stops at the
+    first cell gap below ``below``, returning it (a gap known to be below that is all a
+    screen needs); -inf for the least gap itself."""
     m, k = abc.shape[0], bbc.shape[0]
     lower = np.empty(m * k)
     for I in range(m):
@@ -144,13 +146,17 @@ def least_gap(ac, ar, abc, abr, ablocks, bc, br, bbc, bbr, bblocks):
                 g = _sphere_gap(ac[a], ar[a], bc[b], br[b])
                 if g < best:
                     best = g
+                    if best < below:
+                        return best
     return best
 
 
-def cover_gap(a, b) -> float:
-    """`drake_dock.core.covers.cover_gap` compiled (`least_gap`)."""
+def cover_gap(a, b, below: float = -np.inf) -> float:
+    """`drake_dock.core.covers.cover_gap` compiled (`least_gap`); with ``below``, any gap of
+    two cells below it once one is found (the least gap when it is not below)."""
     return float(least_gap(a.centres, a.radii, a.block_centres, a.block_radii, a.blocks,
-                           b.centres, b.radii, b.block_centres, b.block_radii, b.blocks))
+                           b.centres, b.radii, b.block_centres, b.block_radii, b.blocks,
+                           float(below)))
 
 
 def patch_cover(patch, n: int, block: int):
