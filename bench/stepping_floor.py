@@ -21,8 +21,10 @@ It prints the run's wall time by part (seeking, contact dynamics, impacts and th
 Drake's integrator, the witnesses, the step control and the recording), then the costs per
 evaluation, the ratio of (1) to (3) (the cost per evaluation that compiled stepping would
 leave, taken at the costliest state, so the run's average state costs less), and the share
-of (1) that the kernel itself takes over the run's states. No target: the floor of a design
-not built.
+of (1) that the kernel itself takes over the run's states; and the sample's projected wall
+time with compiled stepping: the run's seeking and impacts as measured (the contact system's
+`timing`), everything else replaced by the run's evaluations at the cost of (3). No target:
+the floor of a design not built.
 
     python bench/stepping_floor.py [--sample 6] [--seconds 0.1] [--repeats 3]
 """
@@ -197,6 +199,13 @@ def main():
         print(f"ratio of the run to the compiled loop: {per_run / per_loop:.1f}x per "
               f"evaluation; the kernel's share of the run's evaluation cost: "
               f"{per_state / per_run:.0%}")
+        parts = run.timing["shares"]
+        wall = statistics.median(r.wall_time for r in runs)
+        kept = wall * (parts["seeking"] + parts["impacts"])
+        projected = kept + run.evaluations * per_loop
+        print(f"projected wall of the sample with compiled stepping: {projected:.3f} s (its "
+              f"seeking and impacts as they are, {kept:.3f} s, and each of its evaluations at "
+              f"the compiled loop's cost), {wall / projected:.1f}x less than the run")
 
 if __name__ == "__main__":
     main()
