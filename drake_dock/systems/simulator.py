@@ -3,13 +3,19 @@
 control of `drake_dock.systems.stepping`, and the tolerances derived from the configuration."""
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import gc
 
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 
 from drake_dock.systems.stepping import WitnessApproach
 
 IMPACT_RTOL_RANGE = (1e-12, 1e-8)
+
+#: the first generation's threshold of Python's cyclic collector during a run
+#: (`collector_relaxed`; Python's default is 700)
+RUN_GC_THRESHOLD = 50_000
 
 
 @dataclasses.dataclass(frozen=True)
@@ -55,3 +61,20 @@ def make_witness_approach(sim: Simulator, sources, config: SimulatorConfig, *,
     cap is ``config.max_step_size``, its window the witness isolation window."""
     return WitnessApproach(sim, sources, config.max_step_size,
                            tolerances(config, witness_accuracy).witness_window)
+
+
+@contextlib.contextmanager
+def collector_relaxed(threshold: int = RUN_GC_THRESHOLD):
+    """Python's cyclic collector with its first generation's threshold raised to
+    ``threshold`` (where it is lower) for the ``with`` block, restored after. A run allocates
+    small objects at every evaluation, nearly all freed by reference counting; at the default
+    threshold the collector runs about once a millisecond and scans, in its older generations,
+    everything the process holds (a Dask worker's state too). A collector the user disabled or
+    set higher is left as it is."""
+    old = gc.get_threshold()
+    if gc.isenabled() and old[0] < threshold:
+        gc.set_threshold(threshold, *old[1:])
+    try:
+        yield
+    finally:
+        gc.set_threshold(*old)
