@@ -136,7 +136,8 @@ def scenario_row(scenario, *, reuse: bool = True) -> dict:
     Diagram's scene."""
     spec = DiagramSpec.of(scenario, scene=scene_for(scenario) if reuse else None)
     dd = diagram_for(spec) if reuse else build_docking_diagram(spec)
-    return measure(simulate(scenario, place(scenario, PlacementCache(dd.scene)), dd=dd))
+    return measure(simulate(scenario, place(scenario, PlacementCache(dd.scene)), dd=dd,
+                            lean=True))
 
 
 def run_sample(base, spec, *, reuse: bool = True) -> dict:

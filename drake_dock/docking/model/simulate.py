@@ -47,18 +47,35 @@ class Record:
     contact system at it gives, made for every sample when first asked (`derive`): a run
     records five references per step."""
 
-    def __init__(self, dd=None):
+    def __init__(self, dd=None, lean: bool = False):
         self.dd = dd
         self.t, self.states, self.kind, self.modes, self.tau = [], [], [], [], []
         self._derived = None
+        # Lean (a campaign's): per sample its `_small` values, from the evaluation the run
+        # made there, so that `derive` without couples evaluates nothing again.
+        self.lean = lean
+        self._small = [] if lean else None
 
-    def append(self, t, state, kind, modes, tau):
+    def append(self, t, state, kind, modes, tau, E=None):
+        """A sample; ``E`` the contact system's evaluation at it where the caller has it (a
+        lean record reads it, or evaluates the sample when it is not given)."""
         self.t.append(t)
         self.states.append(state)
         self.kind.append(kind)
         self.modes.append(modes)
         self.tau.append(tau)
+        if self._small is not None:
+            if E is None:
+                E = self.dd.contact.engine.evaluate(t, state, modes, tau)
+            self._small.append(self._small_of(E, modes, state))
         self._derived = None
+
+    def _small_of(self, E, modes, state) -> tuple:
+        """(largest normal force, energy, bushings, ring distance) of a sample from its
+        evaluation E."""
+        contact = self.dd.contact
+        return (E.lam_n.max(initial=0.0), contact.energy(E, modes), E.bushings.copy(),
+                self.dd.capture.misalignment_of(state[:contact.nq])[0])
 
     @property
     def x(self) -> np.ndarray:
@@ -72,6 +89,14 @@ class Record:
         part), ``lambda_n_max`` (N,) the largest normal force, ``energy`` (N, energy names),
         ``bushings`` (N, bushings, 12: deflection, roll-pitch-yaw, force on the APDS frame,
         world), ``ring_distance`` (N,)."""
+        if self._derived is None and not couples and self._small is not None:
+            lam, energy, bush, ring = zip(*self._small) if self._small else ((),) * 4
+            contact = self.dd.contact
+            self._derived = dict(
+                lambda_n_max=np.array(lam, dtype=float),
+                energy=np.array(energy, dtype=float).reshape(-1, len(contact.energy_names)),
+                bushings=np.array(bush, dtype=float).reshape(-1, contact.engine.nbush, 12),
+                ring_distance=np.array(ring, dtype=float))
         if self._derived is None or (couples and "couples" not in self._derived):
             contact, capture = self.dd.contact, self.dd.capture
             n = len(self.t)
@@ -169,9 +194,9 @@ class _Recorder:
     """The record of a run: ``period`` None, a sample at every step end; else at the multiples
     of ``period`` (`_Grid`)."""
 
-    def __init__(self, dd: DockingDiagram, period: float | None = None):
+    def __init__(self, dd: DockingDiagram, period: float | None = None, lean: bool = False):
         self.dd = dd
-        self.record = Record(dd)
+        self.record = Record(dd, lean)
         self.n_impacts = 0
         self._scratch = dd.diagram.CreateDefaultContext()
         self.grid = None if period is None else _Grid(self, period)
@@ -184,7 +209,16 @@ class _Recorder:
 
     def _append(self, root, kind):
         t, x, modes, tau = self._sample_of(root)
-        self.record.append(t, x, kind, modes, tau)
+        self.record.append(t, x, kind, modes, tau, self._evaluation(root))
+
+    def _evaluation(self, root):
+        """The contact system's evaluation at the root context, for a lean record (the one the
+        step's end asks for anyway: the witnesses and the step control read it); None
+        otherwise."""
+        if not self.record.lean:
+            return None
+        contact = self.dd.contact
+        return contact.eval(contact.GetMyContextFromRoot(root))
 
     def start(self, sim):
         """After `Simulator.Initialize`: the first sample (and the grid's first step start)."""
@@ -317,7 +351,7 @@ def _scene_of(scenario, state):
 
 def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
              progress=None, duration: float | None = None,
-             witness_approach: bool = True) -> RunResult:
+             witness_approach: bool = True, lean: bool = False) -> RunResult:
     """Runs the scenario from ``state`` (`drake_dock.docking.placement.place.place` finds the
     scenario's own) on ``dd`` (built when not given) until a named outcome
     (`drake_dock.docking.model.outcome`), ``simulation.duration`` (or ``duration``) being the
@@ -325,12 +359,15 @@ def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
     system's typed errors (`NumericalError`), and any other failure of the integration as a
     `NumericalError` with the time and the couples in play. ``witness_approach`` shortens the
     steps before predicted witness zeros (`drake_dock.systems.stepping.WitnessApproach`); off,
-    Drake's plain isolation is used. A Diagram built here is built on the state's scene
-    (`InitialState.scene`) where that is the scenario's, so the scene is made once."""
+    Drake's plain isolation is used. ``lean`` (a campaign's): the record keeps of each
+    sample, besides its state, the values that `Record.derive` gives without couples, read
+    from the evaluation the run made there (`Record`). A Diagram built here is built on the
+    state's scene (`InitialState.scene`) where that is the scenario's, so the scene is made
+    once."""
     with numerical_failure("the Diagram's set-up", lambda: (0.0, ())):
         dd = dd or build_docking_diagram(DiagramSpec.of(scenario, scene=_scene_of(scenario,
                                                                                   state)))
-        rec = _Recorder(dd, scenario.simulation.output_period)
+        rec = _Recorder(dd, scenario.simulation.output_period, lean)
         sim = docking_simulator(dd, state, scenario.simulator_config)
     t_end = scenario.simulation.duration if duration is None else duration
 
