@@ -6,7 +6,8 @@ then 2), each a whole campaign (`run_campaign`). Prints each configuration's sam
 minute (the whole campaign), the samples' own wall times (median and range) and their
 outcomes; then the throughput ratio of the last configuration to the first (the ideal for 1
 and 2 workers on 2 free cores is 2). A campaign's wall time is a fixed part (reading the plan,
-the cluster's start; then the results and figures) and the samples' part, from the cluster's
+the cluster's start; then its shutdown, the results and figures, which grow a little with the
+samples) and the samples' part, from the cluster's
 start to the last batch saved (the campaign's progress, which also holds each worker's first
 loads); the projected wall time of 1,000 and of 10,000 samples with the last configuration's
 workers is the fixed part plus their samples at the samples' part's rate, beside the whole
@@ -108,6 +109,7 @@ def main():
           + ("met" if hours <= 2.0 and w == 2
              else f"NOT met ({hours / 2.0:.1f}x over)" if w == 2
              else "not measured (2 workers needed)"))
+
 
 if __name__ == "__main__":
     main()

@@ -3,13 +3,13 @@ empty Python LeafSystem in Drake's simulator (the least any Python system costs 
 and with the plant's own evaluation, for the paper's example and the IDSS box corner
 (`models/idss_box_corner.yaml`), all in this run.
 
-Per scene it prints the integrator's derivative evaluations and how many of them the contact
-system computed (the rest came from its memo), `us per evaluation: <U>` (the contact system's
-time in `RigidContactSystem._lookup`, the one path of its derivatives and of its cache entry:
-the compiled call with its Python around it, memo hits and output evaluations included, over
-the evaluations it computed; over the integrator's derivative evaluations, which the empty
-LeafSystem's figure is per, it would be less) and `ratio to an empty LeafSystem: <N>x`; then
-the whole run's wall
+Per scene it prints the integrator's derivative evaluations and the evaluations the contact
+system computed on every path (derivatives, witnesses, outputs, events; a request with equal
+inputs comes from its memo), `us per evaluation: <U>` (the contact system's time in
+`RigidContactSystem._lookup`, the one path of its derivatives and of its cache entry: the
+compiled call with its Python around it, memo hits included, over the evaluations it
+computed; over the integrator's derivative evaluations, which the empty LeafSystem's figure is
+per, it would be less) and `ratio to an empty LeafSystem: <N>x`; then the whole run's wall
 time per evaluation (witnesses, events, step control, recording and Drake's integrator
 included) and its ratio; and the outcome and capture time. The target (issue: N <= 10 for the
 evaluation) is checked on each scene's line.
@@ -88,8 +88,8 @@ def main():
         n = r.evaluations
         u = spent / n
         t_free, n_free = free_flight(scenario, r.initial, r.end_time)
-        print(f"{name}: {asked} derivative evaluations ({computed} computed, the rest from the "
-              f"memo); us per "
+        print(f"{name}: {asked} derivative evaluations, {computed} evaluations computed (on "
+              f"every path: derivatives, witnesses, outputs, events); us per "
               f"evaluation: {u * 1e6:.1f}; ratio to an empty LeafSystem: {u / empty:.1f}x; "
               f"the plant's own evaluation {t_free / n_free * 1e6:.1f} us "
               f"({u / (t_free / n_free):.1f}x)")

@@ -199,13 +199,16 @@ def main():
         print(f"ratio of the run to the compiled loop: {per_run / per_loop:.1f}x per "
               f"evaluation; the kernel's share of the run's evaluation cost: "
               f"{per_state / per_run:.0%}")
-        parts = run.timing["shares"]
+        kept_of = [r.wall_time * (r.timing["shares"]["seeking"] + r.timing["shares"]["impacts"])
+                   for r in runs]
+        kept = statistics.median(kept_of)
+        projected = statistics.median(k + r.evaluations * per_loop for k, r in zip(kept_of, runs))
         wall = statistics.median(r.wall_time for r in runs)
-        kept = wall * (parts["seeking"] + parts["impacts"])
-        projected = kept + run.evaluations * per_loop
         print(f"projected wall of the sample with compiled stepping: {projected:.3f} s (its "
               f"seeking and impacts as they are, {kept:.3f} s, and each of its evaluations at "
-              f"the compiled loop's cost), {wall / projected:.1f}x less than the run")
+              f"the compiled loop's cost; medians over the runs), {wall / projected:.1f}x less "
+              f"than the run")
+
 
 if __name__ == "__main__":
     main()

@@ -51,9 +51,10 @@ class FollowerForce:
         return (0.0, 0.0, 0.0, f * e0, f * e1, f * e2)
 
     def add_to(self, tau, q, since_contact: float) -> None:
-        """Adds the wrench to the generalized force ``tau`` where it acts."""
+        """Adds the wrench to the generalized force ``tau`` where it acts: its force alone
+        (adding the torque's zeros would at most turn a -0.0 of tau into +0.0)."""
         w = self.wrench(q, since_contact)
-        if w is not None:           # the force alone: the torque adds zeros
+        if w is not None:
             j = self.v_start + 3
             tau[j] += w[3]
             tau[j + 1] += w[4]

@@ -70,11 +70,15 @@ def collector_relaxed(threshold: int = RUN_GC_THRESHOLD):
     small objects at every evaluation, nearly all freed by reference counting; at the default
     threshold the collector runs about once a millisecond and scans, in its older generations,
     everything the process holds (a Dask worker's state too). A collector the user disabled or
-    set higher is left as it is."""
+    set higher (or to 0, Python's other way of disabling it) is left as it is; so is one that
+    another run changed meanwhile (runs in threads: the last to leave does not restore a
+    threshold it did not set)."""
     old = gc.get_threshold()
-    if gc.isenabled() and old[0] < threshold:
+    relax = gc.isenabled() and 0 < old[0] < threshold
+    if relax:
         gc.set_threshold(threshold, *old[1:])
     try:
         yield
     finally:
-        gc.set_threshold(*old)
+        if relax and gc.get_threshold()[0] == threshold:
+            gc.set_threshold(*old)

@@ -1,7 +1,8 @@
-"""A lean record (`simulate(..., lean=True)`, a campaign's) keeps of each sample the values
-that `Record.derive` gives without couples, read from the run's own evaluation there; they are
-bitwise those that a full record derives by evaluating every sample again, at step-end samples
-and on an output grid, with impacts."""
+"""A lean record (`simulate(..., lean=True)`, a campaign's) keeps of each step-end sample the
+values that `Record.derive` gives without couples, read from the run's own evaluation there,
+and the run computes no more evaluations than a full one; what it derives is bitwise what a
+full record derives by evaluating every sample again, at step-end samples and on an output
+grid, with impacts."""
 import copy
 
 import numpy as np
@@ -22,6 +23,7 @@ def test_lean_record_derives_what_the_full_one_does(paper_scenario, period):
     lean = simulate(scenario, state, duration=0.3, lean=True)
     assert len(full.impacts) >= 2           # the samples after impacts are covered
     assert np.array_equal(full.record.x, lean.record.x)
+    assert lean.evaluations == full.evaluations   # the run evaluates nothing for its record
     a, b = full.record.derive(False), lean.record.derive(False)
     for k in KEYS:
         assert a[k].shape == b[k].shape and a[k].dtype == b[k].dtype, k

@@ -36,11 +36,12 @@ def test_docking_lzb_accuracy_follows_the_simulator_config(paper_scenario, accur
     assert dd.contact.options.impact_rtol == tolerances(scenario.simulator_config).impact_rtol
 
 
-@pytest.mark.parametrize("user", [(700, 10, 10), (200_000, 10, 10), None])
+@pytest.mark.parametrize("user", [(700, 10, 10), (200_000, 10, 10), (0, 10, 10), None])
 def test_a_run_relaxes_the_collector_and_restores_it(paper_scenario, user):
     """During a run the collector's first threshold is at least `RUN_GC_THRESHOLD` (read by
-    the run's progress callback), a higher one the user set is kept, a disabled collector stays
-    disabled, and after the run the thresholds are the user's again."""
+    the run's progress callback), a higher one the user set is kept, a disabled collector (by
+    `gc.disable` or a threshold of 0) stays disabled, and after the run the thresholds are the
+    user's again."""
     import gc
     from drake_dock.docking.model.simulate import simulate
     from drake_dock.docking.placement.place import place
@@ -60,6 +61,6 @@ def test_a_run_relaxes_the_collector_and_restores_it(paper_scenario, user):
         gc.set_threshold(*old)
         (gc.enable if enabled else gc.disable)()
     assert seen
-    want = before[0] if user is None else max(before[0], RUN_GC_THRESHOLD)
+    want = before[0] if user is None or before[0] == 0 else max(before[0], RUN_GC_THRESHOLD)
     assert {s for s in seen} == {((want, *before[1:]), user is not None)}
     assert after == (before, user is not None)

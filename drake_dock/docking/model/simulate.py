@@ -51,23 +51,22 @@ class Record:
         self.dd = dd
         self.t, self.states, self.kind, self.modes, self.tau = [], [], [], [], []
         self._derived = None
-        # Lean (a campaign's): per sample its `_small` values, from the evaluation the run
-        # made there, so that `derive` without couples evaluates nothing again.
+        # Lean (a campaign's): per step-end sample its `_small` values, from the evaluation the
+        # run made there, so that `derive` without couples evaluates only the other samples
+        # (after impacts, on an output grid) again; None for those.
         self.lean = lean
         self._small = [] if lean else None
 
     def append(self, t, state, kind, modes, tau, E=None):
-        """A sample; ``E`` the contact system's evaluation at it where the caller has it (a
-        lean record reads it, or evaluates the sample when it is not given)."""
+        """A sample; ``E`` the contact system's evaluation at it where the run made one (a
+        lean record keeps what `derive` reads of it)."""
         self.t.append(t)
         self.states.append(state)
         self.kind.append(kind)
         self.modes.append(modes)
         self.tau.append(tau)
         if self._small is not None:
-            if E is None:
-                E = self.dd.contact.engine.evaluate(t, state, modes, tau)
-            self._small.append(self._small_of(E, modes, state))
+            self._small.append(None if E is None else self._small_of(E, modes, state))
         self._derived = None
 
     def _small_of(self, E, modes, state) -> tuple:
@@ -90,7 +89,11 @@ class Record:
         ``bushings`` (N, bushings, 12: deflection, roll-pitch-yaw, force on the APDS frame,
         world), ``ring_distance`` (N,)."""
         if self._derived is None and not couples and self._small is not None:
-            lam, energy, bush, ring = zip(*self._small) if self._small else ((),) * 4
+            small = [v if v is not None else self._small_of(
+                self.dd.contact.engine.evaluate(self.t[k], self.states[k], self.modes[k],
+                                                self.tau[k]), self.modes[k], self.states[k])
+                for k, v in enumerate(self._small)]
+            lam, energy, bush, ring = zip(*small) if small else ((),) * 4
             contact = self.dd.contact
             self._derived = dict(
                 lambda_n_max=np.array(lam, dtype=float),
@@ -207,14 +210,14 @@ class _Recorder:
         return (root.get_time(), cc.get_continuous_state_vector().CopyToVector(),
                 contact.get_modes(cc), contact.input_force(cc))
 
-    def _append(self, root, kind):
+    def _append(self, root, kind, E=None):
         t, x, modes, tau = self._sample_of(root)
-        self.record.append(t, x, kind, modes, tau, self._evaluation(root))
+        self.record.append(t, x, kind, modes, tau, E)
 
-    def _evaluation(self, root):
-        """The contact system's evaluation at the root context, for a lean record (the one the
-        step's end asks for anyway: the witnesses and the step control read it); None
-        otherwise."""
+    def _step_end_evaluation(self, root):
+        """The contact system's evaluation at a step's end (the root context), for a lean
+        record: the one the step's end asks for anyway (the witnesses and the step control
+        read it); None otherwise."""
         if not self.record.lean:
             return None
         contact = self.dd.contact
@@ -241,7 +244,7 @@ class _Recorder:
             r.kind[-1] = PRE_IMPACT
         self.impacts_since(root, modes)
         if not r.t or root.get_time() > r.t[-1] or new:
-            self._append(root, STEP)
+            self._append(root, STEP, self._step_end_evaluation(root))
 
     def impacts_since(self, root, modes):
         """The post-impact samples of the impacts logged since the last call."""
@@ -360,8 +363,8 @@ def simulate(scenario, state: InitialState, *, dd: DockingDiagram | None = None,
     `NumericalError` with the time and the couples in play. ``witness_approach`` shortens the
     steps before predicted witness zeros (`drake_dock.systems.stepping.WitnessApproach`); off,
     Drake's plain isolation is used. ``lean`` (a campaign's): the record keeps of each
-    sample, besides its state, the values that `Record.derive` gives without couples, read
-    from the evaluation the run made there (`Record`). A Diagram built here is built on the
+    step-end sample, besides its state, the values that `Record.derive` gives without couples,
+    read from the evaluation the run made there (`Record`). A Diagram built here is built on the
     state's scene (`InitialState.scene`) where that is the scenario's, so the scene is made
     once."""
     with numerical_failure("the Diagram's set-up", lambda: (0.0, ())):
