@@ -13,7 +13,7 @@ import numpy as np
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import couples as C
 from drake_dock.core.kernels import model as K
-from drake_dock.core.kernels.witness_values import regular_rates
+from drake_dock.core.kernels import witness_values as WV
 from drake_dock.systems import witnesses
 from drake_dock.systems.witnesses import FAR_WITNESS
 
@@ -25,8 +25,8 @@ class ArmedWitnesses:
     values and couple rows (those of the pairs not far, by their place among them)."""
 
     __slots__ = ("names", "pair", "code", "far", "gap", "flat", "flat_list", "gap_flat",
-                 "g_flat", "no_rates", "regular", "regular_pair", "regular_slot",
-                 "pair_gap_flat")
+                 "g_flat", "gap_pos", "regular", "regular_pos", "regular_pair",
+                 "regular_slot", "pair_gap_flat")
 
     def __init__(self, names, pair, code, far, gap, slot):
         self.names, self.pair, self.code, self.far, self.gap = names, pair, code, far, gap
@@ -34,10 +34,11 @@ class ArmedWitnesses:
         self.flat_list = self.flat.tolist()
         self.gap_flat = slot[gap] * C.ROW + C.VN        # the gaps' v_n in its couple rows
         self.g_flat = slot[gap] * C.ROW + C.GAP         # and the gaps
-        self.no_rates = np.full(len(pair), np.nan)
+        self.gap_pos = np.flatnonzero(gap)              # the gap witnesses' places
         # per witness of a pair: its gap's place in the couple rows (raveled), -1 but for gaps
         self.pair_gap_flat = np.where(gap, slot * C.ROW + C.GAP, -1)
         self.regular = code == K.W_REGULAR              # the domain-end witnesses
+        self.regular_pos = np.flatnonzero(self.regular)
         self.regular_pair = pair[self.regular].astype(np.int64)
         self.regular_slot = slot[self.regular].astype(np.int64)
 
@@ -135,26 +136,19 @@ class WitnessPredictions:
                                     self._armed_modes(modes))
 
     def _witness_now_of(self, E, modes, a) -> WitnessNow:
-        w = E.wv.ravel().take(a.flat)
-        d = a.no_rates.copy()
+        # The impact witness is the gap while positive, its rate v_n; the regular witnesses'
+        # rates where the end margin is the least (compiled, `witness_values.witness_now`).
+        w, d, turning = WV.witness_now(self.engine.packed, E.wv.ravel(), E.out, a.flat,
+                                       a.gap_pos, a.g_flat, a.gap_flat, a.regular_pos,
+                                       a.regular_pair, a.regular_slot)
         epoch = modes.mode_changes
-        if a.g_flat.size:
-            # The impact witness is the gap while positive, its rate v_n.
-            out = E.out.ravel()
-            g, vn = out.take(a.g_flat), out.take(a.gap_flat)
-            d[a.gap] = np.where(g > 0.0, vn, np.nan)
+        if turning.size:
             # While the gap is not positive (just after an impact) the witness is v_n, its
             # rate g'' (a couple turning back within a few microseconds is predicted from
             # the first point after the impact). The witness changes meaning (m/s to m) where
             # the gap turns positive: a new epoch, so that no secant joins the two.
-            turning = np.flatnonzero(a.gap)[g <= 0.0]
-            if turning.size:
-                d[turning] = self._gap_second_rates(E, a, turning.tolist())
-                epoch = (epoch, turning.tobytes())
-        if a.regular_pair.size:
-            rates = np.empty(a.regular_pair.size)
-            regular_rates(self.engine.packed, E.out, a.regular_pair, a.regular_slot, rates)
-            d[a.regular] = rates
+            d[turning] = self._gap_second_rates(E, a, turning.tolist())
+            epoch = (epoch, turning.tobytes())
         if a.far:
             far = E.far_witness if self.options.reseek_early <= 0 else math.inf
             w, d = np.concatenate([[far], w]), np.concatenate([[np.nan], d])

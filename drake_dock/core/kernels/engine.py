@@ -272,7 +272,8 @@ def toy_model():
 def warm():
     """Compiles or loads the engine's kernels: one evaluation of `toy_model`, and its far pass."""
     from drake_dock.core.kernels.records import pack
-    from drake_dock.core.kernels.witness_values import due_far, far_witness, regular_rates
+    from drake_dock.core.kernels.witness_values import (due_far, far_witness, regular_rates,
+                                                        witness_now)
     m, s, x = toy_model()
     mp, sp = pack(m), pack(s)
     nbush, k, F = m.bush_frames.shape[0], s.code.shape[0], m.frame_body.shape[0]
@@ -282,5 +283,8 @@ def warm():
     far_witness(mp, sp, buf)
     due_far(mp, sp, buf)
     n_near = s.near.shape[0]
-    regular_rates(mp, buf[int(m.sizes[Z_NX]):int(m.sizes[Z_NX]) + n_near * K.ROW].reshape(
-        (n_near, K.ROW)), s.near, np.arange(n_near), np.empty(n_near))
+    rows = buf[int(m.sizes[Z_NX]):int(m.sizes[Z_NX]) + n_near * K.ROW].reshape((n_near, K.ROW))
+    regular_rates(mp, rows, s.near, np.arange(n_near), np.empty(n_near))
+    at = np.arange(n_near, dtype=np.intp)
+    witness_now(mp, rows.ravel(), rows, at, at, at * K.ROW + K.GAP, at * K.ROW + K.VN, at,
+                s.near.astype(np.int64), at.astype(np.int64))

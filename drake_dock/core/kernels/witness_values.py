@@ -108,6 +108,38 @@ def regular_rates(mp, rows, pairs, slots, out):
 
 
 @njit(cache=True)
+def witness_now(mp, wv, rows, flat, gap_pos, g_flat, gap_flat, regular_pos, regular_pair,
+                regular_slot):
+    """The armed pair witnesses' values w (the raveled witness values ``wv`` at ``flat``) and
+    rates d, NaN where unknown: a tracked couple's gap witness (places ``gap_pos``; its gap and
+    v_n in the raveled couple ``rows`` at ``g_flat``, ``gap_flat``) has g' = v_n while the gap
+    is positive; the regular witnesses (places ``regular_pos``, pairs ``regular_pair``, rows
+    at ``regular_slot``) have `regular_rates`. Also the places of the gap witnesses whose gap
+    is not positive (their witness is v_n; its rate g'' is for the caller). Returns (w, d,
+    turning)."""
+    n = flat.shape[0]
+    w, d = np.empty(n), np.full(n, np.nan)
+    for k in range(n):
+        w[k] = wv[flat[k]]
+    flat_rows = rows.ravel()
+    turning = np.empty(gap_pos.shape[0], dtype=np.intp)
+    nt = 0
+    for m_ in range(gap_pos.shape[0]):
+        g = flat_rows[g_flat[m_]]
+        if g > 0.0:
+            d[gap_pos[m_]] = flat_rows[gap_flat[m_]]
+        elif g <= 0.0:
+            turning[nt] = gap_pos[m_]
+            nt += 1
+    if regular_pos.shape[0]:
+        rates = np.empty(regular_pos.shape[0])
+        regular_rates(mp, rows, regular_pair, regular_slot, rates)
+        for k in range(regular_pos.shape[0]):
+            d[regular_pos[k]] = rates[k]
+    return w, d, turning[:nt]
+
+
+@njit(cache=True)
 def far_bounds(m, s, R, o, bound):
     """The far pairs' travel bound (Sect. 5.1; `drake_dock.systems.far_pairs`):
     |delta(X21 c1)| + |delta R21|_2 r1 since their last seek, inf for a pair never sought;
