@@ -270,7 +270,8 @@ def toy_model():
 
 
 def warm():
-    """Compiles or loads the engine's kernels: one evaluation of `toy_model`, and its far pass."""
+    """Compiles or loads the engine's kernels: one evaluation of `toy_model`, its far pass and
+    its witness kernels (`regular_rates`, `witness_now`)."""
     from drake_dock.core.kernels.records import pack
     from drake_dock.core.kernels.witness_values import (due_far, far_witness, regular_rates,
                                                         witness_now)
@@ -285,6 +286,6 @@ def warm():
     n_near = s.near.shape[0]
     rows = buf[int(m.sizes[Z_NX]):int(m.sizes[Z_NX]) + n_near * K.ROW].reshape((n_near, K.ROW))
     regular_rates(mp, rows, s.near, np.arange(n_near), np.empty(n_near))
-    at = np.arange(n_near, dtype=np.intp)
+    at = np.arange(n_near, dtype=np.intp)     # arguments of the run's types, values aside
     witness_now(mp, rows.ravel(), rows, at, at, at * K.ROW + K.GAP, at * K.ROW + K.VN, at,
                 s.near.astype(np.int64), at.astype(np.int64))

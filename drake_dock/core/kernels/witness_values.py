@@ -115,8 +115,8 @@ def witness_now(mp, wv, rows, flat, gap_pos, g_flat, gap_flat, regular_pos, regu
     v_n in the raveled couple ``rows`` at ``g_flat``, ``gap_flat``) has g' = v_n while the gap
     is positive; the regular witnesses (places ``regular_pos``, pairs ``regular_pair``, rows
     at ``regular_slot``) have `regular_rates`. Also the places of the gap witnesses whose gap
-    is not positive (their witness is v_n; its rate g'' is for the caller). Returns (w, d,
-    turning)."""
+    is at or below zero (their witness is v_n; its rate g'' is for the caller; a NaN gap is
+    neither, its rate stays NaN). Returns (w, d, turning)."""
     n = flat.shape[0]
     w, d = np.empty(n), np.full(n, np.nan)
     for k in range(n):
