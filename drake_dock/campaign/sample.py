@@ -28,6 +28,7 @@ from drake_dock.docking.report.results import (energy_ledger, final_misalignment
                                                thrust_impulses, timeseries)
 from drake_dock.docking.scenario.validation import validate
 from drake_dock.errors import DrakeDockError, NumericalError
+from drake_dock.systems.simulator import collector_relaxed
 
 # The row's columns after the sample, its seed and the varied inputs (`Field.columns`).
 RESULT_COLUMNS = {
@@ -141,14 +142,15 @@ def scenario_row(scenario, *, reuse: bool = True) -> dict:
 
 
 def run_sample(base, spec, *, reuse: bool = True) -> dict:
-    """The row of one sample ``spec = (sample, seed, {path: value})`` (`scenario_row`).
-    ``reuse``: run on this process's cached Diagram (`diagram_for`); otherwise build a fresh
-    one."""
+    """The row of one sample ``spec = (sample, seed, {path: value})`` (`scenario_row`), with
+    Python's cyclic collector relaxed throughout (`collector_relaxed`). ``reuse``: run on this
+    process's cached Diagram (`diagram_for`); otherwise build a fresh one."""
     sample, seed, values = spec
     row = {"sample": int(sample), "seed": int(seed), **input_columns(values)}
     t0 = time.perf_counter()
     try:
-        row.update(scenario_row(sample_scenario(base, values), reuse=reuse))
+        with collector_relaxed():   # the placement and the row's reduction too, not the run only
+            row.update(scenario_row(sample_scenario(base, values), reuse=reuse))
     except DrakeDockError as e:
         _DIAGRAMS.clear()            # nothing of a failed run is kept
         _SCENES.clear()

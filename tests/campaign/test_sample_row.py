@@ -2,7 +2,8 @@
 per-couple arrays) against two independent computations: its Stewart columns against the
 peaks of `drake_dock.docking.model.plant.stewart_history` (Drake's bushing on its own context, from
 the recorded plant states), and its other columns against the run's `summary` (from the full
-timeseries: the couple table's normal forces, the loads and the ledger)."""
+timeseries: the couple table's normal forces, the loads and the ledger); and a sample's row is
+made with Python's cyclic collector relaxed."""
 import math
 from pathlib import Path
 
@@ -45,3 +46,22 @@ def test_the_row_is_the_summarys(run):
         fm["axial_m"], fm["lateral_m"], fm["tilt_deg"])
     assert row["momentum_drift"] == s["momentum_drift_relative"]["linear"]
     assert row["energy_closure"] == s["energy_ledger"]["closure_error_relative"]
+
+
+def test_a_sample_relaxes_the_collector_throughout_and_restores_it(monkeypatch):
+    """`run_sample` holds Python's cyclic collector at `RUN_GC_THRESHOLD` or above over the
+    whole row (read inside it), and gives back the thresholds it found."""
+    import gc
+    import drake_dock.campaign.sample as sample
+    from drake_dock.systems.simulator import RUN_GC_THRESHOLD
+    seen = []
+    monkeypatch.setattr(sample, "scenario_row",
+                        lambda scenario, reuse=True: seen.append(gc.get_threshold()) or {})
+    old = gc.get_threshold()
+    try:
+        gc.set_threshold(700, 10, 10)
+        sample.run_sample(load_scenario(MODELS / "paper_example.yaml"), (0, 1, {}))
+        after = gc.get_threshold()
+    finally:
+        gc.set_threshold(*old)
+    assert seen == [(RUN_GC_THRESHOLD, 10, 10)] and after == (700, 10, 10)
