@@ -226,14 +226,33 @@ def _need_out(out, what):
 
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
-    if args.command == "study":
-        if args.which is None:
-            print(studies_text())
-            return 0
-        return _with_kernels(args, _study)
-    if args.command == "campaign":
-        return _campaign(args)
-    return _with_kernels(args, _run_command)
+    try:
+        if args.command == "study":
+            if args.which is None:
+                print(studies_text())
+                return 0
+            return _with_kernels(args, _study)
+        if args.command == "campaign":
+            return _campaign(args)
+        return _with_kernels(args, _run_command)
+    except (KeyboardInterrupt, ImportError) as e:   # Ctrl-C before a command's own handling
+        if not _by_ctrl_c(e):
+            raise
+        print(_error("interrupted", "stopped by Ctrl-C"), file=sys.stderr)
+        return 130
+
+
+def _by_ctrl_c(e) -> bool:
+    """Whether the exception ``e`` is Ctrl-C or follows from it: Ctrl-C inside an extension
+    module's initialisation (pydrake's, during an import) surfaces as an ImportError from
+    KeyboardInterrupt."""
+    seen = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return False
 
 
 def _start_kernels_or_none():
@@ -253,7 +272,9 @@ def _with_kernels(args, command) -> int:
         kernels = _start_kernels_or_none()
     try:
         return command(args, kernels)
-    except KeyboardInterrupt:           # the output directory is written whole or not at all
+    except (KeyboardInterrupt, ImportError) as e:   # the output directory is written whole or
+        if not _by_ctrl_c(e):                       # not at all
+            raise
         print(_error("interrupted", f"stopped by Ctrl-C; nothing written to {args.out}"
                      if args.out else "stopped by Ctrl-C"), file=sys.stderr)
         return 130
@@ -316,6 +337,8 @@ def _guarded(work, out, finish=None) -> int:
     except DrakeDockError as e:
         return _failed(3, "numerical failure", e, caught, finish)
     except Exception as e:  # noqa: BLE001 - the last resort of a command line
+        if _by_ctrl_c(e):
+            raise KeyboardInterrupt from e      # the caller says so
         kind = "I/O error" if isinstance(e, OSError) else "internal error"
         return _failed(3, f"{kind} ({type(e).__name__})", str(e)[:2000] or repr(e), caught,
                        finish)

@@ -129,19 +129,22 @@ def _workers(jobs: int) -> list[subprocess.Popen]:
     """``jobs`` processes ``python -m drake_dock.core.kernels --worker`` on this process's
     drake_dock sources and cache base: each compiles the units named on its stdin, one a line,
     and answers each with a line "NAME SECONDS" (the numba it warmed up and the kernels it
-    compiled serve its next unit)."""
+    compiled serve its next unit). Each runs in a session of its own: Ctrl-C at a terminal
+    reaches this process only, which stops them (`Preparation.cancel`), even while they are
+    still importing numba."""
     path = os.pathsep.join([str(cc._PACKAGE.parent)] + [p for p in [os.environ.get(
         "PYTHONPATH")] if p])
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cc.cache_dir().parent), PYTHONPATH=path)
     return [subprocess.Popen([sys.executable, "-m", cc.PACKAGE, "--worker"], env=env,
-                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+                             stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+                             start_new_session=True)
             for _ in range(jobs)]
 
 
 def serve(lines, out) -> None:
     """A worker's loop: compiles each unit named in ``lines`` and writes "NAME SECONDS". Its
-    parent owns it: Ctrl-C (which reaches the whole process group) is the parent's to handle,
-    and a parent gone (its pipe closed) ends the loop quietly."""
+    parent owns it: Ctrl-C is the parent's to handle (a SIGINT sent here all the same is
+    ignored), and a parent gone (its pipe closed) ends the loop quietly."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         for line in lines:
