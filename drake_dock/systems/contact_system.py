@@ -258,20 +258,16 @@ class RigidContactSystem(WitnessFunctions, WitnessPredictions, LeafSystem):
         value.set_value(self._lookup(context))
 
     def _lookup(self, context) -> Evaluation:
-        """The evaluation at the context, from the memo when Drake asked for it before (the
-        path of every derivative: its steps inlined)."""
-        t = context.get_time()
-        modes = context.get_abstract_state(self._mode_index).get_value()
+        t, modes = context.get_time(), self.get_modes(context)
         x = context.get_continuous_state_vector().CopyToVector()
-        tau = self.input_force(context, x, modes)
+        return self._evaluation_at(t, x, modes, self.input_force(context, x, modes))
+
+    def _evaluation_at(self, t, x, modes, tau) -> Evaluation:
+        """The evaluation at (t, x, modes, tau), from the memo when Drake asked for it before
+        (every derivative's path: no closure)."""
         key = (t, x.tobytes(), modes_key(modes), tau.tobytes())
         E = self._evaluations.find(key)
         return self._evaluations.put(key, self._evaluate(t, x, modes, tau)) if E is None else E
-
-    def _evaluation_at(self, t, x, modes, tau) -> Evaluation:
-        """The evaluation at (t, x, modes, tau), from the memo when Drake asked for it before."""
-        key = (t, x.tobytes(), modes_key(modes), tau.tobytes())
-        return self._evaluations.get(key, lambda: self._evaluate(t, x, modes, tau))
 
     def _evaluate(self, t, x, modes, tau) -> Evaluation:
         t0 = perf_counter()

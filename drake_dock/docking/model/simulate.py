@@ -87,38 +87,30 @@ class Record:
         COUPLE_OUTPUT_SIZE) its couple outputs (left out with ``couples`` False: the largest
         part), ``lambda_n_max`` (N,) the largest normal force, ``energy`` (N, energy names),
         ``bushings`` (N, bushings, 12: deflection, roll-pitch-yaw, force on the APDS frame,
-        world), ``ring_distance`` (N,)."""
-        if self._derived is None and not couples and self._small is not None:
-            small = [v if v is not None else self._small_of(
-                self.dd.contact.engine.evaluate(self.t[k], self.states[k], self.modes[k],
-                                                self.tau[k]), self.modes[k], self.states[k])
-                for k, v in enumerate(self._small)]
-            lam, energy, bush, ring = zip(*small) if small else ((),) * 4
+        world), ``ring_distance`` (N,); a lean record's step-end samples without couples from
+        the values it kept."""
+        if self._derived is None or (couples and "couples" not in self._derived):
             contact = self.dd.contact
+            n = len(self.t)
+            kept = self._small if self._small is not None else [None] * n
+            C = np.zeros((n, len(contact.pairs), COUPLE_OUTPUT_SIZE)) if couples else None
+            small = []
+            for k in range(n):
+                v = kept[k]
+                if v is None or couples:
+                    E = contact.engine.evaluate(self.t[k], self.states[k], self.modes[k],
+                                                self.tau[k])
+                    if couples:
+                        C[k] = contact.couple_table_of(E)
+                    if v is None:
+                        v = self._small_of(E, self.modes[k], self.states[k])
+                small.append(v)
+            lam, energy, bush, ring = zip(*small) if small else ((),) * 4
             self._derived = dict(
                 lambda_n_max=np.array(lam, dtype=float),
                 energy=np.array(energy, dtype=float).reshape(-1, len(contact.energy_names)),
                 bushings=np.array(bush, dtype=float).reshape(-1, contact.engine.nbush, 12),
                 ring_distance=np.array(ring, dtype=float))
-        if self._derived is None or (couples and "couples" not in self._derived):
-            contact, capture = self.dd.contact, self.dd.capture
-            n = len(self.t)
-            C = np.zeros((n, len(contact.pairs), COUPLE_OUTPUT_SIZE)) if couples else None
-            lam = np.zeros(n)
-            energy = np.zeros((n, len(contact.energy_names)))
-            bush = np.zeros((n, contact.engine.nbush, 12))
-            ring = np.zeros(n)
-            for k in range(n):
-                E = contact.engine.evaluate(self.t[k], self.states[k], self.modes[k],
-                                            self.tau[k])
-                if couples:
-                    C[k] = contact.couple_table_of(E)
-                lam[k] = E.lam_n.max(initial=0.0)
-                energy[k] = contact.energy(E, self.modes[k])
-                bush[k] = E.bushings
-                ring[k] = capture.misalignment_of(self.states[k][:contact.nq])[0]
-            self._derived = dict(lambda_n_max=lam, energy=energy, bushings=bush,
-                                 ring_distance=ring)
             if couples:
                 self._derived["couples"] = C
         return self._derived
