@@ -82,15 +82,15 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
     pa, pb = P1.patch, P2.patch
     (k1, q1), (k2, q2) = _specs(pa, pb)
     R1, o1 = _pose(P1)
-    R2, o2 = _pose(P2)
+    A, B = K.Placed(k1, q1, R1, o1), K.Placed(k2, q2, *_pose(P2))
     rtol = -1.0 if distance_rtol is None else float(distance_rtol)
     if pa.dim == 1:
-        D1, D2 = pa.kernel_domain(n_coarse), pb.kernel_domain(n_coarse)
-        return _seek_curve(k1, q1, R1, o1, D1, k2, q2, R2, o2, D2, levels, n_fine, candidates,
+        return _seek_curve(A, K.Domain(*pa.kernel_domain(n_coarse)), B,
+                           K.Domain(*pb.kernel_domain(n_coarse)), levels, n_fine, candidates,
                            rtol, float(rtol_beyond))
     if pb.dim == 1:
         x = R1 @ pa.p + o1
-        s, it, x2, concave = K.point_curve(x, k2, q2, R2, o2, *pb.kernel_domain(POINT_CURVE_GRID),
+        s, it, x2, concave = K.point_curve(x, B, K.Domain(*pb.kernel_domain(POINT_CURVE_GRID)),
                                            POINT_CURVE_ITER)
         # A potential contact only on the curve's concave side (docs/model.md, "The petal
         # corner").
@@ -98,8 +98,7 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
         interior = concave and is_interior(pb, u2)
     else:
         u2, it, status, x, x2, interior = K.point_surface(
-            q1, R1, o1, k2, q2, R2, o2, *pb.kernel_domain(POINT_SURFACE_GRID), rtol,
-            float(rtol_beyond))
+            A, B, K.Domain(*pb.kernel_domain(POINT_SURFACE_GRID)), rtol, float(rtol_beyond))
     centre = float(np.linalg.norm(x - x2))
     if status and centre > K.CREEP_TOUCH:
         raise _not_converged(centre)
@@ -110,12 +109,11 @@ def seek_couple(P1, P2, *, distance_rtol=None, rtol_beyond=0.0, n_coarse=12, lev
     return Couple(np.zeros(0), u2, x, x2, dist, int(it), bool(interior))
 
 
-def _seek_curve(k1, q1, R1, o1, D1, k2, q2, R2, o2, D2, levels, n_fine, candidates, rtol,
-                rtol_beyond) -> Couple:
-    """`seek_couple` of a curve (kind k1, parameters q1, pose R1, o1, `_domain` D1) against a
-    curve or a surface (k2, q2, R2, o2, D2) by `kernels.seek.seek`, creeping on where needed."""
-    U, its, status, X1, X2, interior = K.seek(k1, q1, R1, o1, *D1, k2, q2, R2, o2, *D2, levels,
-                                              n_fine, candidates, rtol, rtol_beyond)
+def _seek_curve(A, D1, B, D2, levels, n_fine, candidates, rtol, rtol_beyond) -> Couple:
+    """`seek_couple` of a curve (`kernels.seek.Placed` A over its `Domain` D1) against a curve
+    or a surface (B, D2) by `kernels.seek.seek`, creeping on where needed."""
+    U, its, status, X1, X2, interior = K.seek(A, D1, B, D2, levels, n_fine, candidates, rtol,
+                                              rtol_beyond)
     # The nearest couple. A start whose Newton did not converge (it creeps: a nearly flat
     # valley, e.g. a ring's circle almost parallel to the other ring's face, or a circle that
     # touches or pierces a face, where the minima form a curve) counts where it is not the
@@ -130,7 +128,7 @@ def _seek_curve(k1, q1, R1, o1, D1, k2, q2, R2, o2, D2, levels, n_fine, candidat
     if status[best] and dist > K.CREEP_TOUCH:
         for c in np.flatnonzero(status):
             U[c], it, status[c], X1[c], X2[c], interior[c] = K.creep_on(
-                k1, q1, R1, o1, *D1[:3], k2, q2, R2, o2, *D2[:3], U[c], rtol, rtol_beyond)
+                A, D1, B, D2, U[c], rtol, rtol_beyond)
             its[c] += it
         best, dist = _nearest(X1, X2)
         if status[best] and dist > K.CREEP_TOUCH:

@@ -209,11 +209,10 @@ def test_a_creeping_nearest_start_is_continued_to_the_minimum(case):
     P2 = posed(pair.patch2, np.array(case["R2"]), np.array(case["o2"]))
     rtol, beyond = case["kw"]
     # The case is one the first CLOSEST_MAX_ITER iterations leave unconverged, nearest.
-    R1, o1 = S._pose(P1)
-    R2, o2 = S._pose(P2)
-    _, _, status, X1, X2, _ = K.seek(*kernel_spec(P1.patch), R1, o1, *P1.patch.kernel_domain(12),
-                                     *kernel_spec(P2.patch), R2, o2, *P2.patch.kernel_domain(12),
-                                     2, 21, 3, rtol, beyond)
+    _, _, status, X1, X2, _ = K.seek(K.Placed(*kernel_spec(P1.patch), *S._pose(P1)),
+                                     K.Domain(*P1.patch.kernel_domain(12)),
+                                     K.Placed(*kernel_spec(P2.patch), *S._pose(P2)),
+                                     K.Domain(*P2.patch.kernel_domain(12)), 2, 21, 3, rtol, beyond)
     d = np.linalg.norm(X1 - X2, axis=1)
     assert status[np.argmin(d)] == 1 and d.min() > CREEP_TOUCH
     got = seek_couple(P1, P2, distance_rtol=rtol, rtol_beyond=beyond)

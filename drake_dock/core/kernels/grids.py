@@ -4,10 +4,33 @@ refinement by finer local grids (`hierarchical`). The grids evaluate points only
 (`jets.position`: the jet's r with the same operations)."""
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
 from drake_dock.core.kernels.jets import PETAL, petal_point, petal_row, position
+
+
+class Placed(NamedTuple):
+    """A patch placed in the world, x = R r(u) + o (Eq. 20): its kernel kind and parameters
+    (`jets.patch_spec`; `seek.POINT` and the point's coordinates for a point), its frame's
+    rotation R (3, 3) and origin o (3,)."""
+
+    kind: int
+    prm: np.ndarray
+    R: np.ndarray
+    o: np.ndarray
+
+
+class Domain(NamedTuple):
+    """A patch's parameters as the seek takes them (`Patch.kernel_domain`): the lower and
+    upper bounds and periodic flags per parameter, and the coarse grid (a point a row)."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+    periodic: np.ndarray
+    grid: np.ndarray
 
 @njit(cache=True)
 def _frame(R, o):
@@ -119,13 +142,17 @@ def within(u, c, w):
 
 
 @njit(cache=True)
-def hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
-                 levels, n_fine, candidates):
-    """Sect. 5.1's grids: up to ``candidates`` start couples (C, dim1 + dim2), best first. The
-    best couples of the coarse grids U1, U2 that lie more than two cells apart in one of the
-    patches (a nearly flat distance, a ring almost coaxial with a cone, can put the best cell
-    in the wrong valley), each refined by ``levels`` grids of ``n_fine`` points spanning +-2
-    cells of the previous level around its best point."""
+def hierarchical(a, da, b, db, levels, n_fine, candidates):
+    """Sect. 5.1's grids for the `Placed` patches a and b over their `Domain`s da and db: up to
+    ``candidates`` start couples (C, dim1 + dim2), best first. The best couples of the coarse
+    grids that lie more than two cells apart in one of the patches (a nearly flat distance, a
+    ring almost coaxial with a cone, can put the best cell in the wrong valley), each refined
+    by ``levels`` grids of ``n_fine`` points spanning +-2 cells of the previous level around
+    its best point."""
+    k1, p1, R1, o1 = a
+    lo1, hi1, per1, U1 = da
+    k2, p2, R2, o2 = b
+    lo2, hi2, per2, U2 = db
     n_coarse1 = round(U1.shape[0] ** (1.0 / U1.shape[1]))
     n_coarse2 = round(U2.shape[0] ** (1.0 / U2.shape[1]))
     h1 = (hi1 - lo1) / (n_coarse1 - 1)

@@ -17,11 +17,12 @@ and creeping iterations that `newton` follows.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from drake_dock.core.kernels.grids import hierarchical, positions, within
+from drake_dock.core.kernels.grids import Domain, Placed, hierarchical, positions, within
 from drake_dock.core.kernels.jets import CIRCLE, jet, position
 
 # A point patch (patch 1 of a point pair): its parameters are the point's coordinates.
@@ -107,18 +108,29 @@ def world_point(kind, prm, R, o, u0, u1):
             R[2, 0] * r[0] + R[2, 1] * r[1] + R[2, 2] * r[2] + o[2])
 
 
+class Bounds(NamedTuple):
+    """A couple's parameters as `newton` takes them: lower and upper bounds, periodic flags
+    and scales (the spans, floored at 1e-300)."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+    periodic: np.ndarray
+    scale: np.ndarray
+
+
 @njit(cache=True)
-def _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, n1):
-    """(x1 - x2, x1, x2) at the couple u, patch 1 a curve (n1 = 1) or a `POINT` (n1 = 0)."""
-    x1 = world_point(k1, p1, R1, o1, u[0], 0.0)
-    x2 = world_point(k2, p2, R2, o2, u[n1], u[n1 + 1] if u.shape[0] == n1 + 2 else 0.0)
+def _gap(a, b, u, n1):
+    """(x1 - x2, x1, x2) at the couple u of the `Placed` patches a and b, patch 1 a curve
+    (n1 = 1) or a `POINT` (n1 = 0)."""
+    x1 = world_point(a.kind, a.prm, a.R, a.o, u[0], 0.0)
+    x2 = world_point(b.kind, b.prm, b.R, b.o, u[n1], u[n1 + 1] if u.shape[0] == n1 + 2 else 0.0)
     return (x1[0] - x2[0], x1[1] - x2[1], x1[2] - x2[2]), x1, x2
 
 
 @njit(cache=True)
-def newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale, tol, max_iter,
-           distance_rtol, rtol_beyond):
-    """Bounded Newton on f(u) = 0.5 |r1(u1) - r2(u2)|^2 from u, patch 1 a curve or a `POINT`:
+def newton(pa, pb, u, bounds, tol, max_iter, distance_rtol, rtol_beyond):
+    """Bounded Newton on f(u) = 0.5 |r1(u1) - r2(u2)|^2 from u, for the `Placed` patches pa
+    and pb (patch 1 a curve or a `POINT`) within the `Bounds` of their couple:
     (u, iterations, status), status 0 converged, 1 not converged with the projected gradient
     above 1e-10 |J| |d| (the caller names the couple). Parameters at a domain end with the
     gradient pushing outwards are held (an active set with a band, Bertsekas' projected
@@ -127,6 +139,9 @@ def newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale, tol
     on its way, and is backtracked on f. With ``distance_rtol`` >= 0 (< 0: none) the iteration
     also ends when a step shortens the distance by less than that fraction of it, while the
     distance exceeds ``rtol_beyond``."""
+    k1, p1, R1, o1 = pa
+    k2, p2, R2, o2 = pb
+    lower, upper, periodic, scale = bounds
     n1 = 0 if k1 == POINT else 1
     n = u.shape[0]
     n2 = n - n1
@@ -137,7 +152,7 @@ def newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale, tol
     converged = False
     for it in range(1, max_iter + 1):
         j2 = jet(k2, p2, u[n1], u[n1 + 1] if n2 == 2 else 0.0)
-        _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, n1)
+        _, x1, x2 = _gap(pa, pb, u, n1)
         d = np.array([x1[0] - x2[0], x1[1] - x2[1], x1[2] - x2[2]])
         # J = [T1, -T2] (world tangents); g = J^T d; H = J^T J + diag(d . K1, -d . K2).
         cols = np.empty((n, 3))
@@ -219,7 +234,7 @@ def newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale, tol
             for i in range(n):
                 a = u[i] + t * step[i]
                 un[i] = a if periodic[i] else min(max(a, lower[i]), upper[i])
-            dn = _gap(k1, p1, R1, o1, k2, p2, R2, o2, un, n1)[0]
+            dn = _gap(pa, pb, un, n1)[0]
             fn = 0.5 * (dn[0] * dn[0] + dn[1] * dn[1] + dn[2] * dn[2])
             if fn <= f0 + 1e-4 * (g @ (un - u)):
                 accepted = True
@@ -249,24 +264,25 @@ def newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale, tol
 
 
 @njit(cache=True)
-def _couple_domain(lo1, hi1, per1, lo2, hi2, per2):
-    """A couple's bounds, periodic flags and scales (its spans, floored at 1e-300) from its
-    two patches' domains, as `newton` takes them."""
-    lower, upper = np.concatenate((lo1, lo2)), np.concatenate((hi1, hi2))
-    return lower, upper, np.concatenate((per1, per2)), np.maximum(upper - lower, 1e-300)
+def _couple_domain(da, db):
+    """The `Bounds` of a couple from its two patches' `Domain`s."""
+    lower, upper = np.concatenate((da.lower, db.lower)), np.concatenate((da.upper, db.upper))
+    return Bounds(lower, upper, np.concatenate((da.periodic, db.periodic)),
+                  np.maximum(upper - lower, 1e-300))
 
 
 @njit(cache=True)
-def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2, levels, n_fine,
-         candidates, distance_rtol, rtol_beyond):
-    """The start couples of `hierarchical`, each finished by `newton` unless an earlier one
-    started within 1e-9 of the spans (one finish serves both): the finished couples u (C, n),
+def seek(a, da, b, db, levels, n_fine, candidates, distance_rtol, rtol_beyond):
+    """A curve's seek, of the `Placed` patches a (a curve) and b (a curve or a surface) over
+    their `Domain`s da and db: the start couples of `hierarchical`, each finished by `newton`
+    unless an earlier one started within 1e-9 of the spans (one finish serves both): the
+    finished couples u (C, n),
     their iterations, statuses, points x1, x2 (C, 3) and whether they are interior
     (`seeking.is_interior` of both parts), in the order of the starts."""
-    lower, upper, periodic, scale = _couple_domain(lo1, hi1, per1, lo2, hi2, per2)
+    bounds = _couple_domain(da, db)
+    lower, upper, periodic, scale = bounds
     tol = 1e-9 * (upper - lower)
-    starts = hierarchical(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
-                          levels, n_fine, candidates)
+    starts = hierarchical(a, da, b, db, levels, n_fine, candidates)
     C, n = starts.shape
     U, its, status = np.empty((C, n)), np.zeros(C, dtype=np.int64), np.zeros(C, dtype=np.int64)
     X1, X2 = np.empty((C, 3)), np.empty((C, 3))
@@ -280,10 +296,9 @@ def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
         if dup:
             continue
         started[c] = True
-        u, its[m], status[m] = newton(k1, p1, R1, o1, k2, p2, R2, o2, starts[c], lower, upper,
-                                      periodic, scale, 1e-14, CLOSEST_MAX_ITER, distance_rtol,
-                                      rtol_beyond)
-        _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, 1)
+        u, its[m], status[m] = newton(a, b, starts[c], bounds, 1e-14, CLOSEST_MAX_ITER,
+                                      distance_rtol, rtol_beyond)
+        _, x1, x2 = _gap(a, b, u, 1)
         U[m] = u
         X1[m, 0], X1[m, 1], X1[m, 2] = x1
         X2[m, 0], X2[m, 1], X2[m, 2] = x2
@@ -294,15 +309,14 @@ def seek(k1, p1, R1, o1, lo1, hi1, per1, U1, k2, p2, R2, o2, lo2, hi2, per2, U2,
 
 
 @njit(cache=True)
-def creep_on(k1, p1, R1, o1, lo1, hi1, per1, k2, p2, R2, o2, lo2, hi2, per2, u, distance_rtol,
-             rtol_beyond):
-    """`newton` continued from a finished couple u of `seek` that did not converge, with the
-    seek's bounds, scales and tolerances, for at most CREEP_MAX_ITER further iterations: (u,
-    iterations, status, x1 (3,), x2 (3,), interior), as one couple of `seek`."""
-    lower, upper, periodic, scale = _couple_domain(lo1, hi1, per1, lo2, hi2, per2)
-    u, it, status = newton(k1, p1, R1, o1, k2, p2, R2, o2, u, lower, upper, periodic, scale,
-                           1e-14, CREEP_MAX_ITER, distance_rtol, rtol_beyond)
-    _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, 1)
+def creep_on(a, da, b, db, u, distance_rtol, rtol_beyond):
+    """`newton` continued from a finished couple u of `seek` (its arguments) that did not
+    converge, with the seek's bounds, scales and tolerances, for at most CREEP_MAX_ITER further
+    iterations: (u, iterations, status, x1 (3,), x2 (3,), interior), as one couple of `seek`."""
+    bounds = _couple_domain(da, db)
+    lower, upper, periodic, scale = bounds
+    u, it, status = newton(a, b, u, bounds, 1e-14, CREEP_MAX_ITER, distance_rtol, rtol_beyond)
+    _, x1, x2 = _gap(a, b, u, 1)
     return (u, it, status, np.array([x1[0], x1[1], x1[2]]), np.array([x2[0], x2[1], x2[2]]),
             _interior(u, lower, upper, periodic))
 
@@ -319,34 +333,39 @@ def _interior(u, lower, upper, periodic):
 
 
 @njit(cache=True)
-def point_surface(pt, R1, o1, k2, p2, R2, o2, lo2, hi2, per2, U2, distance_rtol, rtol_beyond):
-    """The couple of the point pt (its frame's coordinates, frame (R1, o1)) and a surface: the
-    nearest point of the grid U2, finished by `newton`. Returns (u (2,), iterations, status,
-    x1, x2 (3,), interior)."""
+def point_surface(a, b, db, distance_rtol, rtol_beyond):
+    """The couple of the `Placed` point a (kind `POINT`: its frame's coordinates first in its
+    parameters) and the `Placed` surface b over its `Domain` db: the nearest point of the
+    domain's grid, finished by `newton`. Returns (u (2,), iterations, status, x1, x2 (3,),
+    interior)."""
+    k2, p2, R2, o2 = b
+    lo2, hi2, per2, U2 = db
     X2 = positions(k2, p2, R2, o2, U2)
-    x = world_point(POINT, pt, R1, o1, 0.0, 0.0)
-    best, a = np.inf, 0
+    x = world_point(POINT, a.prm, a.R, a.o, 0.0, 0.0)
+    best, i_best = np.inf, 0
     for i in range(X2.shape[0]):
         e0, e1, e2 = X2[i, 0] - x[0], X2[i, 1] - x[1], X2[i, 2] - x[2]
         dd = e0 * e0 + e1 * e1 + e2 * e2
         if dd < best:
-            best, a = dd, i
-    scale = np.maximum(hi2 - lo2, 1e-300)
-    u, it, status = newton(POINT, pt, R1, o1, k2, p2, R2, o2, U2[a].copy(), lo2, hi2, per2,
-                           scale, 1e-14, CLOSEST_MAX_ITER, distance_rtol, rtol_beyond)
-    _, x1, x2 = _gap(POINT, pt, R1, o1, k2, p2, R2, o2, u, 0)
+            best, i_best = dd, i
+    bounds = Bounds(lo2, hi2, per2, np.maximum(hi2 - lo2, 1e-300))
+    u, it, status = newton(a, b, U2[i_best].copy(), bounds, 1e-14, CLOSEST_MAX_ITER,
+                           distance_rtol, rtol_beyond)
+    _, x1, x2 = _gap(a, b, u, 0)
     return (u, it, status, np.array([x1[0], x1[1], x1[2]]), np.array([x2[0], x2[1], x2[2]]),
             _interior(u, lo2, hi2, per2))
 
 
 @njit(cache=True)
-def point_curve(x, k2, p2, R2, o2, lo, hi, periodic, U, max_iter):
-    """The couple of the world point x and a curve (frame (R2, o2)): the s of least
+def point_curve(x, b, db, max_iter):
+    """The couple of the world point x and the `Placed` curve b over its `Domain` db: the s of least
     |x - c(s)|, for a full circle (a periodic CIRCLE) its polar angle in the curve's frame (0 on
     the axis), else from the nearest point of the grid U by Newton on F = t2 . d, clipped to the
     domain, for at most ``max_iter`` steps (stopping where F' >= 0, not a minimum). Returns (s,
     iterations, x2 (3,), concave): ``concave`` where the point lies on the curve's concave side
     (d along its curvature direction; true where the curve is straight)."""
+    k2, p2, R2, o2 = b
+    lo, hi, periodic, U = db
     e = (x[0] - o2[0], x[1] - o2[1], x[2] - o2[2])
     q = (R2[0, 0] * e[0] + R2[1, 0] * e[1] + R2[2, 0] * e[2],
          R2[0, 1] * e[0] + R2[1, 1] * e[1] + R2[2, 1] * e[2],
@@ -400,12 +419,16 @@ def warm():
 
     seg = Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1))
     plane = PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0))
+    def placed(patch):
+        return Placed(*patch_spec(patch), eye, z)
+
     for c1, c2 in ((seg, Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0))), (Circle(0.3, 0.1), plane)):
-        U = seek(*patch_spec(c1), eye, z, *c1.kernel_domain(12), *patch_spec(c2), eye, z,
-                 *c2.kernel_domain(12), 2, 21, 3, -1.0, 0.0)[0]
-        creep_on(*patch_spec(c1), eye, z, *c1.kernel_domain(12)[:3], *patch_spec(c2), eye, z,
-                 *c2.kernel_domain(12)[:3], U[0], -1.0, 0.0)
+        args = (placed(c1), Domain(*c1.kernel_domain(12)), placed(c2),
+                Domain(*c2.kernel_domain(12)))
+        U = seek(*args, 2, 21, 3, -1.0, 0.0)[0]
+        creep_on(*args, U[0], -1.0, 0.0)
     pt = np.array([0.1, 0.2, 0.3, 0.01, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-    point_surface(pt, eye, z, *patch_spec(plane), eye, z, *plane.kernel_domain(16), -1.0, 0.0)
+    point_surface(Placed(POINT, pt, eye, z), placed(plane), Domain(*plane.kernel_domain(16)),
+                  -1.0, 0.0)
     for curve in (Circle(0.3), Arc(0.3, 0.0, (0.2, 1.4))):
-        point_curve(z, *patch_spec(curve), eye, z, *curve.kernel_domain(64), 30)
+        point_curve(z, placed(curve), Domain(*curve.kernel_domain(64)), 30)
