@@ -22,7 +22,7 @@ import numpy as np
 from numba import njit
 
 from drake_dock.core import constraints as ref
-from drake_dock.core.kernels.slide_start import slide_start
+from drake_dock.core.kernels.slide_start import Outputs, Problem, slide_start
 from drake_dock.core.kernels.solve import (CODE, DETACH, INDETERMINATE, NAME, NONE_CONSISTENT,
                                            NONFINITE, OK, SLIDE, STICK, accelerations,
                                            solve_modes, stabilised)
@@ -124,8 +124,8 @@ def _select(Minv, a0, W, bias, gap, vn, vt, mu, mu_s, avoid, v_slip, omega, rtol
                     dirs[i, 0], dirs[i, 1] = g0 / ng, g1 / ng
                 else:
                     dirs[i, 0], dirs[i, 1] = 1.0, 0.0
-            st, ok = slide_start(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting,
-                                  omega, vdot, lam_n, lam_t, gf, gdd, at)
+            st, ok = slide_start(Problem(Minv, a0, W, bias, gap, vn, mu, mu_s), modes, dirs,
+                                 starting, omega, Outputs(vdot, lam_n, lam_t, gf, gdd, at))
             if st != OK or not ok:
                 continue
         else:

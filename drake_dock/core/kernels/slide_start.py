@@ -4,6 +4,7 @@ of one couple's direction or the grid and Newton's method for two."""
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -12,17 +13,55 @@ from drake_dock.core import constraints as ref
 from drake_dock.core.kernels.solve import OK, SLIDE_START_ITER, accelerations, solve_modes
 
 
+class Problem(NamedTuple):
+    """The contact problem of a mode solve (`solve.solve_modes`): M^-1, the free acceleration
+    a0, the contact Jacobian W and bias accelerations, the couples' gaps, normal velocities and
+    friction coefficients."""
+
+    Minv: np.ndarray
+    a0: np.ndarray
+    W: np.ndarray
+    bias: np.ndarray
+    gap: np.ndarray
+    vn: np.ndarray
+    mu: np.ndarray
+    mu_s: np.ndarray
+
+
+class Outputs(NamedTuple):
+    """What a mode solve writes: v', lambda_n, lambda_t, the generalized contact force, and
+    the couples' normal and tangential accelerations (`solve.accelerations`)."""
+
+    vdot: np.ndarray
+    lam_n: np.ndarray
+    lam_t: np.ndarray
+    gf: np.ndarray
+    gdd: np.ndarray
+    at: np.ndarray
+
+
 @njit(cache=True)
-def slide_start(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, omega, vdot,
-                 lam_n, lam_t, gf, gdd, at):
-    """`constraints._slide_start`: the sliding directions (in dirs) of the couples starting to
-    slide, s = a_t/|a_t|, the solution in the outputs; returns (status, directions found)."""
+def _solve(P, modes, dirs, omega, out):
+    """`solve_modes` of the `Problem` P under ``modes`` and ``dirs`` into the `Outputs` out,
+    with the couples' accelerations; returns the status."""
+    st, _c = solve_modes(P.Minv, P.a0, P.W, P.bias, P.gap, P.vn, P.mu, P.mu_s, modes, dirs,
+                         omega, out.vdot, out.lam_n, out.lam_t, out.gf)
+    if st != OK:
+        return st
+    accelerations(P.W, P.bias, out.vdot, out.gdd, out.at)
+    return OK
+
+
+@njit(cache=True)
+def slide_start(P, modes, dirs, starting, omega, out):
+    """`constraints._slide_start` for the `Problem` P: the sliding directions (in dirs) of the
+    couples ``starting`` to slide, s = a_t/|a_t|, the solution in the `Outputs` out; returns
+    (status, directions found)."""
+    at = out.at
     for _ in range(SLIDE_START_ITER):
-        st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
-                             lam_t, gf)
+        st = _solve(P, modes, dirs, omega, out)
         if st != OK:
             return st, False
-        accelerations(W, bias, vdot, gdd, at)
         change = 0.0
         for i in starting:
             na = math.hypot(at[i, 0], at[i, 1])
@@ -33,35 +72,28 @@ def slide_start(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, ome
             dirs[i, 0], dirs[i, 1] = n0, n1
         if change < 1e-13:
             break
-    st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
-                         lam_t, gf)
+    st = _solve(P, modes, dirs, omega, out)
     if st != OK:
         return st, False
-    accelerations(W, bias, vdot, gdd, at)
     for i in starting:
         if not at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0:
             if len(starting) == 1:
-                return _slide_start_scan(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i,
-                                         omega, vdot, lam_n, lam_t, gf, gdd, at)
+                return _slide_start_scan(P, modes, dirs, i, omega, out)
             if len(starting) == 2:
-                return _slide_start_grid(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs,
-                                         starting, omega, vdot, lam_n, lam_t, gf, gdd, at)
+                return _slide_start_grid(P, modes, dirs, starting, omega, out)
             return OK, False
     return OK, True
 
 
 @njit(cache=True)
-def _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, th, omega, vdot,
-                   lam_n, lam_t, gf, gdd, at):
+def _slip_residual(P, modes, dirs, i, th, omega, out):
     """`constraints._slide_start_scan`'s residual: couple i sliding along theta; returns
     (status, the angle from its direction to its tangential acceleration)."""
     dirs[i, 0], dirs[i, 1] = math.cos(th), math.sin(th)
-    st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
-                         lam_t, gf)
+    st = _solve(P, modes, dirs, omega, out)
     if st != OK:
         return st, 0.0
-    accelerations(W, bias, vdot, gdd, at)
-    return OK, _slip_angle(dirs, at, i)
+    return OK, _slip_angle(dirs, out.at, i)
 
 
 @njit(cache=True)
@@ -73,18 +105,16 @@ def _slip_angle(dirs, at, i):
 
 
 @njit(cache=True)
-def _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, th, omega,
-                    vdot, lam_n, lam_t, gf, gdd, at, r, angle):
+def _slip_residuals(P, modes, dirs, starting, th, omega, out, r, angle):
     """`constraints._slide_start_grid`'s residual into r (2,): the starting couples sliding
     along th (2,); the angles between their directions and accelerations if ``angle``, else
     s x a_t. Returns the status."""
     for c in range(2):
         dirs[starting[c], 0], dirs[starting[c], 1] = math.cos(th[c]), math.sin(th[c])
-    st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
-                         lam_t, gf)
+    st = _solve(P, modes, dirs, omega, out)
     if st != OK:
         return st
-    accelerations(W, bias, vdot, gdd, at)
+    at = out.at
     for c in range(2):
         i = starting[c]
         r[c] = (_slip_angle(dirs, at, i) if angle
@@ -93,8 +123,7 @@ def _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting,
 
 
 @njit(cache=True)
-def _slide_start_grid(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, omega,
-                      vdot, lam_n, lam_t, gf, gdd, at):
+def _slide_start_grid(P, modes, dirs, starting, omega, out):
     """`constraints._slide_start_grid` (the same grid, Newton steps and test)."""
     n = ref.SLIDE_START_GRID
     th0 = np.empty(2)
@@ -106,14 +135,12 @@ def _slide_start_grid(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, startin
         for g1 in range(n):
             t[0] = th0[0] + 2.0 * math.pi * (g0 / n - 0.5)
             t[1] = th0[1] + 2.0 * math.pi * (g1 / n - 0.5)
-            st = _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting,
-                                 t, omega, vdot, lam_n, lam_t, gf, gdd, at, r, True)
+            st = _slip_residuals(P, modes, dirs, starting, t, omega, out, r, True)
             if st != OK:
                 return st, False
             if abs(r[0]) + abs(r[1]) < best:
                 best, th[0], th[1] = abs(r[0]) + abs(r[1]), t[0], t[1]
-    st = _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, th,
-                         omega, vdot, lam_n, lam_t, gf, gdd, at, r, False)
+    st = _slip_residuals(P, modes, dirs, starting, th, omega, out, r, False)
     if st != OK:
         return st, False
     J = np.empty((2, 2))
@@ -121,8 +148,7 @@ def _slide_start_grid(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, startin
         for c in range(2):
             t[0], t[1] = th[0], th[1]
             t[c] += 1e-7
-            st = _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting,
-                                 t, omega, vdot, lam_n, lam_t, gf, gdd, at, rn, False)
+            st = _slip_residuals(P, modes, dirs, starting, t, omega, out, rn, False)
             if st != OK:
                 return st, False
             J[0, c], J[1, c] = (rn[0] - r[0]) / 1e-7, (rn[1] - r[1]) / 1e-7
@@ -134,8 +160,7 @@ def _slide_start_grid(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, startin
         moved = False
         for _h in range(30):
             t[0], t[1] = th[0] + s0, th[1] + s1
-            st = _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting,
-                                 t, omega, vdot, lam_n, lam_t, gf, gdd, at, rn, False)
+            st = _slip_residuals(P, modes, dirs, starting, t, omega, out, rn, False)
             if st != OK:
                 return st, False
             if abs(rn[0]) + abs(rn[1]) < abs(r[0]) + abs(r[1]):
@@ -144,11 +169,11 @@ def _slide_start_grid(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, startin
             s0, s1 = 0.5 * s0, 0.5 * s1
         if not moved:
             break
-    st = _slip_residuals(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, starting, th,
-                         omega, vdot, lam_n, lam_t, gf, gdd, at, r, False)
+    st = _slip_residuals(P, modes, dirs, starting, th, omega, out, r, False)
     if st != OK:
         return st, False
-    small = 1e-6 * (1.0 + np.abs(vdot).max())
+    small = 1e-6 * (1.0 + np.abs(out.vdot).max())
+    at = out.at
     ok = True
     for c in range(2):
         i = starting[c]
@@ -179,16 +204,15 @@ def _nearest_bracket(ths, rs, th0, within_quarter):
 
 
 @njit(cache=True)
-def _slide_start_scan(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, omega, vdot,
-                      lam_n, lam_t, gf, gdd, at):
+def _slide_start_scan(P, modes, dirs, i, omega, out):
     """`constraints._slide_start_scan` (the same scan, brackets and bisection)."""
+    at = out.at
     th0 = math.atan2(dirs[i, 1], dirs[i, 0])
     n = ref.SLIDE_START_SCAN
     ths, rs = np.empty(n + 1), np.empty(n + 1)
     for k in range(n + 1):
         ths[k] = th0 + 2.0 * math.pi * (k / n - 0.5)
-        st, rs[k] = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i,
-                                   ths[k], omega, vdot, lam_n, lam_t, gf, gdd, at)
+        st, rs[k] = _slip_residual(P, modes, dirs, i, ths[k], omega, out)
         if st != OK:
             return st, False
     first = _nearest_bracket(ths, rs, th0, True)
@@ -201,23 +225,20 @@ def _slide_start_scan(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, omeg
         lo, hi, flo = ths[best_k], ths[best_k + 1], rs[best_k]
         for _ in range(60):
             mid = 0.5 * (lo + hi)
-            st, fm = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, mid,
-                                    omega, vdot, lam_n, lam_t, gf, gdd, at)
+            st, fm = _slip_residual(P, modes, dirs, i, mid, omega, out)
             if st != OK:
                 return st, False
             if fm * flo > 0:
                 lo, flo = mid, fm
             else:
                 hi = mid
-        st, _r = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i,
-                                0.5 * (lo + hi), omega, vdot, lam_n, lam_t, gf, gdd, at)
+        st, _r = _slip_residual(P, modes, dirs, i, 0.5 * (lo + hi), omega, out)
         if st != OK:
             return st, False
         if at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0:
             return OK, True
     if not tried:
-        st, _r = _slip_residual(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, i, th0,
-                                omega, vdot, lam_n, lam_t, gf, gdd, at)
+        st, _r = _slip_residual(P, modes, dirs, i, th0, omega, out)
         return st, False
     return OK, False
 
