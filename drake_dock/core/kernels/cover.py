@@ -4,6 +4,7 @@ the same bounds (tests compare them with the reference)."""
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -68,11 +69,11 @@ def _slab(n, w0, w1, w2, t, e, lo, hi):
 
 
 @njit(cache=True)
-def touched_steps(mc, mr, mbc, mbr, mblocks, mn, mflat, fc, fr, fbc, fbr, fblocks, fn, fflat, e,
-                  grid, slack):
+def touched_steps(moving, fixed, e, grid, slack):
     """`covers.touched_steps` of `covers.touch_set`: the steps of the decreasing grid in which
-    the moving cover (cells mc, mr, slabs mn, mflat; blocks mbc, mbr, mblocks), translated by
-    -lam e, can touch the fixed one."""
+    the `CoverCells` ``moving``, translated by -lam e, can touch the `CoverCells` ``fixed``."""
+    mc, mr, mn, mflat, mbc, mbr, mblocks = moving
+    fc, fr, fn, fflat, fbc, fbr, fblocks = fixed
     K = grid.shape[0] - 1
     neg = -grid
     marks = np.zeros(K + 1, dtype=np.int64)
@@ -118,6 +119,26 @@ def touched_steps(mc, mr, mbc, mbr, mblocks, mn, mflat, fc, fr, fbc, fbr, fblock
     return out
 
 
+class CoverCells(NamedTuple):
+    """A `covers.Cover` as the kernels take it: its cells' sphere centres (N, 3) and radii,
+    their slabs' normals (N, 3) and half-widths (inf: no slab), and its blocks' sphere centres
+    (m, 3), radii and cells (m, b)."""
+
+    centres: np.ndarray
+    radii: np.ndarray
+    normals: np.ndarray
+    flat: np.ndarray
+    block_centres: np.ndarray
+    block_radii: np.ndarray
+    blocks: np.ndarray
+
+
+def cells_of(cover) -> CoverCells:
+    """The `CoverCells` of a `covers.Cover`."""
+    return CoverCells(cover.centres, cover.radii, cover.normals, cover.flat, cover.block_centres,
+                      cover.block_radii, cover.blocks)
+
+
 @njit(cache=True)
 def _sphere_gap(c1, r1, c2, r2):
     d0, d1, d2 = c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]
@@ -125,12 +146,14 @@ def _sphere_gap(c1, r1, c2, r2):
 
 
 @njit(cache=True)
-def least_gap(ac, ar, abc, abr, ablocks, bc, br, bbc, bbr, bblocks, below):
-    """`covers.cover_gap` of the covers a (cells ac, ar; blocks abc, abr, ablocks) and b: the
-    block pairs in increasing order of their spheres' gap, each one's cells only while that gap
-    is below the least cell gap found (a block's sphere holds its cells' spheres). Stops at the
-    first cell gap below ``below``, returning it (a gap known to be below that is all a
-    screen needs); -inf for the least gap itself."""
+def least_gap(a, b, below):
+    """`covers.cover_gap` of the `CoverCells` a and b: the block pairs in increasing order of
+    their spheres' gap, each one's cells only while that gap is below the least cell gap found
+    (a block's sphere holds its cells' spheres). Stops at the first cell gap below ``below``,
+    returning it (a gap known to be below that is all a screen needs); -inf for the least gap
+    itself."""
+    ac, ar, _an, _aflat, abc, abr, ablocks = a
+    bc, br, _bn, _bflat, bbc, bbr, bblocks = b
     m, k = abc.shape[0], bbc.shape[0]
     lower = np.empty(m * k)
     for I in range(m):
@@ -154,9 +177,7 @@ def least_gap(ac, ar, abc, abr, ablocks, bc, br, bbc, bbr, bblocks, below):
 def cover_gap(a, b, below: float = -np.inf) -> float:
     """`drake_dock.core.covers.cover_gap` compiled (`least_gap`); with ``below``, any gap of
     two cells below it once one is found (the least gap when it is not below)."""
-    return float(least_gap(a.centres, a.radii, a.block_centres, a.block_radii, a.blocks,
-                           b.centres, b.radii, b.block_centres, b.block_radii, b.blocks,
-                           float(below)))
+    return float(least_gap(cells_of(a), cells_of(b), float(below)))
 
 
 def patch_cover(patch, n: int, block: int):
@@ -178,11 +199,8 @@ def patch_cover(patch, n: int, block: int):
 
 def touch_steps(moving, fixed, e, grid, slack=1e-9):
     """Booleans (K,): the steps of ``grid`` in which the posed covers can touch."""
-    return touched_steps(moving.centres, moving.radii, moving.block_centres, moving.block_radii,
-                         moving.blocks, moving.normals, moving.flat, fixed.centres, fixed.radii,
-                         fixed.block_centres, fixed.block_radii, fixed.blocks, fixed.normals,
-                         fixed.flat, np.asarray(e, dtype=float), np.asarray(grid, dtype=float),
-                         float(slack))
+    return touched_steps(cells_of(moving), cells_of(fixed), np.asarray(e, dtype=float),
+                         np.asarray(grid, dtype=float), float(slack))
 
 
 def warm():
