@@ -19,19 +19,22 @@ sticking or locked couples by the reference (scipy's DOP853) until they end.
 
 Events, thresholds and the end test are the reference's (`drake_dock.core.lzb.solve`,
 `active_events`, `event_time`, `handle_events`, `ImpactProblem.finished`, `classify`,
-`turn_at_once`), written over arrays.
+`turn_at_once`), written over arrays. The impact's constants come as an
+`lzb_phases.ImpactConstants`, the couples' phase arrays, which the kernel changes in place,
+as an `lzb_phases.Phases`; the step's event brackets are a `Brackets`.
 """
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from drake_dock.core.kernels.lzb_phases import (APPROACH, COMPRESSION, EXPANSION, FRICTION,
-                                                NORMAL, apply_event,
-                                                classify, event_value, event_values, finished,
-                                                rhs)
+                                                NORMAL, EventLog, ImpactConstants, Phases,
+                                                apply_event, classify, event_value,
+                                                event_values, finished, rhs)
 
 # Statuses.
 DONE, PYEVENT, BUDGET, STEP_FAILED, NONFINITE = 0, 1, 2, 3, 4
@@ -55,6 +58,15 @@ D1, D3, D4, D5, D6, D7 = (-12715105075.0 / 11282082432.0, 87487479700.0 / 327004
                           -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0)
 
 
+class Brackets(NamedTuple):
+    """The event brackets of a step (`solve.active_events`), entry b: row kind[b] of couple
+    couple[b] crosses zero in [ta[b], tb[b]]."""
+    kind: np.ndarray
+    couple: np.ndarray
+    ta: np.ndarray
+    tb: np.ndarray
+
+
 # Dense output and root finding ---------------------------------------------------------------
 @njit(cache=True)
 def dense_at(rc, t_old, h, t, out, lo, hi):
@@ -67,24 +79,21 @@ def dense_at(rc, t_old, h, t, out, lo, hi):
 
 
 @njit(cache=True)
-def _root_value(rc, t_old, h, t, tmp, kind, j, s, friction, phase, sep, x_end, slip_dir,
-                v_rest):
+def _root_value(rc, t_old, h, t, tmp, kind, j, imp, ph):
+    """Row ``kind`` of couple j's event function at t on the dense output (tmp: the state)."""
     dense_at(rc, t_old, h, t, tmp, 0, len(tmp))
-    return event_value(tmp, kind, j, s, friction, phase, sep, x_end, slip_dir, v_rest)
+    return event_value(tmp, kind, j, imp, ph)
 
 
 @njit(cache=True)
-def event_time(rc, t_old, h, kind, j, ta, tb, tmp, s, friction, phase, sep, x_end, slip_dir,
-               v_rest):
+def event_time(rc, t_old, h, kind, j, ta, tb, tmp, imp, ph):
     """The zero in [ta, tb] of couple j's event function of row ``kind`` on the dense output
     (ta when it starts on the boundary): Brent's method (Brent, *Algorithms for Minimization
     without Derivatives*, 1973, ch. 4), to xtol 1e-15 max(1, |tb|) and rtol 4 eps."""
-    fa = _root_value(rc, t_old, h, ta, tmp, kind, j, s, friction, phase, sep, x_end, slip_dir,
-                     v_rest)
+    fa = _root_value(rc, t_old, h, ta, tmp, kind, j, imp, ph)
     if fa <= 0.0:
         return ta
-    fb = _root_value(rc, t_old, h, tb, tmp, kind, j, s, friction, phase, sep, x_end, slip_dir,
-                     v_rest)
+    fb = _root_value(rc, t_old, h, tb, tmp, kind, j, imp, ph)
     if fb > 0.0:
         return tb
     xtol, rtol = 1e-15 * max(1.0, abs(tb)), 4.0 * 2.220446049250313e-16
@@ -122,16 +131,16 @@ def event_time(rc, t_old, h, kind, j, ta, tb, tmp, s, friction, phase, sep, x_en
             d = e = m
         a, fa = b, fb
         b += d if abs(d) > tol else (tol if m > 0.0 else -tol)
-        fb = _root_value(rc, t_old, h, b, tmp, kind, j, s, friction, phase, sep, x_end,
-                         slip_dir, v_rest)
+        fb = _root_value(rc, t_old, h, b, tmp, kind, j, imp, ph)
     return b
 
 
 @njit(cache=True)
-def active_events(rc, t_old, t_new, g0, g1, s, friction, phase, sep, x_end, slip_dir, tmp,
-                  br_kind, br_j, br_a, br_b, v_rest):
-    """`solve.active_events`: the brackets (row, couple, ta, tb) of the step, friction rows
-    first, then the normal and approach rows sampled inside the step; their number."""
+def active_events(rc, t_old, t_new, g0, g1, tmp, imp, ph, br):
+    """`solve.active_events`: the brackets of the step into ``br``, friction rows first, then
+    the normal and approach rows sampled inside the step; their number."""
+    s = imp.s
+    br_kind, br_j, br_a, br_b = br
     nb = 0
     h = t_new - t_old
     for j in range(s):
@@ -146,10 +155,8 @@ def active_events(rc, t_old, t_new, g0, g1, s, friction, phase, sep, x_end, slip
     for k in range(_N_INSIDE):
         dense_at(rc, t_old, h, T[k + 1], tmp, 0, 2 * s)
         for j in range(s):
-            samples[k, 0, j] = event_value(tmp, NORMAL, j, s, friction, phase, sep, x_end,
-                                           slip_dir, v_rest)
-            samples[k, 1, j] = event_value(tmp, APPROACH, j, s, friction, phase, sep, x_end,
-                                           slip_dir, v_rest)
+            samples[k, 0, j] = event_value(tmp, NORMAL, j, imp, ph)
+            samples[k, 1, j] = event_value(tmp, APPROACH, j, imp, ph)
     for r in range(2):
         kind = NORMAL if r == 0 else APPROACH
         for j in range(s):
@@ -174,16 +181,18 @@ def _rms(v, sc):
 
 
 @njit(cache=True)
-def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, eta, e, mu,
-               friction, law, phase, sep, rate, x_end, slip_dir, wc, e_start, wc_open,
-               imp_scale):
-    """Integrates the impact from the state y (no couple stuck or locked) until it ends
-    (`DONE`), an event needs Python (`PYEVENT`: the state is that at the step's start, the
-    step's dense output is returned), the step budget is exceeded (`BUDGET`), the step size
-    underflows (`STEP_FAILED`) or the state is not finite (`NONFINITE`). The phase arrays are
-    updated in place. Returns (status, t, y, h, steps, events as (impulse, kind code, couple)
-    with their number, the normal impulses after each accepted step with their number, and
-    for `PYEVENT` t_old, t_new, the dense output and the event values at both ends)."""
+def lzb_impact(y, t, h, steps, imp, ph):
+    """Integrates the impact of constants ``imp`` (an `ImpactConstants`) from the state y at
+    tau = t, with the step h (0: chosen here) and ``steps`` steps taken, no couple stuck or
+    locked, until it ends (`DONE`), an event needs Python (`PYEVENT`: the state is that at the
+    step's start, the step's dense output is returned), the step budget is exceeded
+    (`BUDGET`), the step size underflows (`STEP_FAILED`) or the state is not finite
+    (`NONFINITE`). The phase arrays ``ph`` (a `Phases`) are updated in place. Returns (status,
+    t, y, h, steps, the events as an `EventLog`, the normal impulses after each accepted step
+    with their number, and for `PYEVENT` t_old, t_new, the dense output and the event values
+    at both ends)."""
+    s, nu, rtol, atol, max_steps = imp.s, imp.nu, imp.rtol, imp.atol, imp.max_steps
+    imp_scale, phase = imp.imp_scale, ph.phase
     N = len(y)
     y = y.copy()
     lam = np.empty(nu)
@@ -193,24 +202,24 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
     rc = np.empty((5, N))
     g0, g1, gt = np.empty((3, s)), np.empty((3, s)), np.empty((3, s))
     nbmax = 3 * s
-    br_kind, br_j = np.empty(nbmax, np.int64), np.empty(nbmax, np.int64)
-    br_a, br_b, roots = np.empty(nbmax), np.empty(nbmax), np.empty(nbmax)
+    br = Brackets(np.empty(nbmax, np.int64), np.empty(nbmax, np.int64), np.empty(nbmax),
+                  np.empty(nbmax))
+    br_kind, br_j, br_a, br_b = br
+    roots = np.empty(nbmax)
     order = np.empty(nbmax, np.int64)
     # The event log; its count an int64, not the literal 0, so that apply_event and _log
     # are compiled for one type of it.
-    log = (np.empty(16), np.empty(16, np.int64), np.empty(16, np.int64), np.int64(0))
+    log = EventLog(np.empty(16), np.empty(16, np.int64), np.empty(16, np.int64), np.int64(0))
     hist = np.empty((64, s))
     nh = 0
     # The transaction of an event step: copies of what the events change.
-    sv_y, sv_phase, sv_sep, sv_rate = np.empty(N), phase.copy(), sep.copy(), rate.copy()
-    sv_xe, sv_sd, sv_wc = x_end.copy(), slip_dir.copy(), wc.copy()
-    sv_es, sv_wo = e_start.copy(), wc_open.copy()
+    sv_y, sv = np.empty(N), _copied(ph)
     status = DONE
     t_old = t
-    while not finished(y, s, kappa, eta, phase, settle):
-        classify(y, s, phase, sep)
-        event_values(y, g0, s, friction, phase, sep, x_end, slip_dir, settle)
-        rhs(y, k1, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam)
+    while not finished(y, imp, ph):
+        classify(y, imp, ph)
+        event_values(y, g0, imp, ph)
+        rhs(y, k1, imp, ph, lam)
         if h <= 0.0:
             # The initial step (Hairer, Norsett and Wanner, Sect. II.4).
             for i in range(N):
@@ -219,7 +228,7 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
             h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
             for i in range(N):
                 ys[i] = y[i] + h0 * k1[i]
-            rhs(ys, k2, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam)
+            rhs(ys, k2, imp, ph, lam)
             for i in range(N):
                 tmp[i] = k2[i] - k1[i]
             d2 = _rms(tmp, sc) / h0
@@ -240,24 +249,24 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                     return (STEP_FAILED, t, y, h, steps, log, hist, nh, t, t, rc, g0, g1)
                 for i in range(N):
                     ys[i] = y[i] + h * A21 * k1[i]
-                rhs(ys, k2, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam)
+                rhs(ys, k2, imp, ph, lam)
                 for i in range(N):
                     ys[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
-                rhs(ys, k3, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam)
+                rhs(ys, k3, imp, ph, lam)
                 for i in range(N):
                     ys[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-                rhs(ys, k4, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam)
+                rhs(ys, k4, imp, ph, lam)
                 for i in range(N):
                     ys[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-                rhs(ys, k5, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam)
+                rhs(ys, k5, imp, ph, lam)
                 for i in range(N):
                     ys[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i]
                                         + A65 * k5[i])
-                rhs(ys, k6, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam)
+                rhs(ys, k6, imp, ph, lam)
                 for i in range(N):
                     yn[i] = y[i] + h * (B1 * k1[i] + B3 * k3[i] + B4 * k4[i] + B5 * k5[i]
                                         + B6 * k6[i])
-                rhs(yn, k7, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir, lam)
+                rhs(yn, k7, imp, ph, lam)
                 finite = True
                 for i in range(N):
                     err[i] = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i]
@@ -289,20 +298,17 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                 rc[4, i] = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i]
                                 + D6 * k6[i] + D7 * k7[i])
             h_used = h
-            event_values(yn, g1, s, friction, phase, sep, x_end, slip_dir, settle)
-            nb = active_events(rc, t_old, t_new, g0, g1, s, friction, phase, sep, x_end,
-                               slip_dir, tmp, br_kind, br_j, br_a, br_b, settle)
+            event_values(yn, g1, imp, ph)
+            nb = active_events(rc, t_old, t_new, g0, g1, tmp, imp, ph, br)
             if nb > 0:
                 # `solve.handle_events`, as a transaction.
                 sv_y[:] = y
-                sv_phase[:], sv_sep[:], sv_rate[:], sv_xe[:] = phase, sep, rate, x_end
-                sv_sd[:], sv_wc[:], sv_es[:], sv_wo[:] = slip_dir, wc, e_start, wc_open
-                n_log = log[3]
+                _copy_into(sv, ph)
+                n_log = log.n
                 first = 0
                 for b in range(nb):
                     roots[b] = event_time(rc, t_old, h_used, br_kind[b], br_j[b], br_a[b],
-                                          br_b[b], tmp, s, friction, phase, sep, x_end,
-                                          slip_dir, settle)
+                                          br_b[b], tmp, imp, ph)
                     if roots[b] < roots[first]:
                         first = b
                 t_first = roots[first]
@@ -311,9 +317,7 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                 for j in range(s):
                     impulse += y[s + nu + j]
                 impulse *= imp_scale
-                ok, log = apply_event(y, br_kind[first], br_j[first], impulse, s, nu,
-                                      friction, kappa, eta, e, law, phase, sep, rate, x_end,
-                                      slip_dir, wc, e_start, wc_open, log, settle)
+                ok, log = apply_event(y, br_kind[first], br_j[first], impulse, imp, ph, log)
                 # The others at the same instant, in the order (time, row, couple).
                 for b in range(nb):
                     order[b] = b
@@ -332,12 +336,8 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                     if not ok:
                         break
                     if b != first and roots[b] <= t_first + same and event_value(
-                            y, br_kind[b], br_j[b], s, friction, phase, sep, x_end,
-                            slip_dir, settle) <= 0.0:
-                        ok, log = apply_event(y, br_kind[b], br_j[b], impulse, s, nu,
-                                              friction, kappa, eta, e, law, phase, sep, rate,
-                                              x_end, slip_dir, wc, e_start, wc_open, log,
-                                              settle)
+                            y, br_kind[b], br_j[b], imp, ph) <= 0.0:
+                        ok, log = apply_event(y, br_kind[b], br_j[b], impulse, imp, ph, log)
                 # `ImpactProblem.turn_at_once`.
                 for _ in range(2 * s):
                     if not ok:
@@ -347,8 +347,7 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                         near = near or abs(y[s + j]) <= 1e-12
                     if not near:
                         break
-                    rhs(y, tmp, s, nu, G, kappa, eta, mu, friction, phase, rate, slip_dir,
-                        lam)
+                    rhs(y, tmp, imp, ph, lam)
                     jt = -1
                     for j in range(s):
                         if abs(y[s + j]) <= 1e-12 and (
@@ -359,39 +358,51 @@ def lzb_impact(y, t, h, steps, max_steps, rtol, atol, settle, s, nu, G, kappa, e
                     if jt < 0:
                         break
                     kind = NORMAL if phase[jt] == COMPRESSION else APPROACH
-                    ok, log = apply_event(y, kind, jt, impulse, s, nu, friction, kappa, eta,
-                                          e, law, phase, sep, rate, x_end, slip_dir, wc,
-                                          e_start, wc_open, log, settle)
+                    ok, log = apply_event(y, kind, jt, impulse, imp, ph, log)
                 if not ok:
                     y[:] = sv_y
-                    phase[:], sep[:], rate[:], x_end[:] = sv_phase, sv_sep, sv_rate, sv_xe
-                    slip_dir[:], wc[:], e_start[:], wc_open[:] = sv_sd, sv_wc, sv_es, sv_wo
-                    log = (log[0], log[1], log[2], n_log)
+                    _copy_into(ph, sv)
+                    log = EventLog(log.impulse, log.kind, log.couple, n_log)
                     return (PYEVENT, t, y, h_used, steps, log, hist, nh, t_old, t_new, rc,
                             g0, g1)
                 t = t_first
                 h = h_used
-                nh = _history(hist, nh, y, s, nu, imp_scale)
+                nh = _history(hist, nh, y, imp)
                 hist = _grown(hist, nh)
                 break
             y[:] = yn
             t = t_new
             for i in range(N):
                 k1[i] = k7[i]
-            if classify(y, s, phase, sep):
-                event_values(y, g0, s, friction, phase, sep, x_end, slip_dir, settle)
+            if classify(y, imp, ph):
+                event_values(y, g0, imp, ph)
             else:
                 g0[:, :] = g1
-            nh = _history(hist, nh, y, s, nu, imp_scale)
+            nh = _history(hist, nh, y, imp)
             hist = _grown(hist, nh)
             h = h_used * fac
-            if finished(y, s, kappa, eta, phase, settle):
+            if finished(y, imp, ph):
                 ended = True
                 break
         if ended:
             h = h_used
             break
     return (status, t, y, h, steps, log, hist, nh, t_old, t, rc, g0, g1)
+
+
+@njit(cache=True)
+def _copied(ph):
+    """A copy of the phase arrays."""
+    return Phases(ph.phase.copy(), ph.sep.copy(), ph.rate.copy(), ph.x_end.copy(),
+                  ph.slip_dir.copy(), ph.wc.copy(), ph.e_start.copy(), ph.wc_open.copy())
+
+
+@njit(cache=True)
+def _copy_into(dst, src):
+    """The phase arrays of src into those of dst."""
+    dst.phase[:], dst.sep[:], dst.rate[:], dst.x_end[:] = src.phase, src.sep, src.rate, src.x_end
+    dst.slip_dir[:], dst.wc[:] = src.slip_dir, src.wc
+    dst.e_start[:], dst.wc_open[:] = src.e_start, src.wc_open
 
 
 @njit(cache=True)
@@ -405,7 +416,9 @@ def _after(ta, ka, ja, tb, kb, jb):
 
 
 @njit(cache=True)
-def _history(hist, nh, y, s, nu, imp_scale):
+def _history(hist, nh, y, imp):
+    """The normal impulses of y as row nh of hist; nh + 1."""
+    s, nu, imp_scale = imp.s, imp.nu, imp.imp_scale
     for j in range(s):
         hist[nh, j] = y[s + nu + j] * imp_scale
     return nh + 1
@@ -427,6 +440,9 @@ def warm():
     y = np.zeros(4 * s + 2 * nu)
     y[s], y[s + 1] = -1.0, 0.5
     one = np.ones(s)
-    lzb_impact(y, 0.0, 0.0, 0, 10_000, 1e-8, 1e-10, 1e-8, s, nu, G, one, 1.5 * one, 0.5 * one,
-               0.3 * one, True, 0, np.zeros(s, np.int64), np.zeros(s, np.bool_), one.copy(),
-               np.zeros(s), np.zeros((s, 2)), np.zeros(s), np.zeros(s), np.zeros(s), 1.0)
+    imp = ImpactConstants(s, nu, G, one, 1.5 * one, 0.5 * one, 0.3 * one, friction=True,
+                          law=0, settle=1e-8, rtol=1e-8, atol=1e-10, max_steps=10_000,
+                          imp_scale=1.0)
+    ph = Phases(np.zeros(s, np.int64), np.zeros(s, np.bool_), one.copy(), np.zeros(s),
+                np.zeros((s, 2)), np.zeros(s), np.zeros(s), np.zeros(s))
+    lzb_impact(y, 0.0, 0.0, 0, imp, ph)

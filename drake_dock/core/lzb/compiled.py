@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from drake_dock.core.kernels import lzb as kernel
-from drake_dock.core.kernels.lzb_phases import KINDS, LAW_NAMES
+from drake_dock.core.kernels.lzb_phases import KINDS, LAW_NAMES, ImpactConstants, Phases
 from drake_dock.core.lzb.driver import active_events, budget_error, handle_events, segment
 from drake_dock.core.lzb.state import COMPRESSION, EXPANSION, LOCKED, ImpactEvent
 from drake_dock.errors import NumericalError
@@ -43,9 +43,13 @@ def integrate_compiled(prob, y, events, *, rtol, max_steps, impulse_scale):
     """`drake_dock.core.lzb.driver.integrate` by the compiled kernel: the same events and
     outputs, (y, steps, the normal impulses after each accepted step)."""
     m_s, v_s = impulse_scale
-    s, nu = prob.s, prob.layout.nu
-    G = np.ascontiguousarray(prob.G)
-    law = LAW_NAMES.index(prob.law)
+    s = prob.s
+    imp = ImpactConstants(s, prob.layout.nu, np.ascontiguousarray(prob.G), prob.kappa,
+                          prob.eta, prob.e, prob.mu, bool(prob.friction),
+                          LAW_NAMES.index(prob.law), prob.settle, rtol, rtol * 1e-2, max_steps,
+                          m_s * v_s)
+    ph = Phases(prob.phase, prob.sep, prob.rate, prob.x_end, prob.slip_dir, prob.wc,
+                prob.e_start, prob.wc_open)       # the kernel changes these in place
     steps, history = 0, []
     t, h = 0.0, None
     while not prob.finished(y):
@@ -54,15 +58,10 @@ def integrate_compiled(prob, y, events, *, rtol, max_steps, impulse_scale):
                                      max_steps=max_steps, impulse_scale=impulse_scale)
             continue
         (status, t, y, h, steps, log, hist, nh, t_old, t_new, rc, g_old, g_new) = \
-            kernel.lzb_impact(y, t, 0.0 if h is None else h, steps, max_steps, rtol,
-                              rtol * 1e-2, prob.settle, s, nu, G, prob.kappa, prob.eta,
-                              prob.e, prob.mu, bool(prob.friction), law, prob.phase, prob.sep,
-                              prob.rate, prob.x_end, prob.slip_dir, prob.wc, prob.e_start,
-                              prob.wc_open, m_s * v_s)
+            kernel.lzb_impact(y, t, 0.0 if h is None else h, steps, imp, ph)
         _sync(prob)
-        ev_imp, ev_kind, ev_couple, n = log
-        events.extend(ImpactEvent(float(ev_imp[i]), KINDS[ev_kind[i]], int(ev_couple[i]))
-                      for i in range(n))
+        events.extend(ImpactEvent(float(log.impulse[i]), KINDS[log.kind[i]],
+                                  int(log.couple[i])) for i in range(log.n))
         history.extend(hist[:nh])
         if status == kernel.BUDGET:
             raise budget_error(max_steps, events)
