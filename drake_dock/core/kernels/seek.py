@@ -119,11 +119,12 @@ class Bounds(NamedTuple):
 
 
 @njit(cache=True)
-def _gap(a, b, u, n1):
-    """(x1 - x2, x1, x2) at the couple u of the `Placed` patches a and b, patch 1 a curve
-    (n1 = 1) or a `POINT` (n1 = 0)."""
-    x1 = world_point(a.kind, a.prm, a.R, a.o, u[0], 0.0)
-    x2 = world_point(b.kind, b.prm, b.R, b.o, u[n1], u[n1 + 1] if u.shape[0] == n1 + 2 else 0.0)
+def _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, n1):
+    """(x1 - x2, x1, x2) at the couple u of two placed patches (the fields of their `Placed`,
+    read once by the caller: `newton` calls this at every iteration), patch 1 a curve (n1 = 1)
+    or a `POINT` (n1 = 0)."""
+    x1 = world_point(k1, p1, R1, o1, u[0], 0.0)
+    x2 = world_point(k2, p2, R2, o2, u[n1], u[n1 + 1] if u.shape[0] == n1 + 2 else 0.0)
     return (x1[0] - x2[0], x1[1] - x2[1], x1[2] - x2[2]), x1, x2
 
 
@@ -152,7 +153,7 @@ def newton(pa, pb, u, bounds, tol, max_iter, distance_rtol, rtol_beyond):
     converged = False
     for it in range(1, max_iter + 1):
         j2 = jet(k2, p2, u[n1], u[n1 + 1] if n2 == 2 else 0.0)
-        _, x1, x2 = _gap(pa, pb, u, n1)
+        _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, n1)
         d = np.array([x1[0] - x2[0], x1[1] - x2[1], x1[2] - x2[2]])
         # J = [T1, -T2] (world tangents); g = J^T d; H = J^T J + diag(d . K1, -d . K2).
         cols = np.empty((n, 3))
@@ -234,7 +235,7 @@ def newton(pa, pb, u, bounds, tol, max_iter, distance_rtol, rtol_beyond):
             for i in range(n):
                 a = u[i] + t * step[i]
                 un[i] = a if periodic[i] else min(max(a, lower[i]), upper[i])
-            dn = _gap(pa, pb, un, n1)[0]
+            dn = _gap(k1, p1, R1, o1, k2, p2, R2, o2, un, n1)[0]
             fn = 0.5 * (dn[0] * dn[0] + dn[1] * dn[1] + dn[2] * dn[2])
             if fn <= f0 + 1e-4 * (g @ (un - u)):
                 accepted = True
@@ -281,6 +282,8 @@ def seek(a, da, b, db, levels, n_fine, candidates, distance_rtol, rtol_beyond):
     (`seeking.is_interior` of both parts), in the order of the starts."""
     bounds = _couple_domain(da, db)
     lower, upper, periodic, scale = bounds
+    k1, p1, R1, o1 = a
+    k2, p2, R2, o2 = b
     tol = 1e-9 * (upper - lower)
     starts = hierarchical(a, da, b, db, levels, n_fine, candidates)
     C, n = starts.shape
@@ -298,7 +301,7 @@ def seek(a, da, b, db, levels, n_fine, candidates, distance_rtol, rtol_beyond):
         started[c] = True
         u, its[m], status[m] = newton(a, b, starts[c], bounds, 1e-14, CLOSEST_MAX_ITER,
                                       distance_rtol, rtol_beyond)
-        _, x1, x2 = _gap(a, b, u, 1)
+        _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, 1)
         U[m] = u
         X1[m, 0], X1[m, 1], X1[m, 2] = x1
         X2[m, 0], X2[m, 1], X2[m, 2] = x2
@@ -316,7 +319,7 @@ def creep_on(a, da, b, db, u, distance_rtol, rtol_beyond):
     bounds = _couple_domain(da, db)
     lower, upper, periodic, scale = bounds
     u, it, status = newton(a, b, u, bounds, 1e-14, CREEP_MAX_ITER, distance_rtol, rtol_beyond)
-    _, x1, x2 = _gap(a, b, u, 1)
+    _, x1, x2 = _gap(a.kind, a.prm, a.R, a.o, b.kind, b.prm, b.R, b.o, u, 1)
     return (u, it, status, np.array([x1[0], x1[1], x1[2]]), np.array([x2[0], x2[1], x2[2]]),
             _interior(u, lower, upper, periodic))
 
@@ -351,7 +354,7 @@ def point_surface(a, b, db, distance_rtol, rtol_beyond):
     bounds = Bounds(lo2, hi2, per2, np.maximum(hi2 - lo2, 1e-300))
     u, it, status = newton(a, b, U2[i_best].copy(), bounds, 1e-14, CLOSEST_MAX_ITER,
                            distance_rtol, rtol_beyond)
-    _, x1, x2 = _gap(a, b, u, 0)
+    _, x1, x2 = _gap(POINT, a.prm, a.R, a.o, k2, p2, R2, o2, u, 0)
     return (u, it, status, np.array([x1[0], x1[1], x1[2]]), np.array([x2[0], x2[1], x2[2]]),
             _interior(u, lo2, hi2, per2))
 
