@@ -109,11 +109,14 @@ STATS = """
 
 
 def _kernels():
-    """(module, dispatcher) of every kernel defined in the kernels package."""
+    """(module, dispatcher) of every kernel defined in the kernels package that has machine
+    code of its own (one inlined where it is called, ``inline="always"``, has none, nor a cache
+    index)."""
     import importlib
     for name in prepare.kernel_modules():
         for value in vars(importlib.import_module(K + name)).values():
-            if isinstance(value, CPUDispatcher) and value.py_func.__module__ == K + name:
+            if (isinstance(value, CPUDispatcher) and value.py_func.__module__ == K + name
+                    and value.targetoptions.get("inline") != "always"):
                 yield name, value
 
 
