@@ -53,7 +53,7 @@ def cone_interval(a, b, c0, c1, d0, d1, mu):
             cuts[3], cuts[4] = (-q - root) / p, (-q + root) / p
     elif q != 0.0:
         cuts[3] = -r / (2.0 * q)
-    cuts = np.sort(cuts[~np.isnan(cuts)])
+    cuts = sorted_values(cuts[~np.isnan(cuts)])
     lo, hi = np.inf, -np.inf
     for j in range(len(cuts) - 1):
         x0, x1 = cuts[j], cuts[j + 1]
@@ -68,6 +68,24 @@ def cone_interval(a, b, c0, c1, d0, d1, mu):
         if inside(a + b * t, c0 + d0 * t, c1 + d1 * t, mu):
             lo, hi = min(lo, x0), max(hi, x1)
     return lo, hi
+
+
+@register_jitable
+def sorted_values(x):
+    """A copy of x in ascending order, by a stable insertion sort: the order numba's np.sort
+    gives a handful of values. Not np.sort itself: the kernels argsort float arrays elsewhere
+    (the SVD's singular values), and numba names the machine code of its quicksort per
+    process, the sort's and the argsort's alike; a solve compiled in a process that loaded
+    the SVD from the cache could then link one of the two in place of the other."""
+    out = x.copy()
+    for i in range(1, len(out)):
+        v = out[i]
+        j = i
+        while j > 0 and v < out[j - 1]:
+            out[j] = out[j - 1]
+            j -= 1
+        out[j] = v
+    return out
 
 
 @register_jitable

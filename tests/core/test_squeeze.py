@@ -14,7 +14,7 @@ import pytest
 from drake_dock.core import constraints
 from drake_dock.core.constraints import SLIDE, STICK, ContactRow
 from drake_dock.core.kernels import constraints as compiled
-from drake_dock.core.squeeze import SHRINK, cone_interval
+from drake_dock.core.squeeze import SHRINK, cone_interval, sorted_values
 
 G, OMEGA = 9.81, 20.0
 
@@ -23,6 +23,22 @@ G, OMEGA = 9.81, 20.0
 def select_contact_modes(request):
     return {"python": constraints.select_contact_modes,
             "compiled": compiled.select_contact_modes}[request.param]
+
+
+def test_sorted_values_is_a_stable_ascending_sort():
+    """The squeeze's sort of its cut points, called as Python and compiled, against Python's
+    sorted() (stable): up to five values drawn from few, with infinities and both zeros, whose
+    order sorted() keeps as given (their sign bits compared, not only their values)."""
+    from numba import njit
+    compiled_sort = njit(lambda x: sorted_values(x))
+    pool = np.array([-np.inf, np.inf, 0.0, -0.0, 1.5, -2.0, 1.5])
+    rng = np.random.default_rng(5)
+    for _ in range(300):
+        x = rng.choice(pool, size=rng.integers(0, 6))
+        want = np.array(sorted(x.tolist()), dtype=float)
+        for got in (sorted_values(x), compiled_sort(x)):
+            assert got.tolist() == want.tolist()
+            assert np.signbit(got).tolist() == np.signbit(want).tolist()
 
 
 def point_row(name, r, n, mu):
