@@ -22,10 +22,10 @@ import numpy as np
 from numba import njit
 
 from drake_dock.core import constraints as ref
-from drake_dock.core.kernels.slide_start import Outputs, Problem, slide_start
+from drake_dock.core.kernels.slide_start import Outputs, slide_start
 from drake_dock.core.kernels.solve import (CODE, DETACH, INDETERMINATE, NAME, NONE_CONSISTENT,
-                                           NONFINITE, OK, SLIDE, STICK, accelerations,
-                                           solve_modes, stabilised)
+                                           NONFINITE, OK, SLIDE, STICK, Problem, Solution,
+                                           accelerations, solve_modes, stabilised)
 from drake_dock.errors import (NumericalError, PainleveError, PainleveInconsistency,
                                SingularContactError)
 
@@ -48,11 +48,13 @@ def _consistent(modes, lam_n, lam_t, gdd, vn, gap, mu_s, omega, tol_f, tol_a):
 
 
 @njit(cache=True)
-def _select(Minv, a0, W, bias, gap, vn, vt, mu, mu_s, avoid, v_slip, omega, rtol, tie_rtol):
-    """`constraints.select_contact_modes` without its errors: returns (status, modes (n, k), dirs
+def _select(P, vt, avoid, v_slip, omega, rtol, tie_rtol):
+    """`constraints.select_contact_modes` without its errors, for the `Problem` P and the
+    couples' tangential velocities vt (k, 2): returns (status, modes (n, k), dirs
     (n, k, 2), vdot (n, nv), lam_n (n, k), lam_t (n, k, 2), gf (n, nv), best, other), with
     row ``best`` the choice, and for INDETERMINATE row ``other`` the second consistent
     choice."""
+    Minv, a0, W, bias, gap, vn, mu, mu_s = P
     k, nv = W.shape[0], W.shape[1]
     nopt = np.empty(k, np.int64)
     moving = np.zeros((k, 2))
@@ -111,8 +113,7 @@ def _select(Minv, a0, W, bias, gap, vn, vt, mu, mu_s, avoid, v_slip, omega, rtol
             # tangential acceleration).
             for i in range(k):
                 gmodes[i] = STICK if modes[i] == SLIDE and not has_dir[i] else modes[i]
-            st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, gmodes, dirs, omega, vdot,
-                                 lam_n, lam_t, gf)
+            st, _c = solve_modes(P, gmodes, dirs, omega, Solution(vdot, lam_n, lam_t, gf))
             if st != OK:
                 continue
             for i in starting:
@@ -124,13 +125,12 @@ def _select(Minv, a0, W, bias, gap, vn, vt, mu, mu_s, avoid, v_slip, omega, rtol
                     dirs[i, 0], dirs[i, 1] = g0 / ng, g1 / ng
                 else:
                     dirs[i, 0], dirs[i, 1] = 1.0, 0.0
-            st, ok = slide_start(Problem(Minv, a0, W, bias, gap, vn, mu, mu_s), modes, dirs,
-                                 starting, omega, Outputs(vdot, lam_n, lam_t, gf, gdd, at))
+            st, ok = slide_start(P, modes, dirs, starting, omega,
+                                 Outputs(vdot, lam_n, lam_t, gf, gdd, at))
             if st != OK or not ok:
                 continue
         else:
-            st, _c = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot,
-                                 lam_n, lam_t, gf)
+            st, _c = solve_modes(P, modes, dirs, omega, Solution(vdot, lam_n, lam_t, gf))
             if st != OK:
                 continue
             accelerations(W, bias, vdot, gdd, at)
@@ -188,15 +188,13 @@ def _dirs_array(modes, dirs):
     return out
 
 
-def solve_packed(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, *, time=None,
-                 names=()):
-    """(vdot, lam_n (k,), lam_t (k, 2), generalized force) for the packed rows and the mode
-    codes ``modes`` (int array), ``dirs`` (k, 2) the sliding directions; `SingularContactError`
-    (naming ``names``) as the reference."""
-    k, nv = W.shape[0], len(a0)
+def solve_packed(P, modes, dirs, omega, *, time=None, names=()):
+    """(vdot, lam_n (k,), lam_t (k, 2), generalized force) for the `Problem` P of the packed
+    rows and the mode codes ``modes`` (int array), ``dirs`` (k, 2) the sliding directions;
+    `SingularContactError` (naming ``names``) as the reference."""
+    k, nv = P.W.shape[0], len(P.a0)
     vdot, lam_n, lam_t, gf = np.empty(nv), np.empty(k), np.empty((k, 2)), np.empty(nv)
-    st, cond = solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n,
-                           lam_t, gf)
+    st, cond = solve_modes(P, modes, dirs, omega, Solution(vdot, lam_n, lam_t, gf))
     if st != OK:
         raise_status(st, cond, modes, names, time)
     return vdot, lam_n, lam_t, gf
@@ -219,9 +217,10 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None):
     """`constraints.solve_given_modes` compiled: the same arguments and `ContactSolution`."""
     W, bias, gap, vn, vt, mu, mu_s = pack_rows(rows)
     codes = np.array([CODE[m] for m in modes], dtype=np.int64)
-    vdot, lam_n, lam_t, gf = solve_packed(np.ascontiguousarray(Minv, dtype=float),
-                                          np.asarray(a0, dtype=float), W, bias, gap, vn, mu,
-                                          mu_s, codes, _dirs_array(modes, dirs), omega,
+    vdot, lam_n, lam_t, gf = solve_packed(Problem(np.ascontiguousarray(Minv, dtype=float),
+                                                  np.asarray(a0, dtype=float), W, bias, gap, vn,
+                                                  mu, mu_s),
+                                          codes, _dirs_array(modes, dirs), omega,
                                           time=time,
                                           names=[r.name for r in rows])
     return ref.ContactSolution(tuple(modes), list(dirs), vdot, lam_n, lam_t, gf, list(rows))
@@ -243,8 +242,9 @@ def select_contact_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, r
         for m in a:
             av[i, CODE[m]] = 1
     st, M_, D_, V_, LN, LT, GF, best, other = _select(
-        np.ascontiguousarray(Minv, dtype=float), np.asarray(a0, dtype=float), W, bias, gap, vn,
-        vt, mu, mu_s, av, float(v_slip), float(omega), float(rtol), ref.TIE_RTOL)
+        Problem(np.ascontiguousarray(Minv, dtype=float), np.asarray(a0, dtype=float), W, bias,
+                gap, vn, mu, mu_s),
+        vt, av, float(v_slip), float(omega), float(rtol), ref.TIE_RTOL)
     if st == NONE_CONSISTENT:
         raise PainleveInconsistency(
             "no consistent contact mode (Painleve inconsistency: the rigid model with this "
@@ -271,7 +271,7 @@ def warm():
     bias = np.zeros((2, 3))
     z, vt = np.zeros(2), np.array([[0.0, 0.0], [0.1, 0.0]])
     one = np.ones(2)
-    _select(np.eye(nv), -np.ones(nv), W, bias, z, z, vt, 0.1 * one, 0.1 * one,
-            np.zeros((2, 3), np.int64), 1e-6, 20.0, 1e-9, ref.TIE_RTOL)
-    solve_packed(np.eye(nv), -np.ones(nv), W, bias, z, z, 0.1 * one, 0.1 * one,
-                 np.array([STICK, SLIDE], np.int64), np.array([[0.0, 0.0], [1.0, 0.0]]), 20.0)
+    P = Problem(np.eye(nv), -np.ones(nv), W, bias, z, z, 0.1 * one, 0.1 * one)
+    _select(P, vt, np.zeros((2, 3), np.int64), 1e-6, 20.0, 1e-9, ref.TIE_RTOL)
+    solve_packed(P, np.array([STICK, SLIDE], np.int64), np.array([[0.0, 0.0], [1.0, 0.0]]),
+                 20.0)

@@ -43,7 +43,7 @@ from drake_dock.core.kernels.model import (BUSH_ROW, CC, FAR, NW, O_COND_MIN, O_
                                            W_HANDOVER, W_IMPACT, W_LAMBDA, W_REGULAR, W_SIDE, W_SLIP,
                                            Z_IE, Z_NQ, Z_NV, Z_NX, layout, unpack_model,
                                            unpack_modes)
-from drake_dock.core.kernels.solve import OK, SLIDE, STICK, solve_modes
+from drake_dock.core.kernels.solve import OK, SLIDE, STICK, Problem, Solution, solve_modes
 from drake_dock.core.kernels.witness_values import end_margin, handover_guard, point_curve_side
 
 @njit(cache=True)
@@ -206,8 +206,8 @@ def evaluate(mp, sp, x, tau_in, buf):
             else:
                 dirs[j, 0], dirs[j, 1] = s.slide_dir[i, 0], s.slide_dir[i, 1]
     lr_n, lr_t = np.empty(r), np.empty((r, 2))
-    status, cond = solve_modes(Minv, a0, W, bias, gap, vn, mus, mus_s, codes, dirs,
-                               opt[O_OMEGA], vdot, lr_n, lr_t, gf)
+    status, cond = solve_modes(Problem(Minv, a0, W, bias, gap, vn, mus, mus_s), codes, dirs,
+                               opt[O_OMEGA], Solution(vdot, lr_n, lr_t, gf))
     sc[S_STATUS], sc[S_COND] = status, cond
     sc[S_REPORT] = 1.0 if status != OK or sc[S_BUSH] != 0.0 else 0.0
     power = 0.0

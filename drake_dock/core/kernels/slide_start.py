@@ -10,27 +10,14 @@ import numpy as np
 from numba import njit
 
 from drake_dock.core import constraints as ref
-from drake_dock.core.kernels.solve import OK, SLIDE_START_ITER, accelerations, solve_modes
-
-
-class Problem(NamedTuple):
-    """The contact problem of a mode solve (`solve.solve_modes`): M^-1, the free acceleration
-    a0, the contact Jacobian W and bias accelerations, the couples' gaps, normal velocities and
-    friction coefficients."""
-
-    Minv: np.ndarray
-    a0: np.ndarray
-    W: np.ndarray
-    bias: np.ndarray
-    gap: np.ndarray
-    vn: np.ndarray
-    mu: np.ndarray
-    mu_s: np.ndarray
+from drake_dock.core.kernels.solve import (OK, SLIDE_START_ITER, Solution, accelerations,
+                                           solve_modes)
 
 
 class Outputs(NamedTuple):
-    """What a mode solve writes: v', lambda_n, lambda_t, the generalized contact force, and
-    the couples' normal and tangential accelerations (`solve.accelerations`)."""
+    """What a start of sliding writes: a mode solve's `solve.Solution` (v', lambda_n,
+    lambda_t, the generalized contact force) and the couples' normal and tangential
+    accelerations (`solve.accelerations`)."""
 
     vdot: np.ndarray
     lam_n: np.ndarray
@@ -42,11 +29,10 @@ class Outputs(NamedTuple):
 
 @njit(cache=True, inline="always")
 def _solve(P, modes, dirs, omega, out):
-    """`solve_modes` of the `Problem` P under ``modes`` and ``dirs`` into the `Outputs` out,
+    """`solve_modes` of the `solve.Problem` P under ``modes`` and ``dirs`` into the `Outputs` out,
     with the couples' accelerations; returns the status. Inlined where it is called: as a
     function of its own it added a tenth to the unit's compile."""
-    st, _c = solve_modes(P.Minv, P.a0, P.W, P.bias, P.gap, P.vn, P.mu, P.mu_s, modes, dirs,
-                         omega, out.vdot, out.lam_n, out.lam_t, out.gf)
+    st, _c = solve_modes(P, modes, dirs, omega, Solution(out.vdot, out.lam_n, out.lam_t, out.gf))
     if st != OK:
         return st
     accelerations(P.W, P.bias, out.vdot, out.gdd, out.at)
@@ -55,7 +41,7 @@ def _solve(P, modes, dirs, omega, out):
 
 @njit(cache=True)
 def slide_start(P, modes, dirs, starting, omega, out):
-    """`constraints._slide_start` for the `Problem` P: the sliding directions (in dirs) of the
+    """`constraints._slide_start` for the `solve.Problem` P: the sliding directions (in dirs) of the
     couples ``starting`` to slide, s = a_t/|a_t|, the solution in the `Outputs` out; returns
     (status, directions found)."""
     at = out.at

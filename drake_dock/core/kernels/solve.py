@@ -6,6 +6,7 @@ SVD for the singular case (`small_linalg`), and the squeeze of two sticking coup
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -21,6 +22,31 @@ OK, SINGULAR, NONFINITE, NONE_CONSISTENT, INDETERMINATE = 0, 1, 2, 3, 4
 SLIDE_START_ITER = ref.SLIDE_START_ITER
 
 
+class Problem(NamedTuple):
+    """The contact problem of a mode solve: M^-1 (nv, nv), the free acceleration a0 (nv,),
+    the rows' W (k, nv, 3) and bias accelerations (k, 3), the couples' gaps, normal velocities
+    and friction coefficients mu, mu_s (k,)."""
+
+    Minv: np.ndarray
+    a0: np.ndarray
+    W: np.ndarray
+    bias: np.ndarray
+    gap: np.ndarray
+    vn: np.ndarray
+    mu: np.ndarray
+    mu_s: np.ndarray
+
+
+class Solution(NamedTuple):
+    """What a mode solve writes: v' (nv,), lambda_n (k,), lambda_t (k, 2) and the generalized
+    contact force (nv,)."""
+
+    vdot: np.ndarray
+    lam_n: np.ndarray
+    lam_t: np.ndarray
+    gf: np.ndarray
+
+
 
 @njit(cache=True)
 def stabilised(x, vn, gap, omega):
@@ -30,11 +56,13 @@ def stabilised(x, vn, gap, omega):
 
 
 @njit(cache=True)
-def solve_modes(Minv, a0, W, bias, gap, vn, mu, mu_s, modes, dirs, omega, vdot, lam_n, lam_t,
-                gf):
-    """`constraints.solve_given_modes` into vdot (nv,), lam_n (k,), lam_t (k, 2) and the
-    generalized force gf (nv,); returns (status, cond(A)): SINGULAR when the constraint matrix
-    is singular and the equations inconsistent, NONFINITE when they hold an inf or a nan."""
+def solve_modes(P, modes, dirs, omega, out):
+    """`constraints.solve_given_modes` of the `Problem` P under the mode codes ``modes`` and
+    the sliding directions ``dirs`` (k, 2) into the `Solution` out; returns (status,
+    cond(A)): SINGULAR when the constraint matrix is singular and the equations inconsistent,
+    NONFINITE when they hold an inf or a nan."""
+    Minv, a0, W, bias, gap, vn, mu, mu_s = P
+    vdot, lam_n, lam_t, gf = out
     k, nv = W.shape[0], W.shape[1]
     m = 0
     for i in range(k):
@@ -173,7 +201,7 @@ def warm():
     for i in range(k):
         W[i, :3] = np.eye(3)
         W[i, 3:, 0] = (1.0, 0.0, 0.0)
-    solve_modes(np.eye(nv), np.zeros(nv), W, np.zeros((k, 3)), np.zeros(k), np.zeros(k),
-                np.full(k, 0.3), np.full(k, 0.3), np.array([STICK, SLIDE], dtype=np.int64),
-                np.array([[0.0, 0.0], [1.0, 0.0]]), 20.0, np.empty(nv), np.empty(k),
-                np.empty((k, 2)), np.empty(nv))
+    solve_modes(Problem(np.eye(nv), np.zeros(nv), W, np.zeros((k, 3)), np.zeros(k),
+                        np.zeros(k), np.full(k, 0.3), np.full(k, 0.3)),
+                np.array([STICK, SLIDE], dtype=np.int64), np.array([[0.0, 0.0], [1.0, 0.0]]),
+                20.0, Solution(np.empty(nv), np.empty(k), np.empty((k, 2)), np.empty(nv)))
