@@ -2,7 +2,7 @@
 wings of `drake_dock.docking`, import only downwards; no import circles; no private name imported
 across modules; no module over 500 lines, no class over 300 lines; module names unique, and none
 an inflection of another; a wing's package only a docstring; tests/core reaches no Drake module
-through any chain of imports."""
+through any chain of imports; the compiled code sorts by np.argsort only."""
 import ast
 from pathlib import Path
 
@@ -250,3 +250,22 @@ def test_core_modules_use_numpy_and_scipy_only(layer):
             for mod, _ in _imports(path, package):
                 top = mod.split(".")[0]
                 assert top == "drake_dock" or top in allowed, f"{name} imports {mod}"
+
+
+def test_compiled_code_sorts_by_argsort_only():
+    """numba names the machine code of its np.sort and its np.argsort of one array type alike,
+    per process, so a kernel compiled in a process that loaded another from the cache can link
+    one in place of the other (docs/performance.md, "Compiled kernels"). The compiled code -
+    the kernels package but its compile infrastructure, and the modules of `register_jitable`
+    functions - therefore calls np.argsort and never np.sort or an array's sort()."""
+    kernels = PACKAGE / "core" / "kernels"
+    infrastructure = {"__init__", "__main__", "compile_cache", "prepare"}
+    compiled = [p for p in sorted(kernels.glob("*.py")) if p.stem not in infrastructure]
+    compiled += [p for p in sorted(PACKAGE.rglob("*.py"))
+                 if p.parent != kernels and "register_jitable" in p.read_text()]
+    assert len(compiled) > 20
+    sorts = [f"{p.relative_to(ROOT)}:{node.lineno}"
+             for p in compiled for node in ast.walk(ast.parse(p.read_text()))
+             if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+             and node.func.attr == "sort"]
+    assert not sorts, f"np.sort or sort() in compiled code: {sorts}"
