@@ -126,7 +126,7 @@ def _select(P, vt, avoid, v_slip, omega, rtol, tie_rtol):
                 else:
                     dirs[i, 0], dirs[i, 1] = 1.0, 0.0
             st, ok = slide_start(P, modes, dirs, starting, omega,
-                                 Outputs(vdot, lam_n, lam_t, gf, gdd, at))
+                                 Outputs(Solution(vdot, lam_n, lam_t, gf), gdd, at))
             if st != OK or not ok:
                 continue
         else:
@@ -213,15 +213,18 @@ def raise_status(status, cond, modes, names, time):
         couples=[c for c, m in zip(names, modes) if m != DETACH])
 
 
+def _problem(Minv, a0, rows):
+    """(the `Problem` of the rows under M^-1 and a0, the rows' tangential velocities vt)."""
+    W, bias, gap, vn, vt, mu, mu_s = pack_rows(rows)
+    return Problem(np.ascontiguousarray(Minv, dtype=float), np.asarray(a0, dtype=float), W,
+                   bias, gap, vn, mu, mu_s), vt
+
+
 def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None):
     """`constraints.solve_given_modes` compiled: the same arguments and `ContactSolution`."""
-    W, bias, gap, vn, vt, mu, mu_s = pack_rows(rows)
     codes = np.array([CODE[m] for m in modes], dtype=np.int64)
-    vdot, lam_n, lam_t, gf = solve_packed(Problem(np.ascontiguousarray(Minv, dtype=float),
-                                                  np.asarray(a0, dtype=float), W, bias, gap, vn,
-                                                  mu, mu_s),
-                                          codes, _dirs_array(modes, dirs), omega,
-                                          time=time,
+    vdot, lam_n, lam_t, gf = solve_packed(_problem(Minv, a0, rows)[0], codes,
+                                          _dirs_array(modes, dirs), omega, time=time,
                                           names=[r.name for r in rows])
     return ref.ContactSolution(tuple(modes), list(dirs), vdot, lam_n, lam_t, gf, list(rows))
 
@@ -236,15 +239,13 @@ def select_contact_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, r
     if k > ref.MAX_ENUMERATED:
         raise NumericalError(f"{k} couples in contact at once; mode enumeration is limited to "
                              f"{ref.MAX_ENUMERATED}", time=time, couples=names)
-    W, bias, gap, vn, vt, mu, mu_s = pack_rows(rows)
+    P, vt = _problem(Minv, a0, rows)
     av = np.zeros((k, 3), dtype=np.int64)
     for i, a in enumerate(avoid or [()] * k):
         for m in a:
             av[i, CODE[m]] = 1
     st, M_, D_, V_, LN, LT, GF, best, other = _select(
-        Problem(np.ascontiguousarray(Minv, dtype=float), np.asarray(a0, dtype=float), W, bias,
-                gap, vn, mu, mu_s),
-        vt, av, float(v_slip), float(omega), float(rtol), ref.TIE_RTOL)
+        P, vt, av, float(v_slip), float(omega), float(rtol), ref.TIE_RTOL)
     if st == NONE_CONSISTENT:
         raise PainleveInconsistency(
             "no consistent contact mode (Painleve inconsistency: the rigid model with this "

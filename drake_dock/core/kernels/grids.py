@@ -32,6 +32,7 @@ class Domain(NamedTuple):
     periodic: np.ndarray
     grid: np.ndarray
 
+
 @njit(cache=True)
 def _frame(R, o):
     """R and o as twelve scalars, read once for a grid's loop."""

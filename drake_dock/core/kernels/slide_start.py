@@ -19,10 +19,7 @@ class Outputs(NamedTuple):
     lambda_t, the generalized contact force) and the couples' normal and tangential
     accelerations (`solve.accelerations`)."""
 
-    vdot: np.ndarray
-    lam_n: np.ndarray
-    lam_t: np.ndarray
-    gf: np.ndarray
+    solution: Solution
     gdd: np.ndarray
     at: np.ndarray
 
@@ -30,12 +27,12 @@ class Outputs(NamedTuple):
 @njit(cache=True, inline="always")
 def _solve(P, modes, dirs, omega, out):
     """`solve_modes` of the `solve.Problem` P under ``modes`` and ``dirs`` into the `Outputs` out,
-    with the couples' accelerations; returns the status. Inlined where it is called: as a
-    function of its own it added a tenth to the unit's compile."""
-    st, _c = solve_modes(P, modes, dirs, omega, Solution(out.vdot, out.lam_n, out.lam_t, out.gf))
+    with the couples' accelerations; returns the status. Inlined where it is called (as a
+    function of its own it would add about a tenth to the unit's compile)."""
+    st, _c = solve_modes(P, modes, dirs, omega, out.solution)
     if st != OK:
         return st
-    accelerations(P.W, P.bias, out.vdot, out.gdd, out.at)
+    accelerations(P.W, P.bias, out.solution.vdot, out.gdd, out.at)
     return OK
 
 
@@ -159,7 +156,7 @@ def _slide_start_grid(P, modes, dirs, starting, omega, out):
     st = _slip_residuals(P, modes, dirs, starting, th, omega, out, r, False)
     if st != OK:
         return st, False
-    small = 1e-6 * (1.0 + np.abs(out.vdot).max())
+    small = 1e-6 * (1.0 + np.abs(out.solution.vdot).max())
     at = out.at
     ok = True
     for c in range(2):
