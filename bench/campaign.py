@@ -46,16 +46,12 @@ def plan_with(samples: int, where: Path) -> Path:
 
 
 class Clock(CampaignProgress):
-    """The campaign's progress, silent, with the times of its start (the cluster connected)
-    and of its last batch saved."""
+    """The campaign's progress, silent, with the time of its last batch saved (its start, the
+    cluster connected, is the progress's own ``t0``)."""
 
     def __init__(self):
         super().__init__(io.StringIO())
-        self.started = self.last_saved = None
-
-    def start(self, total, saved):
-        self.started = time.perf_counter()
-        super().start(total, saved)
+        self.last_saved = None
 
     def update(self, rows):
         super().update(rows)
@@ -70,7 +66,7 @@ def measure(samples: int, workers: int, where: Path) -> dict:
     summary = run_campaign(plan, out, workers=workers, progress=clock)
     wall = time.perf_counter() - t0
     rows = pq.read_table(out / "results.parquet").to_pylist()
-    running = clock.last_saved - clock.started
+    running = clock.last_saved - clock.t0
     return {"workers": workers, "wall": wall, "rate": samples / wall * 60.0,
             "per_sample": running / samples, "fixed": wall - running,
             "sample_walls": [r["wall_time"] for r in rows if r["wall_time"] is not None],

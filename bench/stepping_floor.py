@@ -150,9 +150,10 @@ def main():
     runs = [simulate(scenario, state, dd=dd) for _ in range(args.repeats)]
     run = runs[0]
     per_run = statistics.median(r.wall_time / r.evaluations for r in runs)
+    wall = statistics.median(r.wall_time for r in runs)
     print(f"sample {args.sample}: {run.outcome} at {run.end_time:.3f} s simulated, "
-          f"{run.evaluations} evaluations computed, wall {statistics.median(r.wall_time for r in runs):.3f}"
-          f" s (median of {args.repeats})")
+          f"{run.evaluations} evaluations computed, wall {wall:.3f} s (median of "
+          f"{args.repeats})")
     shares = ", ".join(f"{k.replace('_', ' ')} {v:.0%}" for k, v in run.timing["shares"].items())
     print(f"the run's wall time by part (`RigidContactSystem.timing`): {shares}")
 
@@ -203,7 +204,6 @@ def main():
                    for r in runs]
         kept = statistics.median(kept_of)
         projected = statistics.median(k + r.evaluations * per_loop for k, r in zip(kept_of, runs))
-        wall = statistics.median(r.wall_time for r in runs)
         print(f"projected wall of the sample with compiled stepping: {projected:.3f} s (its "
               f"seeking and impacts as they are, {kept:.3f} s, and each of its evaluations at "
               f"the compiled loop's cost; medians over the runs), {wall / projected:.1f}x less "
