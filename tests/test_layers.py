@@ -269,3 +269,38 @@ def test_compiled_code_sorts_by_argsort_only():
              if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
              and node.func.attr == "sort"]
     assert not sorts, f"np.sort or sort() in compiled code: {sorts}"
+
+
+def _is_scalar_constant(node) -> bool:
+    """A number, or np.inf / np.nan, possibly negated."""
+    if isinstance(node, ast.UnaryOp):
+        node = node.operand
+    return (isinstance(node, ast.Constant) and isinstance(node.value, (int, float))
+            or isinstance(node, ast.Attribute) and node.attr in ("inf", "nan"))
+
+
+def test_kernels_copy_arrays_without_slice_assignment():
+    """numba checks the shapes of an array assigned into a slice with an error message it
+    formats at run time, which compiles its string formatting into each kernel holding one
+    (docs/performance.md, "Compiled kernels"): the compiled functions copy with
+    `copies.copy1`/`copy2` and assign only constants to slices. (An array assigned to an
+    indexed row, R[k] = M, has the same check; read from the sources, only the slice forms
+    are caught here.)"""
+    kernels = PACKAGE / "core" / "kernels"
+    infrastructure = {"__init__", "__main__", "compile_cache", "prepare"}
+    found = []
+    for p in sorted(kernels.glob("*.py")):
+        if p.stem in infrastructure:
+            continue
+        jitted = [f for f in ast.parse(p.read_text()).body if isinstance(f, ast.FunctionDef)
+                  and any("jit" in ast.unparse(d) for d in f.decorator_list)]
+        for node in (n for f in jitted for n in ast.walk(f)):
+            targets = node.targets if isinstance(node, ast.Assign) else []
+            for t in targets:
+                elts = t.elts if isinstance(t, ast.Tuple) else [t]
+                for e in elts:
+                    if (isinstance(e, ast.Subscript)
+                            and any(isinstance(s, ast.Slice) for s in ast.walk(e.slice))
+                            and not _is_scalar_constant(node.value)):
+                        found.append(f"{p.relative_to(ROOT)}:{node.lineno}")
+    assert not found, f"an array assigned into a slice in the kernels: {found}"

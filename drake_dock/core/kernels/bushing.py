@@ -107,7 +107,7 @@ def _vec(a):
     return (a[0], a[1], a[2])
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _mtm(A, B):
     """A^T B for row-major 9-tuples."""
     return (A[0] * B[0] + A[3] * B[3] + A[6] * B[6], A[0] * B[1] + A[3] * B[4] + A[6] * B[7],

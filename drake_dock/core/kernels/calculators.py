@@ -7,6 +7,7 @@ import numpy as np
 from numba import njit
 
 from drake_dock.core.kernels import couples as K
+from drake_dock.core.kernels.copies import copy1, copy2
 from drake_dock.core.kernels.engine import couple_rates
 from drake_dock.core.kernels.forces import block_apply, element_forces, kinetic_energy
 from drake_dock.core.kernels.free_bodies import (body_kinematics, frame_kinematics,
@@ -70,7 +71,7 @@ def contact_row(mp, i, row, pb, wb, W, bias):
     Wt = np.empty((W.shape[0], 3))
     point_rows(m.vs, pb, wb, m.frame_body[a], m.frame_body[b], row[K.P1:K.P1 + 3],
                row[K.P2:K.P2 + 3], D, Wt, acc)
-    W[:] = Wt
+    copy2(W, Wt)
     bias[0] = row[K.BIAS_N] + acc[0]
     bias[1] = row[K.BIAS_T] + acc[1]
     bias[2] = row[K.BIAS_T + 1] + acc[2]
@@ -98,7 +99,7 @@ def dynamics_at(mp, q, v, tau_in, M, Minv, a0, scal):
     mass_matrix(m.vs, m.mass, m.com, m.inertia, Rb, M)
     cv = np.zeros(nv)
     mass_inverse_and_bias(m.vs, m.mass, m.com, m.inertia_inv, m.inertia, Rb, wb, Minv, cv)
-    a0[:] = block_apply(m.vs, Minv, tau_el + tau_in - cv)
+    copy1(a0, block_apply(m.vs, Minv, tau_el + tau_in - cv))
     p_el, p_in = 0.0, 0.0
     for a in range(nv):
         p_el += tau_el[a] * v[a]

@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit
 
 from drake_dock.core import constraints as ref
+from drake_dock.core.kernels.copies import copy1
 from drake_dock.core.kernels.slide_start import Outputs, slide_start
 from drake_dock.core.kernels.solve import (CODE, DETACH, INDETERMINATE, NAME, NONE_CONSISTENT,
                                            NONFINITE, OK, SLIDE, STICK, Problem, Solution,
@@ -91,14 +92,14 @@ def _select(P, vt, avoid, v_slip, omega, rtol, tie_rtol):
             o = r % nopt[i]
             r //= nopt[i]
             modes[i] = (SLIDE, DETACH)[o] if has_dir[i] else o
-        M_[c] = modes
+        copy1(M_[c], modes)
         level[c] = 2
         dirs = D_[c]
         nstart = 0
         for i in range(k):
             if modes[i] == SLIDE:
                 if has_dir[i]:
-                    dirs[i] = moving[i]
+                    copy1(dirs[i], moving[i])
                 else:
                     nstart += 1
         starting = np.empty(nstart, np.int64)

@@ -64,7 +64,7 @@ def _residual(cc, d, T1, K1, T2, T2b, K2, K2ab, K2bb):
              _dot(T1, _add(_cr(suv, sv), _cr(su, svv)))))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _det(n, A0, A1, A2):
     if n == 2:
         return A0[0] * A1[1] - A0[1] * A1[0]

@@ -46,7 +46,7 @@ from drake_dock.core.kernels.model import (BUSH_ROW, CC, FAR, NW, O_COND_MIN, O_
 from drake_dock.core.kernels.solve import OK, SLIDE, STICK, Problem, Solution, solve_modes
 from drake_dock.core.kernels.witness_values import end_margin, handover_guard, point_curve_side
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _couple(m, i, R, o, w, vf, u, sigma, row):
     """Pair i's couple into its couple row (its kind's kernel)."""
     a, b = m.fidx[i, 0], m.fidx[i, 1]

@@ -52,7 +52,7 @@ def perp_rate(unit, rate, norm):
     return mul(axpy(-dot(unit, rate), unit, rate), 1.0 / norm)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def frame_rates_cc(t1, t2, t1dot, t2dot, w1, w2, u1dot, u2dot, sigma):
     """C-C: n = sigma t1 x t2 / |t1 x t2|, ta = t2 / |t2| and their rates from the tangents'
     rates; conv, the part of the contact points' relative acceleration due to the couple's
@@ -79,7 +79,7 @@ def frame_rates_cs(t1, su, sv, sudot, svdot, N, w1, w2, u1dot, u2dot_a, u2dot_b,
     return n, ndot, ta, tadot, conv
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def frame_rates_pc(d, t2, ddot, t2dot, w2, u2dot, sigma):
     """P-C (a point against a curve, d = p - c(s)): n = sigma d / |d|, ta = t2 / |t2| and their
     rates from d' (= v_rel - t2 s') and t2'; conv = -w2 x t2 s' (the point has no parameter).

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from drake_dock.core.kernels.copies import copy1, copy2
 
 
 @njit(cache=True)
@@ -69,7 +70,7 @@ def mv3(A, x):
     return y
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def mtv3(A, x):
     """A^T x of a 3x3 matrix and a 3-vector."""
     y = np.empty(3)
@@ -91,7 +92,7 @@ def body_kinematics(qs, vs, q, v, Rb, pb, wb, vb):
     velocities vb (nb, 3)."""
     for b in range(qs.shape[0]):
         i, j = qs[b], vs[b]
-        Rb[b] = rotation(q[i], q[i + 1], q[i + 2], q[i + 3])
+        copy2(Rb[b], rotation(q[i], q[i + 1], q[i + 2], q[i + 3]))
         for c in range(3):
             pb[b, c] = q[i + 4 + c]
             wb[b, c] = v[j + c]
@@ -106,12 +107,12 @@ def frame_kinematics(fb, R_BF, p_BF, Rb, pb, wb, vb, R, o, w, vf):
     for f in range(fb.shape[0]):
         b = fb[f]
         if b < 0:
-            R[f] = R_BF[f]
-            o[f] = p_BF[f]
+            copy2(R[f], R_BF[f])
+            copy1(o[f], p_BF[f])
             w[f] = 0.0
             vf[f] = 0.0
             continue
-        R[f] = mm3(Rb[b], R_BF[f])
+        copy2(R[f], mm3(Rb[b], R_BF[f]))
         for c in range(3):
             r[c] = Rb[b, c, 0] * p_BF[f, 0] + Rb[b, c, 1] * p_BF[f, 1] + Rb[b, c, 2] * p_BF[f, 2]
         _cross(wb[b], r, wr)
@@ -121,7 +122,7 @@ def frame_kinematics(fb, R_BF, p_BF, Rb, pb, wb, vb, R, o, w, vf):
             vf[f, c] = vb[b, c] + wr[c]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def qdot(qs, vs, q, v, out):
     """q' for v: the quaternion's rate 1/2 (0, w) (x) q, the origin's v_WBo."""
     for b in range(qs.shape[0]):
@@ -237,12 +238,12 @@ def frame_poses(qs, q, fb, R_BF, p_BF, R, o):
     for f in range(fb.shape[0]):
         b = fb[f]
         if b < 0:
-            R[f] = R_BF[f]
-            o[f] = p_BF[f]
+            copy2(R[f], R_BF[f])
+            copy1(o[f], p_BF[f])
             continue
         i = qs[b]
         Rb = rotation(q[i], q[i + 1], q[i + 2], q[i + 3])
-        R[f] = mm3(Rb, R_BF[f])
+        copy2(R[f], mm3(Rb, R_BF[f]))
         for c in range(3):
             o[f, c] = q[i + 4 + c] + Rb[c, 0] * p_BF[f, 0] + Rb[c, 1] * p_BF[f, 1] \
                 + Rb[c, 2] * p_BF[f, 2]

@@ -9,6 +9,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from drake_dock.core.kernels.copies import copy1, copy2
 from drake_dock.core.kernels.jets import PETAL, petal_point, petal_row, position
 
 
@@ -122,7 +123,7 @@ def _axes_positions(kind, prm, R, o, A):
     if kind != PETAL or dim == 1:
         U = np.empty((n ** dim, dim))
         for a in range(n ** dim):
-            U[a] = _axes_point(A, a)
+            copy1(U[a], _axes_point(A, a))
         return positions(kind, prm, R, o, U)
     X = np.empty((n * n, 3))
     F = _frame(R, o)
@@ -171,7 +172,8 @@ def hierarchical(a, da, b, db, levels, n_fine, candidates):
                     best, bi, bj = d2[i, j], i, j
         if bi < 0:
             break
-        C1[C], C2[C] = U1[bi], U2[bj]
+        copy1(C1[C], U1[bi])
+        copy1(C2[C], U2[bj])
         C += 1
         near2 = np.empty(d2.shape[1], dtype=np.bool_)
         for j in range(d2.shape[1]):
@@ -188,8 +190,10 @@ def hierarchical(a, da, b, db, levels, n_fine, candidates):
             A2 = _local_axes(C2[c].copy(), 2 * g2, lo2, hi2, per2, n_fine)
             i, j = _argmin_d2(_axes_positions(k1, p1, R1, o1, A1),
                               _axes_positions(k2, p2, R2, o2, A2))
-            C1[c], C2[c] = _axes_point(A1, i), _axes_point(A2, j)
+            copy1(C1[c], _axes_point(A1, i))
+            copy1(C2[c], _axes_point(A2, j))
         g1, g2 = 4 * g1 / (n_fine - 1), 4 * g2 / (n_fine - 1)
     out = np.empty((C, dim1 + dim2))
-    out[:, :dim1], out[:, dim1:] = C1[:C], C2[:C]
+    copy2(out[:, :dim1], C1[:C])
+    copy2(out[:, dim1:], C2[:C])
     return out

@@ -64,7 +64,7 @@ def patch_spec(patch):
     return kind, prm
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _polar(r, r1, r2, z, z1, z2, th):
     c, s = math.cos(th), math.sin(th)
     return ((r * c, r * s, z), (r1 * c - r * s, r1 * s + r * c, z1), _Z,
@@ -87,7 +87,7 @@ def _petal_z(prm, z):
     return (z if inside else min(max(z, prm[8]), prm[9])), inside
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _petal(prm, a, z):
     """`_PetalMap.jet` composed with the cone's jet by `Reparametrized.jet`'s chain rule;
     theta_1 held beyond the reach (its derivatives zero there)."""

@@ -12,9 +12,10 @@ from __future__ import annotations
 import math
 
 from numba import njit
+from drake_dock.core.kernels.copies import copy1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def lead_points(t0, w0, t1, w1, t2, w2, n):
     """Time from t2 to the predicted zero of the witness through its last n points (2 or 3,
     the oldest first: (t0, w0) only when n == 3), inf if none is predicted ahead."""
@@ -102,15 +103,15 @@ def push(T, W, D, n, t, w, d):
         n -= 1
         for r in (1, 0):
             T[r + 1] = T[r]
-            W[r + 1, :] = W[r, :]
-            D[r + 1, :] = D[r, :]
+            copy1(W[r + 1], W[r])
+            copy1(D[r + 1], D[r])
     for r in range(2):
         T[r] = T[r + 1]
-        W[r, :] = W[r + 1, :]
-        D[r, :] = D[r + 1, :]
+        copy1(W[r], W[r + 1])
+        copy1(D[r], D[r + 1])
     T[2] = t
-    W[2, :] = w
-    D[2, :] = d
+    copy1(W[2], w)
+    copy1(D[2], d)
     return min(n + 1, 3)
 
 

@@ -31,6 +31,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from drake_dock.core.kernels.copies import copy1, copy2
 from drake_dock.core.kernels.lzb_phases import (APPROACH, COMPRESSION, EXPANSION, FRICTION,
                                                 NORMAL, EventLog, ImpactConstants, Phases,
                                                 apply_event, classify, event_value,
@@ -302,7 +303,7 @@ def lzb_impact(y, t, h, steps, imp, ph):
             nb = active_events(rc, t_old, t_new, g0, g1, tmp, imp, ph, br)
             if nb > 0:
                 # `solve.handle_events`, as a transaction.
-                sv_y[:] = y
+                copy1(sv_y, y)
                 _copy_into(sv, ph)
                 n_log = log.n
                 first = 0
@@ -360,7 +361,7 @@ def lzb_impact(y, t, h, steps, imp, ph):
                     kind = NORMAL if phase[jt] == COMPRESSION else APPROACH
                     ok, log = apply_event(y, kind, jt, impulse, imp, ph, log)
                 if not ok:
-                    y[:] = sv_y
+                    copy1(y, sv_y)
                     _copy_into(ph, sv)
                     log = EventLog(log.impulse, log.kind, log.couple, n_log)
                     return (PYEVENT, t, y, h_used, steps, log, hist, nh, t_old, t_new, rc,
@@ -370,14 +371,14 @@ def lzb_impact(y, t, h, steps, imp, ph):
                 nh = _history(hist, nh, y, imp)
                 hist = _grown(hist, nh)
                 break
-            y[:] = yn
+            copy1(y, yn)
             t = t_new
             for i in range(N):
                 k1[i] = k7[i]
             if classify(y, imp, ph):
                 event_values(y, g0, imp, ph)
             else:
-                g0[:, :] = g1
+                copy2(g0, g1)
             nh = _history(hist, nh, y, imp)
             hist = _grown(hist, nh)
             h = h_used * fac
@@ -400,9 +401,14 @@ def _copied(ph):
 @njit(cache=True)
 def _copy_into(dst, src):
     """The phase arrays of src into those of dst."""
-    dst.phase[:], dst.sep[:], dst.rate[:], dst.x_end[:] = src.phase, src.sep, src.rate, src.x_end
-    dst.slip_dir[:], dst.wc[:] = src.slip_dir, src.wc
-    dst.e_start[:], dst.wc_open[:] = src.e_start, src.wc_open
+    copy1(dst.phase, src.phase)
+    copy1(dst.sep, src.sep)
+    copy1(dst.rate, src.rate)
+    copy1(dst.x_end, src.x_end)
+    copy2(dst.slip_dir, src.slip_dir)
+    copy1(dst.wc, src.wc)
+    copy1(dst.e_start, src.e_start)
+    copy1(dst.wc_open, src.wc_open)
 
 
 @njit(cache=True)
@@ -429,7 +435,7 @@ def _grown(hist, nh):
     if nh < len(hist):
         return hist
     out = np.empty((2 * len(hist), hist.shape[1]))
-    out[:nh] = hist[:nh]
+    copy2(out[:nh], hist[:nh])
     return out
 
 

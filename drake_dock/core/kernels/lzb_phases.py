@@ -15,6 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from drake_dock.core.kernels.copies import copy1
 
 # Phases (`drake_dock.core.lzb.state`) and event rows (`drake_dock.core.lzb.problem`).
 COMPRESSION, EXPANSION, LOCKED = 0, 1, 2
@@ -203,7 +204,9 @@ def _log(log, impulse, kind, j):
     if n >= len(ev_kind):
         m = 2 * len(ev_kind)
         a, b, c = np.empty(m), np.empty(m, np.int64), np.empty(m, np.int64)
-        a[:n], b[:n], c[:n] = ev_imp[:n], ev_kind[:n], ev_couple[:n]
+        copy1(a[:n], ev_imp[:n])
+        copy1(b[:n], ev_kind[:n])
+        copy1(c[:n], ev_couple[:n])
         ev_imp, ev_kind, ev_couple = a, b, c
     ev_imp[n], ev_kind[n], ev_couple[n] = impulse, kind, j
     return EventLog(ev_imp, ev_kind, ev_couple, n + 1)

@@ -22,6 +22,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from drake_dock.core.kernels.copies import copy1
 from drake_dock.core.kernels.grids import Domain, Placed, hierarchical, positions, within
 from drake_dock.core.kernels.jets import CIRCLE, jet, position
 
@@ -160,11 +161,11 @@ def newton(pa, pb, u, bounds, tol, max_iter, distance_rtol, rtol_beyond):
         k1d = 0.0
         if n1 == 1:
             j1 = jet(k1, p1, u[0], 0.0)
-            cols[0] = R1 @ np.array(j1[1])
+            copy1(cols[0], R1 @ np.array(j1[1]))
             k1d = (R1.T @ d) @ np.array(j1[3])
-        cols[n1] = -(R2 @ np.array(j2[1]))
+        copy1(cols[n1], -(R2 @ np.array(j2[1])))
         if n2 == 2:
-            cols[n1 + 1] = -(R2 @ np.array(j2[2]))
+            copy1(cols[n1 + 1], -(R2 @ np.array(j2[2])))
         g = cols @ d
         H = cols @ cols.T
         d2 = R2.T @ d
@@ -214,7 +215,8 @@ def newton(pa, pb, u, bounds, tol, max_iter, distance_rtol, rtol_beyond):
                 if f != 0.0 and not periodic[a]:
                     room = ((upper[a] if f > 0 else lower[a]) - u[a]) / f
                     cut = min(cut, max(room, 0.0))
-            step[fi] = sf + cut * flat
+            for m in range(fi.shape[0]):
+                step[fi[m]] = sf[m] + cut * flat[m]
             reach = np.max(np.abs(step) / scale)
             if reach > 0.25:
                 step = step * (0.25 / reach)
@@ -302,7 +304,7 @@ def seek(a, da, b, db, levels, n_fine, candidates, distance_rtol, rtol_beyond):
         u, its[m], status[m] = newton(a, b, starts[c], bounds, 1e-14, CLOSEST_MAX_ITER,
                                       distance_rtol, rtol_beyond)
         _, x1, x2 = _gap(k1, p1, R1, o1, k2, p2, R2, o2, u, 1)
-        U[m] = u
+        copy1(U[m], u)
         X1[m, 0], X1[m, 1], X1[m, 2] = x1
         X2[m, 0], X2[m, 1], X2[m, 2] = x2
         interior[m] = True

@@ -36,7 +36,7 @@ def _solve(P, modes, dirs, omega, out):
     return OK
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def slide_start(P, modes, dirs, starting, omega, out):
     """`constraints._slide_start` for the `solve.Problem` P: the sliding directions (in dirs) of the
     couples ``starting`` to slide, s = a_t/|a_t|, the solution in the `Outputs` out; returns
@@ -106,7 +106,7 @@ def _slip_residuals(P, modes, dirs, starting, th, omega, out, r, angle):
     return OK
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _slide_start_grid(P, modes, dirs, starting, omega, out):
     """`constraints._slide_start_grid` (the same grid, Newton steps and test)."""
     n = ref.SLIDE_START_GRID
@@ -187,7 +187,7 @@ def _nearest_bracket(ths, rs, th0, within_quarter):
     return best_k
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _slide_start_scan(P, modes, dirs, i, omega, out):
     """`constraints._slide_start_scan` (the same scan, brackets and bisection)."""
     at = out.at

@@ -14,6 +14,7 @@ from numba import njit
 from drake_dock.core import constraints as ref
 from drake_dock.core.kernels import small_linalg as L
 from drake_dock.core.squeeze import cones_hold, squeeze_along
+from drake_dock.core.kernels.copies import copy1
 
 STICK, SLIDE, DETACH = 0, 1, 2
 CODE = {ref.STICK: STICK, ref.SLIDE: SLIDE, ref.DETACH: DETACH}
@@ -70,7 +71,7 @@ def solve_modes(P, modes, dirs, omega, out):
     lam_n[:] = 0.0
     lam_t[:] = 0.0
     if m == 0:
-        vdot[:] = a0
+        copy1(vdot, a0)
         gf[:] = 0.0
         return OK, 0.0
     Ct = np.empty((m, nv))         # C^T and D^T, C-ordered: C = Ct.T as the reference's

@@ -24,7 +24,7 @@ def rot_col(R, a0, a1, a2):
             R[2, 0] * a0 + R[2, 1] * a1 + R[2, 2] * a2)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def handover_guard(m, i, row, R2):
     """Edge pair i's hand-over guard (`drake_dock.core.handover.edge_guard`): the least over
     its edges of n . b, b the surface's outward conormal at the edge point, Body 2 turned by
@@ -51,7 +51,7 @@ def handover_guard(m, i, row, R2):
     return g
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def point_curve_side(m, i, row, R2):
     """A point-curve pair's side (`drake_dock.core.couple.point_curve_side`): the cosine
     between its normal and the curve's curvature direction, 1 where the curve is straight."""
@@ -76,7 +76,7 @@ def end_margin(m, i, row):
     return w
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def end_margin_rate(m, i, row):
     """The rate (1/s) of `end_margin`: that of the margin it takes, from the couple's rate
     (Eq. 47, row UDOT); NaN when no parameter is bounded."""
@@ -139,7 +139,7 @@ def witness_now(mp, wv, rows, flat, gap_pos, g_flat, gap_flat, regular_pos, regu
     return w, d, turning[:nt]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def far_bounds(m, s, R, o, bound):
     """The far pairs' travel bound (Sect. 5.1; `drake_dock.systems.far_pairs`):
     |delta(X21 c1)| + |delta R21|_2 r1 since their last seek, inf for a pair never sought;
@@ -174,7 +174,7 @@ def far_bounds(m, s, R, o, bound):
         bound[i] = math.sqrt(lin2) + math.sqrt(max(3.0 - tr, 0.0)) * m.radius1[i]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def bound_rate(m, i, R, o, w, vf):
     """An upper bound of the rate of far pair i's travel bound (`far_bounds`): the speed of
     its bounding sphere's centre relative to frame 2 plus the relative angular speed times
