@@ -2,8 +2,12 @@
 in N processes (default: one per core) with a line per module and its time, loads them all and
 prints the cache directory. ``--worker`` is a worker's command: it compiles the modules named on
 its stdin, one a line, and answers each with a line "NAME SECONDS"
-(`drake_dock.core.kernels.prepare`)."""
+(`drake_dock.core.kernels.prepare`), and ends without the interpreter's teardown: freeing what
+the compiler built takes up to a second or two, and the run that waits for the workers would
+wait for it."""
 import argparse
+import contextlib
+import os
 import sys
 
 from drake_dock.core.kernels import prepare
@@ -19,7 +23,10 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.worker:
         prepare.serve(sys.stdin, sys.stdout)
-        return 0
+        with contextlib.suppress(OSError, ValueError):
+            sys.stdout.flush()
+            sys.stderr.flush()
+        os._exit(0)     # the cache and the answers are written (module docstring)
     seconds = prepare.prepare(sys.stdout, jobs=args.jobs)
     print(f"kernels ready in {seconds:.2f} s; numba cache: {cache_dir()}")
     return 0
