@@ -49,6 +49,7 @@ bench: $(BIN)/.installed
 	$(BIN)/python bench/offnominal.py
 	$(BIN)/python bench/evaluation.py
 	$(BIN)/python bench/campaign.py
+	$(BIN)/python bench/campaign_step.py
 	$(BIN)/python bench/cold_start.py
 
 # Every figure, table and data file under docs/, each from the command that docs/results.md
