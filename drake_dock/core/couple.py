@@ -167,18 +167,16 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
     out = np.zeros(K.ROW)
     project = np.bool_(project)
     sigma = float(sigma)
+    f1, f2 = K.Frame(R1, o1, w1, v1), K.Frame(R2, o2, w2, v2)
     if pair == K.PC:
-        K.evaluate_pc_one(k2, q2, p, patch1.radius, R1, o1, w1, v1, R2, o2, w2, v2, u[0],
-                          sigma, project, out)
+        K.evaluate_pc_one(k2, q2, p, patch1.radius, f1, f2, u[0], sigma, project, out)
         if math.isnan(out[K.GAP]):
             raise SingularCoupleError("point-curve couple: the point lies on the curve "
                                       "(|d| = 0), its normal is undefined")
     elif pair == K.PS:
-        K.evaluate_ps_one(k2, q2, p, patch1.radius, R1, o1, w1, v1, R2, o2, w2, v2,
-                          (u[0], u[1]), sigma, project, out)
+        K.evaluate_ps_one(k2, q2, p, patch1.radius, f1, f2, (u[0], u[1]), sigma, project, out)
     else:
-        K.evaluate_one(pair == K.CC, k1, q1, k2, q2, R1, o1, w1, v1, R2, o2, w2, v2, u, sigma,
-                       project, out)
+        K.evaluate_one(pair == K.CC, k1, q1, k2, q2, f1, f2, u, sigma, project, out)
     return CoupleEval(
         u=out[K.U:K.U + m], drift=out[K.DRIFT:K.DRIFT + m], residual=float(out[K.RESIDUAL]),
         udot=out[K.UDOT:K.UDOT + m], conditioning=float(out[K.COND]), p1=out[K.P1:K.P1 + 3],

@@ -8,13 +8,13 @@ from numba import njit
 
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.copies import copy1, copy2
-from drake_dock.core.kernels.engine import couple_rates
+from drake_dock.core.kernels.engine import couple_rates, pair_couple
 from drake_dock.core.kernels.forces import block_apply, element_forces, kinetic_energy
 from drake_dock.core.kernels.free_bodies import (body_kinematics, frame_kinematics,
                                                  mass_inverse_and_bias, mass_matrix,
                                                  point_rows)
 from drake_dock.core.kernels.jets import position
-from drake_dock.core.kernels.model import (BUSH_ROW, CC, CS, FAR, PC, PS, Z_NQ, Z_NV, Z_NX,
+from drake_dock.core.kernels.model import (BUSH_ROW, CS, FAR, PC, PS, Z_NQ, Z_NV, Z_NX,
                                            layout, unpack_model, unpack_modes)
 from drake_dock.core.kernels.witness_values import rot_col
 
@@ -34,26 +34,8 @@ def couples_at(mp, R, o, w, vf, u, sigma, which, project, drift_feedback, out):
     m = unpack_model(mp)
     rate = np.zeros(u.shape[0])
     for i in which:
-        a, b = m.fidx[i, 0], m.fidx[i, 1]
         row = out[i]
-        ui = u[m.uoff[i]:m.uoff[i + 1]]
-        kind = m.pair_kind[i]
-        o1, w1, v1 = (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]), \
-            (vf[a, 0], vf[a, 1], vf[a, 2])
-        o2, w2, v2 = (o[b, 0], o[b, 1], o[b, 2]), (w[b, 0], w[b, 1], w[b, 2]), \
-            (vf[b, 0], vf[b, 1], vf[b, 2])
-        if kind == PC:
-            p = (m.prm1[i, 0], m.prm1[i, 1], m.prm1[i, 2])
-            K.evaluate_pc_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], R[a], o1, w1, v1, R[b],
-                              o2, w2, v2, ui[0], sigma[i], project, row)
-        elif kind == PS:
-            p = (m.prm1[i, 0], m.prm1[i, 1], m.prm1[i, 2])
-            K.evaluate_ps_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], R[a], o1, w1, v1, R[b],
-                              o2, w2, v2, (ui[0], ui[1]), sigma[i], project, row)
-        else:
-            us = (ui[0], ui[1], ui[2] if len(ui) == 3 else 0.0)
-            K.evaluate_one(kind == CC, m.kind1[i], m.prm1[i], m.kind2[i], m.prm2[i], R[a], o1,
-                           w1, v1, R[b], o2, w2, v2, us, sigma[i], project, row)
+        pair_couple(m, i, R, o, w, vf, u, sigma[i], row)
         couple_rates(m, i, row, drift_feedback, rate)
 
 

@@ -8,12 +8,15 @@ Eq. (52) into one row, its fields at the offsets below (`ROW`). `conditions` giv
 Jacobian Fu (Eq. 40) and their conditioning at a couple without projecting it.
 
 The patches are kernel descriptions (`drake_dock.core.kernels.jets`), a point by its frame's
-coordinates and radius; the frames' rotations are arrays, points and twists 3-tuples.
+coordinates and radius; each patch's frame comes as a `Frame` record (its rotation an array,
+its origin and twist 3-tuples), points as 3-tuples.
 """
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
+import numpy as np
 from numba import njit
 
 from drake_dock.core.kernels.frames import (add as _add, axpy as _axpy, cross as _cr, dot as _dot,
@@ -30,6 +33,15 @@ ROW = 40
 # Pair kinds.
 CC, CS, PC, PS = 0, 1, 2, 3
 _Z = (0.0, 0.0, 0.0)
+
+
+class Frame(NamedTuple):
+    """A patch's frame in the world: its rotation R (3, 3), its origin o, and its twist, the
+    angular velocity w and the velocity v of its origin (3-tuples)."""
+    R: np.ndarray
+    o: tuple
+    w: tuple
+    v: tuple
 
 
 @njit(cache=True)
@@ -118,13 +130,14 @@ def _put(out, at, a):
 
 
 @njit(cache=True)
-def evaluate_one(cc, kind1, prm1, kind2, prm2, R1, o1, w1, v1, R2, o2, w2, v2, u_state,
-                 sigma, project, out):
+def evaluate_one(cc, kind1, prm1, kind2, prm2, f1, f2, u_state, sigma, project, out):
     """One curve-curve (``cc``) or curve-surface couple at ``u_state`` (u1, u2[, u2b]) into
-    the row ``out``: patch 1 the curve (kind1, prm1) of the frame (R1, o1) with twist
-    (w1, v1), patch 2 (kind2, prm2) of (R2, o2), (w2, v2); sigma = +-1 orients n
-    (Definition 2). With ``project`` one Newton step on F(u) = 0 (Eq. 37-38) corrects the
-    couple first; a correction below 1e-9 of u moves the points along their tangents."""
+    the row ``out``: patch 1 the curve (kind1, prm1) of the `Frame` f1, patch 2 (kind2, prm2)
+    of f2; sigma = +-1 orients n (Definition 2). With ``project`` one Newton step on F(u) = 0
+    (Eq. 37-38) corrects the couple first; a correction below 1e-9 of u moves the points along
+    their tangents."""
+    R1, o1, w1, v1 = f1
+    R2, o2, w2, v2 = f2
     n = 2 if cc else 3
     u = (u_state[0], u_state[1], u_state[2] if n == 3 else 0.0)
     r1, T1, _, K1, _, _ = _geometry(kind1, prm1, R1, u[0], 0.0)
@@ -208,13 +221,15 @@ def evaluate_one(cc, kind1, prm1, kind2, prm2, R1, o1, w1, v1, R2, o2, w2, v2, u
 
 
 @njit(cache=True)
-def evaluate_pc_one(kind2, prm2, p, radius, R1, o1, w1, v1, R2, o2, w2, v2, s, sigma,
-                    project, out):
-    """One point-curve couple (kind "PC"): the point p (its frame's coordinates; a sphere of
-    ``radius``) against the curve (kind2, prm2), u = (s,), into the row ``out``. F = t2 . d,
+def evaluate_pc_one(kind2, prm2, p, radius, f1, f2, s, sigma, project, out):
+    """One point-curve couple (kind "PC"): the point p (coordinates in its `Frame` f1; a
+    sphere of ``radius``) against the curve (kind2, prm2) of f2, u = (s,), into the row
+    ``out``. F = t2 . d,
     Fu = k2 . d - t2 . t2; s' = -Ft / Fu (Eq. 47); the frame from d' = v_rel - t2 s' and
     t2' = w2 x t2 + k2 s' (`frame_rates_pc`). A point on the curve (|d| = 0, no normal) leaves
     the gap NaN for the caller to report."""
+    R1, o1, w1, v1 = f1
+    R2, o2, w2, v2 = f2
     r1 = _rot(R1, p)
     x1 = _add(r1, o1)
     r2, T2, _, K2, _, _ = _geometry(kind2, prm2, R2, s, 0.0)
@@ -270,13 +285,15 @@ def evaluate_pc_one(kind2, prm2, p, radius, R1, o1, w1, v1, R2, o2, w2, v2, s, s
 
 
 @njit(cache=True)
-def evaluate_ps_one(kind2, prm2, p, radius, R1, o1, w1, v1, R2, o2, w2, v2, u_state, sigma,
-                    project, out):
-    """One point-surface couple (kind "PS"): the point p (its frame's coordinates; a sphere of
-    ``radius``) against the surface (kind2, prm2), u = (u, v), into the row ``out`` (its u,
+def evaluate_ps_one(kind2, prm2, p, radius, f1, f2, u_state, sigma, project, out):
+    """One point-surface couple (kind "PS"): the point p (coordinates in its `Frame` f1; a
+    sphere of ``radius``) against the surface (kind2, prm2) of f2, u = (u, v), into the row
+    ``out`` (its u,
     drift and udot in the row's first two places of each). F = [s_u . d, s_v . d] (Eq. 38
     without its tangency row); the frame as for C-S with no curve on Body 1; the contact point
     is the sphere's point towards the surface, q = -radius n from its centre."""
+    R1, o1, w1, v1 = f1
+    R2, o2, w2, v2 = f2
     r1 = _rot(R1, p)
     x1 = _add(r1, o1)
     a0, a1 = u_state[0], u_state[1]
@@ -391,26 +408,24 @@ def conditions(pair, kind1, prm1, kind2, prm2, p, R1, o1, R2, o2, u_state, out):
 def warm():
     """Compiles or loads the couples of each kind with the argument types of the compiled
     engine's calls (`drake_dock.core.kernels.engine`): frames' rotations as views of a stacked
-    array, points and twists as tuples, a row of a stacked array."""
+    array in `Frame` records with their origins and twists as tuples, a row of a stacked
+    array."""
     from drake_dock.core.patches import Circle, PlaneRect, Segment
     from drake_dock.core.kernels.jets import patch_spec
-    import numpy as np
     R = np.tile(np.eye(3), (2, 1, 1))
     out = np.zeros((3, ROW))
     z = (0.0, 0.0, 0.0)
     project = np.bool_(True)
     k1, p1 = patch_spec(Segment((0.0, 0.0, 0.1), (1.0, 0.0, 0.1)))
     k2, p2 = patch_spec(Segment((0.5, -1.0, 0.0), (0.5, 1.0, 0.0)))
-    evaluate_one(True, k1, p1, k2, p2, R[0], z, z, z, R[1], z, z, z, (0.5, 0.5, 0.0), 1.0,
-                 project, out[0])
+    f1, f2 = Frame(R[0], z, z, z), Frame(R[1], z, z, z)
+    evaluate_one(True, k1, p1, k2, p2, f1, f2, (0.5, 0.5, 0.0), 1.0, project, out[0])
     kc, pcirc = patch_spec(Circle(0.3, 0.1))
     kp, pplane = patch_spec(PlaneRect((-1, -1, 0), (2, 0, 0), (0, 2, 0)))
-    evaluate_one(False, kc, pcirc, kp, pplane, R[0], z, z, z, R[1], z, z, z, (0.5, 0.5, 0.5),
-                 1.0, project, out[1])
-    evaluate_pc_one(kc, pcirc, (0.1, 0.2, 0.3), 0.01, R[0], z, z, z, R[1], z, z, z, 0.5, 1.0,
-                    project, out[2])
-    evaluate_ps_one(kp, pplane, (0.1, 0.2, 0.3), 0.01, R[0], z, z, z, R[1], z, z, z,
-                    (0.5, 0.5), 1.0, project, out[2])
+    evaluate_one(False, kc, pcirc, kp, pplane, f1, f2, (0.5, 0.5, 0.5), 1.0, project, out[1])
+    evaluate_pc_one(kc, pcirc, (0.1, 0.2, 0.3), 0.01, f1, f2, 0.5, 1.0, project, out[2])
+    evaluate_ps_one(kp, pplane, (0.1, 0.2, 0.3), 0.01, f1, f2, (0.5, 0.5), 1.0, project,
+                    out[2])
     for pair, (ka, pa), (kb, pb) in ((CC, (k1, p1), (k2, p2)), (CS, (kc, pcirc), (kp, pplane)),
                                      (PC, (0, p1), (kc, pcirc)), (PS, (0, p1), (kp, pplane))):
         conditions(pair, ka, pa, kb, pb, z, R[0], z, R[1], z, (0.5, 0.5, 0.5), out[0])

@@ -47,13 +47,10 @@ from drake_dock.core.kernels.solve import OK, SLIDE, STICK, Problem, Solution, s
 from drake_dock.core.kernels.witness_values import end_margin, handover_guard, point_curve_side
 
 @njit(cache=True, inline="always")
-def _couple(m, i, R, o, w, vf, u, sigma, row):
-    """Pair i's couple into its couple row (its kind's kernel)."""
-    a, b = m.fidx[i, 0], m.fidx[i, 1]
-    o1, w1, v1 = (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]), \
-        (vf[a, 0], vf[a, 1], vf[a, 2])
-    o2, w2, v2 = (o[b, 0], o[b, 1], o[b, 2]), (w[b, 0], w[b, 1], w[b, 2]), \
-        (vf[b, 0], vf[b, 1], vf[b, 2])
+def pair_couple(m, i, R, o, w, vf, u, sigma, row):
+    """Pair i's couple into its couple row (its kind's kernel), from the frames' poses and
+    twists (R, o, w, vf) and the couples u (the layout of u*)."""
+    f1, f2 = _frame(m.fidx[i, 0], R, o, w, vf), _frame(m.fidx[i, 1], R, o, w, vf)
     ui = u[m.uoff[i]:m.uoff[i + 1]]
     kind = m.pair_kind[i]
     # Projected; a bool, not the literal True, so that the couples' kernels compiled for the
@@ -61,16 +58,23 @@ def _couple(m, i, R, o, w, vf, u, sigma, row):
     project = np.bool_(True)
     if kind == PC:
         p = (m.prm1[i, 0], m.prm1[i, 1], m.prm1[i, 2])
-        K.evaluate_pc_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], R[a], o1, w1, v1, R[b], o2,
-                          w2, v2, ui[0], sigma, project, row)
+        K.evaluate_pc_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], f1, f2, ui[0], sigma,
+                          project, row)
     elif kind == PS:
         p = (m.prm1[i, 0], m.prm1[i, 1], m.prm1[i, 2])
-        K.evaluate_ps_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], R[a], o1, w1, v1, R[b], o2,
-                          w2, v2, (ui[0], ui[1]), sigma, project, row)
+        K.evaluate_ps_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], f1, f2, (ui[0], ui[1]),
+                          sigma, project, row)
     else:
         us = (ui[0], ui[1], ui[2] if len(ui) == 3 else 0.0)
-        K.evaluate_one(kind == CC, m.kind1[i], m.prm1[i], m.kind2[i], m.prm2[i], R[a], o1,
-                       w1, v1, R[b], o2, w2, v2, us, sigma, project, row)
+        K.evaluate_one(kind == CC, m.kind1[i], m.prm1[i], m.kind2[i], m.prm2[i], f1, f2, us,
+                       sigma, project, row)
+
+
+@njit(cache=True, inline="always")
+def _frame(a, R, o, w, vf):
+    """Frame a's `couples.Frame` from the frames' poses and twists."""
+    return K.Frame(R[a], (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]),
+                   (vf[a, 0], vf[a, 1], vf[a, 2]))
 
 
 @njit(cache=True)
@@ -138,7 +142,7 @@ def evaluate(mp, sp, x, tau_in, buf):
         row = out[j]
         row[:] = 0.0
         wv[j, :] = 1.0
-        _couple(m, i, R, o, w, vf, u, s.sigma[i], row)
+        pair_couple(m, i, R, o, w, vf, u, s.sigma[i], row)
         couple_rates(m, i, row, fb, udot)
         if m.pair_kind[i] == PC and math.isnan(row[K.GAP]):
             if sc[S_BAD_PC] < 0:
