@@ -62,6 +62,7 @@ import math
 import numpy as np
 
 from drake_dock.core.kernels import couples as K
+from drake_dock.core.kernels.frames import Frame
 from drake_dock.core.kernels.jets import jet, patch_spec
 from drake_dock.core.relations import relation
 from drake_dock.errors import SingularCoupleError
@@ -167,7 +168,7 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
     out = np.zeros(K.ROW)
     project = np.bool_(project)
     sigma = float(sigma)
-    f1, f2 = K.Frame(R1, o1, w1, v1), K.Frame(R2, o2, w2, v2)
+    f1, f2 = Frame(R1, o1, w1, v1), Frame(R2, o2, w2, v2)
     if pair == K.PC:
         K.evaluate_pc_one(k2, q2, p, patch1.radius, f1, f2, u[0], sigma, project, out)
         if math.isnan(out[K.GAP]):

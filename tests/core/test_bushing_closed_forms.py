@@ -15,6 +15,7 @@ import pytest
 from drake_dock.core.kernels.bushing import (GIMBAL_LOCK, GIMBAL_LOCK_COS_PITCH, NONFINITE, OK,
                                              bushing_coordinates, bushing_wrenches,
                                              half_rotation, roll_pitch_yaw)
+from drake_dock.core.kernels.frames import Frame
 
 RNG = np.random.default_rng(5)
 K_T = np.array([105.0, 120.0, 938.0])      # distinct per axis, to catch a permutation
@@ -37,14 +38,22 @@ def _random_rotation():
     return _rot(RNG.normal(size=3), RNG.uniform(0, math.pi))
 
 
+def _frame(R, p, w=(0.0, 0.0, 0.0), v=(0.0, 0.0, 0.0)):
+    """The kernels' `Frame` of a pose (R, p) and a twist (w, v)."""
+    def vec(a):
+        return tuple(float(x) for x in a)
+    return Frame(np.ascontiguousarray(R, dtype=float), vec(p), vec(w), vec(v))
+
+
 def _call(R_WA, p_WA, w_WA, v_WA, R_WC, p_WC, w_WC, v_WC, k_t=K_T, d_t=D_T, k_f=K_F, d_f=D_F):
-    out = [np.zeros(6) for _ in range(4)]
-    status = bushing_wrenches(np.ascontiguousarray(R_WA), np.asarray(p_WA, float),
-                              np.asarray(w_WA, float), np.asarray(v_WA, float),
-                              np.ascontiguousarray(R_WC), np.asarray(p_WC, float),
-                              np.asarray(w_WC, float), np.asarray(v_WC, float),
-                              k_t, d_t, k_f, d_f, *out)
+    out = np.zeros((4, 6))
+    status = bushing_wrenches(_frame(R_WA, p_WA, w_WA, v_WA), _frame(R_WC, p_WC, w_WC, v_WC),
+                              np.array([k_t, d_t, k_f, d_f], dtype=float), out)
     return status, out
+
+
+def _coordinates(R_WA, p_WA, R_WC, p_WC, xyz, rpy):
+    return bushing_coordinates(_frame(R_WA, p_WA), _frame(R_WC, p_WC), xyz, rpy)
 
 
 def _random_frames(tilt=math.radians(40), stroke=0.2):
@@ -150,7 +159,7 @@ def test_action_and_reaction():
 
 def _potential(R_WA, p_WA, R_WC, p_WC):
     xyz, rpy = np.zeros(3), np.zeros(3)
-    assert bushing_coordinates(R_WA, p_WA, R_WC, p_WC, xyz, rpy) == OK
+    assert _coordinates(R_WA, p_WA, R_WC, p_WC, xyz, rpy) == OK
     return 0.5 * K_F @ xyz**2 + 0.5 * K_T @ rpy**2
 
 
@@ -197,7 +206,7 @@ def _potential_rate(t, changing_axis, k_t, k_f, h=1e-5):
     def V(s):
         R_WA, p_WA, _, _, R_WC, p_WC, _, _ = _motion(s, changing_axis)
         xyz, rpy = np.zeros(3), np.zeros(3)
-        assert bushing_coordinates(R_WA, p_WA, R_WC, p_WC, xyz, rpy) == OK
+        assert _coordinates(R_WA, p_WA, R_WC, p_WC, xyz, rpy) == OK
         return 0.5 * k_f @ xyz**2 + 0.5 * k_t @ rpy**2
     return (V(t + h) - V(t - h)) / (2 * h)
 
@@ -235,7 +244,7 @@ def test_damping_power_is_minus_the_dissipation():
     for s in (t - h, t + h):
         R_WA, p_WA, _, _, R_WC, p_WC, _, _ = _motion(s, False)
         xyz, rpy = np.zeros(3), np.zeros(3)
-        bushing_coordinates(R_WA, p_WA, R_WC, p_WC, xyz, rpy)
+        _coordinates(R_WA, p_WA, R_WC, p_WC, xyz, rpy)
         coords.append((xyz, rpy))
     xyz_dt = (coords[1][0] - coords[0][0]) / (2 * h)
     q_dt = (coords[1][1] - coords[0][1]) / (2 * h)

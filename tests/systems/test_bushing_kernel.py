@@ -24,6 +24,7 @@ from pydrake.multibody.math import SpatialVelocity
 from pydrake.multibody.tree import MultibodyForces
 
 from drake_dock.core.kernels.bushing import GIMBAL_LOCK, OK, bushing_wrenches
+from drake_dock.core.kernels.frames import Frame
 from drake_dock.docking.model.plant import PlantSpec, StewartDamperPower, make_docking_plant
 
 RNG = np.random.default_rng(2024)
@@ -79,9 +80,15 @@ def _kernel(dp, ctx):
     """(status, F_C, F_A, F_C_damp, F_A_damp, frame A's inputs, frame C's inputs)."""
     A = _frame(dp.bushing.frameA(), ctx)
     C = _frame(dp.bushing.frameC(), ctx)
-    out = [np.full(6, -1.0) for _ in range(4)]
-    status = bushing_wrenches(*A, *C, *_constants(dp.bushing), *out)
+    out = np.full((4, 6), -1.0)
+    status = bushing_wrenches(_record(A), _record(C), np.array(_constants(dp.bushing)), out)
     return (status, *out, A, C)
+
+
+def _record(frame):
+    """The kernel's `Frame` of [R, p, w, v]."""
+    R, p, w, v = frame
+    return Frame(R, tuple(p.tolist()), tuple(w.tolist()), tuple(v.tolist()))
 
 
 def _in_world(F, R):

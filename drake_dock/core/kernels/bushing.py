@@ -1,5 +1,6 @@
-"""Drake's `LinearBushingRollPitchYaw` force element in compiled code, over plain float arrays:
-the spatial forces the bushing applies on its two frames, and their damping part alone.
+"""Drake's `LinearBushingRollPitchYaw` force element in compiled code, on its two frames given as
+`frames.Frame` records: the spatial forces the bushing applies on them, and their damping part
+alone.
 
 Written from the formulas of Drake's documentation (v1.51; the class documentation of
 LinearBushingRollPitchYaw, its methods CalcBushingSpatialForceOnFrameA/C, and of
@@ -66,6 +67,8 @@ import math
 
 import numpy as np
 from numba import njit
+
+from drake_dock.core.kernels.frames import Frame
 
 OK, GIMBAL_LOCK, NONFINITE = 0, 1, 2
 GIMBAL_LOCK_COS_PITCH = 0.008     # Drake's RollPitchYaw::kGimbalLockToleranceCosPitchAngle
@@ -171,12 +174,13 @@ def _relative(R_WA, p_WA, R_WC, p_WC):
 
 
 @njit(cache=True)
-def bushing_coordinates(R_WA, p_WA, R_WC, p_WC, xyz, rpy):
-    """The bushing's coordinates: xyz (3,) <- [x y z], the position of Co from Ao in the
+def bushing_coordinates(A, C, xyz, rpy):
+    """The bushing's coordinates between its frames A and C (`frames.Frame`s; their poses are
+    read): xyz (3,) <- [x y z], the position of Co from Ao in the
     half-angle frame B [D3]; rpy (3,) <- the roll-pitch-yaw angles of R_AC [D2]. The potential
     energy is 1/2 k_f . xyz^2 + 1/2 k_t . rpy^2. Returns OK, or GIMBAL_LOCK where the angles'
     rates are undefined (|cos pitch| < GIMBAL_LOCK_COS_PITCH; the coordinates are written)."""
-    _, R_AC, _, r_A = _relative(R_WA, p_WA, R_WC, p_WC)
+    _, R_AC, _, r_A = _relative(A.R, A.o, C.R, C.o)
     b = _mtv(half_rotation(R_AC), r_A)
     q = roll_pitch_yaw(R_AC)
     for i in range(3):
@@ -203,16 +207,20 @@ def _pair(tau, f_B, a, b, cy, sy, sp, RA, R_AB, half, F_C, F_A):
 
 
 @njit(cache=True)
-def bushing_wrenches(R_WA, p_WA, w_WA, v_WA, R_WC, p_WC, w_WC, v_WC, k_t, d_t, k_f, d_f,
-                     F_C, F_A, F_C_damp, F_A_damp):
+def bushing_wrenches(A, C, gains, F):
     """The spatial forces [torque, force] (6,) in the world frame that Drake's
-    LinearBushingRollPitchYaw(frameA, frameC, k_t, d_t, k_f, d_f) applies: F_C on frame C about
-    its origin Co, F_A on frame A about its origin Ao, and F_C_damp, F_A_damp their damping
-    parts (the same with k_t = k_f = 0). Inputs: each frame's world rotation (3, 3), origin
-    (3,), angular velocity (3,) and origin velocity (3,), all in the world frame; the constants
-    (3,) as given to Drake's constructor. The outputs are written in place. Returns OK;
-    GIMBAL_LOCK (outputs NaN) where Drake throws, |cos pitch| < GIMBAL_LOCK_COS_PITCH; NONFINITE
-    if an output is not finite. Formulas: the module docstring."""
+    LinearBushingRollPitchYaw(frameA, frameC, k_t, d_t, k_f, d_f) applies, into the rows of F
+    (4, 6): F_C on frame C about its origin Co, F_A on frame A about its origin Ao, then
+    F_C_damp and F_A_damp, their damping parts (the same with k_t = k_f = 0). Inputs: the
+    frames A and C (`frames.Frame`s: world rotation, origin, angular velocity and origin
+    velocity, all in the world frame) and ``gains`` (4, 3), the rows k_t, d_t, k_f, d_f as
+    given to Drake's constructor. Returns OK; GIMBAL_LOCK (outputs NaN) where Drake throws,
+    |cos pitch| < GIMBAL_LOCK_COS_PITCH; NONFINITE if an output is not finite. Formulas: the
+    module docstring."""
+    R_WA, p_WA, w_WA, v_WA = A
+    R_WC, p_WC, w_WC, v_WC = C
+    k_t, d_t, k_f, d_f = gains[0], gains[1], gains[2], gains[3]
+    F_C, F_A, F_C_damp, F_A_damp = F[0], F[1], F[2], F[3]
     RA, R_AC, d_W, r_A = _relative(R_WA, p_WA, R_WC, p_WC)
     w_A = _mtv(RA, _sub(_vec(w_WC), _vec(w_WA)))
     v_rel = _sub(_sub(_vec(v_WC), _vec(v_WA)), _cross(_vec(w_WA), d_W))
@@ -247,8 +255,11 @@ def bushing_wrenches(R_WA, p_WA, w_WA, v_WA, R_WC, p_WC, w_WC, v_WC, k_t, d_t, k
 
 
 def warm():
-    """Compiles (or loads) the kernel for C-contiguous float64 arrays."""
-    I, z, k = np.eye(3), np.zeros(3), np.ones(3)
-    F = [np.zeros(6) for _ in range(4)]
-    bushing_wrenches(I, z, z, z, I, z, z, z, k, k, k, k, *F)
-    bushing_coordinates(I, z, I, z, np.zeros(3), np.zeros(3))
+    """Compiles (or loads) the kernels with the argument types of the compiled engine's calls
+    (`forces.element_forces`): frames whose rotations are views of a stacked array, the
+    gains (4, 3) and the forces (4, 6) C-contiguous, the coordinates views of a row."""
+    R, z = np.tile(np.eye(3), (2, 1, 1)), (0.0, 0.0, 0.0)
+    A, C = Frame(R[0], z, z, z), Frame(R[1], z, z, z)
+    bush = np.zeros((1, 6))
+    bushing_wrenches(A, C, np.ones((4, 3)), np.zeros((4, 6)))
+    bushing_coordinates(A, C, bush[0, 0:3], bush[0, 3:6])

@@ -8,20 +8,19 @@ Eq. (52) into one row, its fields at the offsets below (`ROW`). `conditions` giv
 Jacobian Fu (Eq. 40) and their conditioning at a couple without projecting it.
 
 The patches are kernel descriptions (`drake_dock.core.kernels.jets`), a point by its frame's
-coordinates and radius; each patch's frame comes as a `Frame` record (its rotation an array,
+coordinates and radius; each patch's frame comes as a `frames.Frame` record (its rotation an array,
 its origin and twist 3-tuples), points as 3-tuples.
 """
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from drake_dock.core.kernels.frames import (add as _add, axpy as _axpy, cross as _cr, dot as _dot,
-                                             frame_rates_cc, frame_rates_cs, frame_rates_pc,
-                                             mul as _mul, sub as _sub)
+from drake_dock.core.kernels.frames import (Frame, add as _add, axpy as _axpy, cross as _cr,
+                                             dot as _dot, frame_rates_cc, frame_rates_cs,
+                                             frame_rates_pc, mul as _mul, sub as _sub)
 from drake_dock.core.kernels.jets import jet
 
 # Row layout: u (3), drift (3), udot (3), residual, conditioning, p1 (3), p2 (3), n (3),
@@ -33,15 +32,6 @@ ROW = 40
 # Pair kinds.
 CC, CS, PC, PS = 0, 1, 2, 3
 _Z = (0.0, 0.0, 0.0)
-
-
-class Frame(NamedTuple):
-    """A patch's frame in the world: its rotation R (3, 3), its origin o, and its twist, the
-    angular velocity w and the velocity v of its origin (3-tuples)."""
-    R: np.ndarray
-    o: tuple
-    w: tuple
-    v: tuple
 
 
 @njit(cache=True)

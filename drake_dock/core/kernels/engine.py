@@ -33,6 +33,7 @@ from numba import njit
 
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.forces import block_apply, element_forces, kinetic_energy
+from drake_dock.core.kernels.frames import frame_of
 from drake_dock.core.kernels.free_bodies import (body_kinematics, frame_kinematics,
                                                  mass_inverse_and_bias, point_rows, qdot)
 from drake_dock.core.kernels.model import (BUSH_ROW, CC, FAR, NW, O_COND_MIN, O_DRIFT_FB, O_DRIFT_TOL,
@@ -50,7 +51,7 @@ from drake_dock.core.kernels.witness_values import end_margin, handover_guard, p
 def pair_couple(m, i, R, o, w, vf, u, sigma, row):
     """Pair i's couple into its couple row (its kind's kernel), from the frames' poses and
     twists (R, o, w, vf) and the couples u (the layout of u*)."""
-    f1, f2 = _frame(m.fidx[i, 0], R, o, w, vf), _frame(m.fidx[i, 1], R, o, w, vf)
+    f1, f2 = frame_of(m.fidx[i, 0], R, o, w, vf), frame_of(m.fidx[i, 1], R, o, w, vf)
     ui = u[m.uoff[i]:m.uoff[i + 1]]
     kind = m.pair_kind[i]
     # Projected; a bool, not the literal True, so that the couples' kernels compiled for the
@@ -68,13 +69,6 @@ def pair_couple(m, i, R, o, w, vf, u, sigma, row):
         us = (ui[0], ui[1], ui[2] if len(ui) == 3 else 0.0)
         K.evaluate_one(kind == CC, m.kind1[i], m.prm1[i], m.kind2[i], m.prm2[i], f1, f2, us,
                        sigma, project, row)
-
-
-@njit(cache=True, inline="always")
-def _frame(a, R, o, w, vf):
-    """Frame a's `couples.Frame` from the frames' poses and twists."""
-    return K.Frame(R[a], (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]),
-                   (vf[a, 0], vf[a, 1], vf[a, 2]))
 
 
 @njit(cache=True)

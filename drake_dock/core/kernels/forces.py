@@ -7,6 +7,7 @@ import numpy as np
 from numba import njit
 
 from drake_dock.core.kernels.bushing import OK as BUSH_OK, bushing_coordinates, bushing_wrenches
+from drake_dock.core.kernels.frames import frame_of
 from drake_dock.core.kernels.free_bodies import mtv3, mv3
 
 @njit(cache=True)
@@ -34,15 +35,15 @@ def element_forces(m, q, v, Rb, pb, R, o, w, vf, tau, bush, damp):
         tau[j + 4] += f1_
         tau[j + 5] += f2_
         pe -= f0 * (pb[b, 0] + c0) + f1_ * (pb[b, 1] + c1) + f2_ * (pb[b, 2] + c2)
-    FC, FA = np.empty(6), np.empty(6)
-    FCd, FAd = np.empty(6), np.empty(6)
+    W = np.empty((4, 6))                    # F_C, F_A and their damping parts
+    FC, FA, FCd, FAd = W[0], W[1], W[2], W[3]
     td = np.zeros(v.shape[0])
     for n in range(m.bush_frames.shape[0]):
         a, c = m.bush_frames[n, 0], m.bush_frames[n, 1]
         G = m.bush_gains[n]
-        st = bushing_wrenches(R[a], o[a], w[a], vf[a], R[c], o[c], w[c], vf[c], G[0], G[1],
-                              G[2], G[3], FC, FA, FCd, FAd)
-        bushing_coordinates(R[a], o[a], R[c], o[c], bush[n, 0:3], bush[n, 3:6])
+        A, C = frame_of(a, R, o, w, vf), frame_of(c, R, o, w, vf)
+        st = bushing_wrenches(A, C, G, W)
+        bushing_coordinates(A, C, bush[n, 0:3], bush[n, 3:6])
         if st != BUSH_OK and status == BUSH_OK:
             status = st
         for j in range(3):

@@ -1,11 +1,31 @@
 """The contact frame and its rates along a couple (Definition 2; the Eq. 52 bias terms) for the
-couple kernels (`couples`), and the 3-vector arithmetic they share; 3-vectors are tuples of
-floats."""
+couple kernels (`couples`), the 3-vector arithmetic they share (3-vectors are tuples of
+floats), and `Frame`, the record of a body-fixed frame's pose and twist that the couples and
+the bushing take."""
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
+import numpy as np
 from numba import njit
+
+
+class Frame(NamedTuple):
+    """A body-fixed frame in the world: its rotation R (3, 3), its origin o, and its twist, the
+    angular velocity w and the velocity v of its origin (3-tuples)."""
+    R: np.ndarray
+    o: tuple
+    w: tuple
+    v: tuple
+
+
+@njit(cache=True, inline="always")
+def frame_of(a, R, o, w, vf):
+    """Frame a's `Frame` from the frames' stacked poses and twists: R (F, 3, 3), o, w, vf
+    (F, 3)."""
+    return Frame(R[a], (o[a, 0], o[a, 1], o[a, 2]), (w[a, 0], w[a, 1], w[a, 2]),
+                 (vf[a, 0], vf[a, 1], vf[a, 2]))
 
 
 @njit(cache=True)
