@@ -13,6 +13,7 @@ import pytest
 from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 
+from drake_dock.core.couple import closest_point_conditions
 from drake_dock.core.hybrid import Mode
 from drake_dock.core.kernels import couples as K
 from drake_dock.core.kernels.couple_row import CoupleRow
@@ -116,6 +117,31 @@ def test_gravity_and_energies_of_a_small_scene_equal_the_plants():
     assert math.isclose(ke, system.plant.CalcKineticEnergy(ctx), rel_tol=1e-13)
     assert math.isclose(pe, system.plant.CalcPotentialEnergy(ctx), rel_tol=1e-13,
                         abs_tol=1e-13)
+
+
+@pytest.mark.parametrize("trial", range(4))
+def test_a_couple_is_projected_only_when_asked(docking, trial):
+    """A couple evaluated unprojected (``project=False``) keeps the given u with no drift;
+    projected, its drift is one Newton step on F(u) = 0 (Eq. 37-38, 40), -Fu^-1 F, from F and
+    Fu of the conditions kernel (`closest_point_conditions`), and its u is u plus that step."""
+    system, _ = docking
+    eng = system.engine
+    q, v = _random_state(system)
+    kin = eng.kinematics(q, v)
+    i = int(RNG.integers(len(system.pairs)))
+    p = system.pairs[i]
+    u = np.concatenate([0.5 * (pt.lower + pt.upper) + 0.1 * (pt.upper - pt.lower)
+                        * RNG.uniform(-1, 1, pt.dim) for pt in (p.patch1, p.patch2)])
+    fa, fb = eng.fidx[i]
+    F, Fu = closest_point_conditions(p.kind, p.patch1, (kin.R[fa], kin.o[fa]), p.patch2,
+                                     (kin.R[fb], kin.o[fb]), u)
+    raw = eng.couple(i, u, kin, 1.0, project=False)
+    np.testing.assert_array_equal(raw.u, u)
+    np.testing.assert_array_equal(raw.drift, np.zeros(len(u)))
+    c = eng.couple(i, u, kin, 1.0, project=True)
+    step = -np.linalg.solve(Fu, F)
+    np.testing.assert_allclose(c.drift, step, rtol=1e-8, atol=1e-12 * (1 + np.abs(u).max()))
+    np.testing.assert_array_equal(c.u, u + c.drift)
 
 
 @pytest.mark.parametrize("trial", range(4))

@@ -56,7 +56,7 @@ tau . q' + f_B . [x' y' z'].
 Singularity: Np has 1 / cos(pitch); at pitch = +-90 deg (gimbal lock) the rates q' and the
 torque t are undefined, and near it they lose accuracy. Where Drake throws [D7]
 (|cos pitch| < GIMBAL_LOCK_COS_PITCH = 0.008), `bushing_wrenches` writes NaN into all four
-outputs and returns GIMBAL_LOCK; it returns NONFINITE if the inputs make any output non-finite
+rows of F and returns GIMBAL_LOCK; it returns NONFINITE if the inputs make any output non-finite
 (NaN or inf in, say); OK otherwise. A caller must check the status (the NaNs propagate if it
 does not). A 180 deg rotation (e0 = 0) is not singular but B's sign is ambiguous there, as in
 Drake (a measure-zero set; the sign of e_v then decides).

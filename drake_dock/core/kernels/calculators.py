@@ -35,7 +35,7 @@ def couples_at(mp, R, o, w, vf, u, sigma, which, project, drift_feedback, out):
     rate = np.zeros(u.shape[0])
     for i in which:
         row = out[i]
-        pair_couple(m, i, R, o, w, vf, u, sigma[i], row)
+        pair_couple(m, i, R, o, w, vf, u, sigma[i], project, row)
         couple_rates(m, i, row, drift_feedback, rate)
 
 

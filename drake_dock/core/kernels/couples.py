@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 from drake_dock.core.kernels.frames import (Frame, add as _add, axpy as _axpy, cross as _cr,
@@ -402,6 +401,7 @@ def warm():
     array."""
     from drake_dock.core.patches import Circle, PlaneRect, Segment
     from drake_dock.core.kernels.jets import patch_spec
+    import numpy as np
     R = np.tile(np.eye(3), (2, 1, 1))
     out = np.zeros((3, ROW))
     z = (0.0, 0.0, 0.0)

@@ -47,16 +47,14 @@ from drake_dock.core.kernels.model import (BUSH_ROW, CC, FAR, NW, O_COND_MIN, O_
 from drake_dock.core.kernels.solve import OK, SLIDE, STICK, Problem, Solution, solve_modes
 from drake_dock.core.kernels.witness_values import end_margin, handover_guard, point_curve_side
 
-@njit(cache=True, inline="always")
-def pair_couple(m, i, R, o, w, vf, u, sigma, row):
+@njit(cache=True)
+def pair_couple(m, i, R, o, w, vf, u, sigma, project, row):
     """Pair i's couple into its couple row (its kind's kernel), from the frames' poses and
-    twists (R, o, w, vf) and the couples u (the layout of u*)."""
+    twists (R, o, w, vf) and the couples u (the layout of u*), projected (one Newton step)
+    when ``project``."""
     f1, f2 = frame_of(m.fidx[i, 0], R, o, w, vf), frame_of(m.fidx[i, 1], R, o, w, vf)
     ui = u[m.uoff[i]:m.uoff[i + 1]]
     kind = m.pair_kind[i]
-    # Projected; a bool, not the literal True, so that the couples' kernels compiled for the
-    # calculators (`calculators.couples_at`) serve here too.
-    project = np.bool_(True)
     if kind == PC:
         p = (m.prm1[i, 0], m.prm1[i, 1], m.prm1[i, 2])
         K.evaluate_pc_one(m.kind2[i], m.prm2[i], p, m.prm1[i, 3], f1, f2, ui[0], sigma,
@@ -136,7 +134,9 @@ def evaluate(mp, sp, x, tau_in, buf):
         row = out[j]
         row[:] = 0.0
         wv[j, :] = 1.0
-        pair_couple(m, i, R, o, w, vf, u, s.sigma[i], row)
+        # Projected; a bool, not the literal True, so that the kernel compiled for the
+        # calculators (`calculators.couples_at`) serves here too.
+        pair_couple(m, i, R, o, w, vf, u, s.sigma[i], np.bool_(True), row)
         couple_rates(m, i, row, fb, udot)
         if m.pair_kind[i] == PC and math.isnan(row[K.GAP]):
             if sc[S_BAD_PC] < 0:

@@ -20,7 +20,7 @@ class Frame(NamedTuple):
     v: tuple
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def frame_of(a, R, o, w, vf):
     """Frame a's `Frame` from the frames' stacked poses and twists: R (F, 3, 3), o, w, vf
     (F, 3)."""
