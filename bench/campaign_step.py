@@ -28,10 +28,13 @@ COMPARED = ("peak_contact_force", "peak_stewart_stroke", "peak_stewart_force", "
 
 
 def at_cap(spec, cap, period):
-    """The sample ``spec`` with the step cap ``cap`` and the output period ``period`` (s)."""
+    """The sample ``spec`` with the step cap ``cap`` and the output period ``period`` (s; None:
+    the plan's)."""
     sample, seed, values = spec
-    return sample, seed, {**values, "simulator_config.max_step_size": cap,
-                          "simulation.output_period": period}
+    values = {**values, "simulator_config.max_step_size": cap}
+    if period is not None:
+        values["simulation.output_period"] = period
+    return sample, seed, values
 
 
 def largest_difference(pairs, key):
