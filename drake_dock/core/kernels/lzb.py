@@ -373,8 +373,7 @@ def lzb_impact(y, t, h, steps, imp, ph):
                 break
             copy1(y, yn)
             t = t_new
-            for i in range(N):
-                k1[i] = k7[i]
+            copy1(k1, k7)                   # first same as last
             if classify(y, imp, ph):
                 event_values(y, g0, imp, ph)
             else:
