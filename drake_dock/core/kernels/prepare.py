@@ -15,9 +15,10 @@ holds it, and a unit starts after the owners of the modules it holds (`engine` a
 which owns the constraint solve that `constraints` calls too): common callees are then compiled
 once, by their owner, and loaded by the others, and two units that share only an owner's
 modules compile side by side. Among the units free to start, the one heading the longest chain
-of waiting units goes first, a unit's length being the kernel source lines of every module it
-holds (a rough measure of its compile time: numba links a callee's code into each caller's
-and optimises the whole, so a unit's compile grows with what it calls, compiled or loaded).
+of waiting units goes first, a unit's length being the kernel source lines of the modules it
+owns (a rough measure of its compile time, which is mostly that of the modules it compiles: a
+unit that holds many modules but owns few, such as `calculators`, links the others' code from
+the cache and is among the quicker ones; `bench/cold_start.py` prints each unit's time).
 
 `Preparation` splits `prepare` in two around the caller's own start-up: `Preparation.start` sets
 the missing units compiling in the workers (a thread here feeds them), `Preparation.finish`
@@ -80,8 +81,9 @@ def schedule(names: list[str], package=cc._PACKAGE):
     after = {a: {owner[d] for d in deps[a]} - {a} for a in names}
     here = package / "core" / "kernels"
 
-    def length(n):  # the kernel source lines of the modules unit n holds
-        return sum((here / f"{m}.py").read_bytes().count(b"\n") for m in deps[n])
+    def length(n):  # the kernel source lines of the modules unit n owns (compiles)
+        return sum((here / f"{m}.py").read_bytes().count(b"\n") for m in deps[n]
+                   if owner[m] == n)
 
     def path(n):    # its length and that of the longest chain of units waiting for it
         return length(n) + max((path(a) for a in names if n in after[a]), default=0)
