@@ -5,17 +5,21 @@ to one internal squeeze along that line. The minimum-norm forces of the solve ma
 couple's static cone while a squeeze puts every couple inside it: a consistent stick that the
 minimum-norm split would reject as a Painleve inconsistency.
 
-`squeezed` takes the minimum-norm forces lam (m,) of the solve, the solve's matrix A (m, m) and
-its force directions C (nv, m), and the modes' layout (each sticking couple's offset in lam and
-its mu_s). Where the minimum-norm forces lie inside every sticking couple's cone, or the
+The compiled solve (`drake_dock.core.kernels.solve`) takes the minimum-norm forces lam (m,) of
+the solve, and where they leave a cone (`cones_hold`) calls `squeeze_along` with the solve's
+matrix A (m, m) through its singular values and last right singular vector, its force
+directions C (nv, m) through |C z| and |C|, and the modes' layout (each sticking couple's
+offset in lam and its mu_s). Where the minimum-norm forces lie inside every sticking couple's
+cone, or the
 redundancy is not a single squeeze that does no work (A's null space of dimension 1 with
 C z = 0), lam is returned as it is. Otherwise the squeeze s z nearest to lam is added that puts
 every sticking couple inside its cone shrunk to ``SHRINK`` mu_s (so that the stick-slip witness
 does not start at zero), or, if none does, inside the cone itself; if no squeeze does, lam as it
 is (the mode is then inconsistent). The accelerations are those of lam either way (C z = 0).
 
-Plain Python over floats and numpy arrays, marked `register_jitable`: the reference solve
-calls them as Python and `drake_dock.core.kernels.constraints` compiles the same functions.
+Plain Python over floats and numpy arrays, marked `register_jitable`: the compiled solve
+compiles them, and tests/core/test_squeeze.py calls `cone_interval` and `sorted_values` as
+Python too.
 """
 from __future__ import annotations
 
@@ -102,18 +106,6 @@ def squeeze_interval(lam, z, offsets, mus, shrink):
 
 
 @register_jitable
-def squeezed(lam, A, C, offsets, mus):
-    """lam, or lam plus the squeeze nearest to it that puts the sticking couples inside their
-    cones (module docstring)."""
-    if cones_hold(lam, offsets, mus):
-        return lam
-    U, S, Vt = np.linalg.svd(A)
-    z = Vt[-1].copy()
-    return squeeze_along(lam, S, z, np.linalg.norm(np.dot(C, z)), np.linalg.norm(C), offsets,
-                         mus)
-
-
-@register_jitable
 def cones_hold(lam, offsets, mus):
     """Whether lam puts every sticking couple in its cone, or there are fewer than two (no
     squeeze)."""
@@ -126,9 +118,10 @@ def cones_hold(lam, offsets, mus):
 
 @register_jitable
 def squeeze_along(lam, S, z, Cz_norm, C_norm, offsets, mus):
-    """`squeezed` from A's singular values S (descending) and the right singular vector z of
-    the smallest, with |C z| and |C| (Frobenius): the squeeze along z when it is A's only null
-    direction and does no work."""
+    """lam, or lam plus the squeeze nearest to it that puts the sticking couples inside their
+    cones (module docstring), from A's singular values S (descending) and the right singular
+    vector z of the smallest, with |C z| and |C| (Frobenius): the squeeze along z when it is
+    A's only null direction and does no work."""
     if S[-1] > NULL_RTOL * S[0] or (len(S) > 1 and S[-2] <= NULL_RTOL * S[0]):
         return lam
     if Cz_norm > WORK_RTOL * C_norm:

@@ -1,15 +1,13 @@
 """Mode selection of the contact set on rigid bodies resting on the plane z = 0: a rod whose
 sliding tip unloads and lifts off with the gap drift of a docking run, Painleve's rod, and random
-sliding contacts against a brute-force enumeration of the modes. Each test runs the pure-Python
-reference (drake_dock.core.constraints) and the compiled kernels
-(drake_dock.core.kernels.constraints). Runs without Drake."""
+sliding contacts against a brute-force enumeration of the modes, by the compiled solve and mode
+selection (drake_dock.core.kernels.constraints). Runs without Drake."""
 import itertools
 import math
 
 import numpy as np
 import pytest
 
-from drake_dock.core import constraints
 from drake_dock.core.constraints import DETACH, SLIDE, TIE_RTOL, ContactRow, stabilised_gddot
 from drake_dock.core.kernels import constraints as compiled
 from drake_dock.errors import PainleveError
@@ -18,11 +16,10 @@ G = 9.81
 OMEGA = 20.0          # the contact system's Baumgarte omega (rad/s)
 
 
-@pytest.fixture(params=["python", "compiled"])
-def select_contact_modes(request):
-    """Mode selection by the reference or by the compiled kernels."""
-    return {"python": constraints.select_contact_modes,
-            "compiled": compiled.select_contact_modes}[request.param]
+@pytest.fixture
+def select_contact_modes():
+    """The mode selection (`drake_dock.core.kernels.constraints.select_contact_modes`)."""
+    return compiled.select_contact_modes
 
 
 def body_mass(m, inertia):
@@ -196,9 +193,7 @@ def test_random_sliding_contacts_match_the_enumeration(select_contact_modes):
     assert 0 < detached < 300
 
 
-@pytest.mark.parametrize("solve", [constraints.solve_given_modes, compiled.solve_given_modes],
-                         ids=["python", "compiled"])
-def test_two_sticking_points_carry_the_load_within_the_baumgarte_terms(solve):
+def test_two_sticking_points_carry_the_load_within_the_baumgarte_terms():
     """A box resting on two sticking points of the plane is statically indeterminate: their
     six rows have rank 5 (the two points' distance is held twice). When the two couples' gaps
     drift apart by round-off, the stabilised rows (Eq. 52) ask the two normal accelerations for
@@ -211,7 +206,8 @@ def test_two_sticking_points_carry_the_load_within_the_baumgarte_terms(solve):
     r = np.array([0.3, 0.0, -0.1])
     rows = [plane_row("left", r * [-1, 1, 1], gap=0.0, vn=0.0, vt=[0, 0], mu=0.5),
             plane_row("right", r, gap=0.0, vn=3e-7, vt=[0, 0], mu=0.5)]
-    sol = solve(np.linalg.inv(M), a0, rows, ("stick", "stick"), [None, None], omega=OMEGA)
+    sol = compiled.solve_given_modes(np.linalg.inv(M), a0, rows, ("stick", "stick"),
+                                     [None, None], omega=OMEGA)
     soft = 2 * OMEGA * 3e-7
     assert sol.lam_n.sum() == pytest.approx(m * G, abs=10 * m * soft)
     assert sol.lam_n[0] == pytest.approx(sol.lam_n[1], abs=10 * m * soft)
@@ -220,9 +216,7 @@ def test_two_sticking_points_carry_the_load_within_the_baumgarte_terms(solve):
     assert max(abs(x) for x in gdd) <= soft
 
 
-@pytest.mark.parametrize("solve", [constraints.solve_given_modes, compiled.solve_given_modes],
-                         ids=["python", "compiled"])
-def test_inconsistent_redundant_sticking_beyond_the_baumgarte_terms_is_singular(solve):
+def test_inconsistent_redundant_sticking_beyond_the_baumgarte_terms_is_singular():
     """The same box with the two points at one place but asked for different normal
     accelerations by their velocity-product terms (1e-3 m/s^2 apart, far beyond round-off and
     with no Baumgarte term to account for it): no forces hold both rows, a
@@ -234,4 +228,5 @@ def test_inconsistent_redundant_sticking_beyond_the_baumgarte_terms_is_singular(
     rows = [plane_row("a", r, gap=0.0, vn=0.0, vt=[0, 0], mu=0.5),
             plane_row("b", r, gap=0.0, vn=0.0, vt=[0, 0], mu=0.5, bn=1e-3)]
     with pytest.raises(SingularContactError):
-        solve(np.linalg.inv(M), a0, rows, ("stick", "stick"), [None, None], omega=OMEGA)
+        compiled.solve_given_modes(np.linalg.inv(M), a0, rows, ("stick", "stick"),
+                                   [None, None], omega=OMEGA)

@@ -2,8 +2,9 @@
 (`drake_dock.core.squeeze`): a ball resting in a V-groove, whose minimum-norm forces are
 vertical and so outside a small friction cone, sticks with forces inside it (statics: they
 carry the weight), and a block standing on two points of an incline steeper than its friction
-angle slides with the closed-form acceleration. The reference and the compiled kernels alike;
-runs without Drake."""
+angle slides with the closed-form acceleration; starts of sliding found where the tangential
+acceleration lies along the direction (dense samplings, scipy's least squares). The compiled
+solve and mode selection (drake_dock.core.kernels.constraints); runs without Drake."""
 import json
 import math
 from pathlib import Path
@@ -11,18 +12,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drake_dock.core import constraints
-from drake_dock.core.constraints import SLIDE, STICK, ContactRow
+from drake_dock.core.constraints import (SLIDE, SLIDE_START_ITER, SLIDE_START_SCAN, STICK,
+                                         ContactRow, slip_angle)
 from drake_dock.core.kernels import constraints as compiled
 from drake_dock.core.squeeze import SHRINK, cone_interval, sorted_values
 
 G, OMEGA = 9.81, 20.0
 
 
-@pytest.fixture(params=["python", "compiled"])
-def select_contact_modes(request):
-    return {"python": constraints.select_contact_modes,
-            "compiled": compiled.select_contact_modes}[request.param]
+@pytest.fixture
+def select_contact_modes():
+    return compiled.select_contact_modes
 
 
 def test_sorted_values_is_a_stable_ascending_sort():
@@ -135,14 +135,14 @@ def _slip_angles(Minv, a0, rows, v1, omega, th):
     angle, along = [], []
     for t in th:
         e = np.array([math.cos(t), math.sin(t)])
-        at = constraints.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), [e, v1],
+        at = compiled.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), [e, v1],
                                            omega=omega).at[0]
-        angle.append(constraints.slip_angle(e, at))
+        angle.append(slip_angle(e, at))
         along.append(at @ e > 0)
     return np.array(angle), np.array(along)
 
 
-def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_contact_modes, monkeypatch):
+def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_contact_modes):
     """A docking selection (tests/core/slide_start_docking.json): couple 0 at rest, couple 1
     sliding. Couple 0 sticking needs more than its cone; the fixed point s = a_t/|a_t| for its
     start of sliding does not converge. A dense sampling of its direction (3600 angles, no
@@ -152,7 +152,7 @@ def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_contact_modes
                        avoid=[tuple(a) for a in d["avoid"]])
     assert sol.modes == (SLIDE, SLIDE)
     s = sol.dirs[0]
-    assert abs(constraints.slip_angle(s, sol.at[0])) < 1e-9 and sol.at[0] @ s > 0
+    assert abs(slip_angle(s, sol.at[0])) < 1e-9 and sol.at[0] @ s > 0
     assert (sol.lam_n > 0).all()
     v1 = rows[1].vt / np.hypot(*rows[1].vt)
     th = np.linspace(-math.pi, math.pi, 3601)
@@ -160,13 +160,19 @@ def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_contact_modes
     t_best = th[int(np.argmin(res))]
     assert min(res) < 2 * math.pi / 3600
     assert math.atan2(s[1], s[0]) == pytest.approx(t_best, abs=2 * math.pi / 3600)
-    # The fixed point alone (no scan) misses it from the selection's own start.
-    monkeypatch.setattr(constraints, "_slide_start_scan", lambda *args: (None, False))
-    stick = constraints.solve_given_modes(Minv, a0, rows, (STICK, SLIDE), [None, v1],
-                                          omega=d["omega"])
-    start = -stick.lam_t[0] / np.hypot(*stick.lam_t[0])
-    assert not constraints._slide_start(Minv, a0, rows, (SLIDE, SLIDE), [start, v1], [0],
-                                        d["omega"], None)[1]
+    # The fixed point alone misses it: s <- a_t/|a_t| from the sticking force's direction
+    # (where the selection starts), iterated as often as the selection does, ends with a_t
+    # not along s.
+    stick = compiled.solve_given_modes(Minv, a0, rows, (STICK, SLIDE), [None, v1],
+                                       omega=d["omega"])
+    e = -stick.lam_t[0] / np.hypot(*stick.lam_t[0])
+    for _ in range(SLIDE_START_ITER):
+        at = compiled.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), [e, v1],
+                                        omega=d["omega"]).at[0]
+        e = at / np.hypot(*at)
+    at = compiled.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), [e, v1],
+                                    omega=d["omega"]).at[0]
+    assert not at @ e > 0
 
 
 def test_two_couples_starting_to_slide_are_found(select_contact_modes):
@@ -186,9 +192,9 @@ def test_two_couples_starting_to_slide_are_found(select_contact_modes):
 
     def residual(th):
         dirs = [np.array([math.cos(t), math.sin(t)]) for t in th]
-        at = constraints.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), dirs,
+        at = compiled.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), dirs,
                                            omega=d["omega"]).at
-        return [constraints.slip_angle(e, a) for e, a in zip(dirs, at)]
+        return [slip_angle(e, a) for e, a in zip(dirs, at)]
 
     g = np.linspace(-math.pi, math.pi, 36, endpoint=False)
     start = min(((a, b) for a in g for b in g), key=lambda t: np.abs(residual(t)).sum())
@@ -209,7 +215,7 @@ def test_two_couples_at_the_stick_slip_transition_start_to_slide(select_contact_
                        np.array(r["bt"]), r["gap"], r["vn"], np.array(r["vt"]), r["mu"],
                        r["mu_s"]) for r in d["rows"]]
     Minv, a0 = np.array(d["Minv"]), np.array(d["a0"])
-    stick = constraints.solve_given_modes(Minv, a0, rows, (STICK, STICK), [None, None],
+    stick = compiled.solve_given_modes(Minv, a0, rows, (STICK, STICK), [None, None],
                                           omega=d["omega"])
     C = np.column_stack([c for r in rows for c in (r.Wn, r.Wt[:, 0], r.Wt[:, 1])])
     z = np.linalg.svd(C.T @ Minv @ C)[2][-1]
@@ -233,7 +239,7 @@ def test_a_start_of_sliding_next_to_the_stick_slip_transition_is_found(select_co
     sampling (20,000 angles) finds where a_t lies along s; the selection slides along it."""
     Minv, a0, rows, d = _docking_selection("slide_start_steep.json")
     v1 = rows[1].vt / np.hypot(*rows[1].vt)
-    stick = constraints.solve_given_modes(Minv, a0, rows, (STICK, SLIDE), [None, v1],
+    stick = compiled.solve_given_modes(Minv, a0, rows, (STICK, SLIDE), [None, v1],
                                           omega=d["omega"])
     ratio = np.hypot(*stick.lam_t[0]) / (rows[0].mu_s * stick.lam_n[0])
     assert 1.0 < ratio < 1.05
@@ -241,7 +247,7 @@ def test_a_start_of_sliding_next_to_the_stick_slip_transition_is_found(select_co
                        avoid=[tuple(a) for a in d["avoid"]])
     assert sol.modes == (SLIDE, SLIDE) and (sol.lam_n > 0).all()
     s = sol.dirs[0]
-    assert abs(constraints.slip_angle(s, sol.at[0])) < 1e-6 and sol.at[0] @ s > 0
+    assert abs(slip_angle(s, sol.at[0])) < 1e-6 and sol.at[0] @ s > 0
     th = np.linspace(-math.pi, math.pi, 20001)
     angle, along = _slip_angles(Minv, a0, rows, v1, d["omega"], th)
     res = np.where(along, angle, math.pi)
@@ -250,43 +256,35 @@ def test_a_start_of_sliding_next_to_the_stick_slip_transition_is_found(select_co
     assert math.atan2(s[1], s[0]) == pytest.approx(th[k], abs=2 * math.pi / 20000)
 
 
-def test_the_scan_brackets_cross_zero_not_the_half_turn():
-    """`constraints.scan_brackets` on hand-made scans of the slip angle: a sign change through
-    +-180 deg (a_t opposite s) next to th0 is never a bracket; a steep crossing of zero (15 deg
-    to -103 deg) is, after any crossing with both ends within 90 deg; and the compiled scan's
-    choice (`_nearest_bracket`, first kind then second) is the same on 2,000 random scans with
-    ties."""
+def _bracket_order(ths, rs, th0):
+    """The brackets the compiled scan bisects, in order (`slide_start._nearest_bracket`: the
+    first kind, then the second where it is another)."""
     from drake_dock.core.kernels.slide_start import _nearest_bracket
+    ths, rs = np.asarray(ths, float), np.asarray(rs, float)
+    first = _nearest_bracket(ths, rs, th0, True)
+    second = _nearest_bracket(ths, rs, th0, False)
+    return [k for i, k in enumerate((first, second)) if k >= 0 and not (i and k == first)]
+
+
+def test_the_scan_brackets_cross_zero_not_the_half_turn():
+    """The slide-start scan's brackets on hand-made scans of the slip angle: a sign change
+    through +-180 deg (a_t opposite s) next to th0 is never a bracket; a steep crossing of zero
+    (15 deg to -103 deg) is, after any crossing with both ends within 90 deg."""
     ths = np.linspace(-math.pi, math.pi, 9)
     rs = np.array([1.0, 1.0, 3.1, -3.1, 0.27, -1.8, -1.0, -1.0, -1.0])   # th0 = 0: k = 3 wraps
-    assert constraints.scan_brackets(ths, rs, 0.0) == [4]
+    assert _bracket_order(ths, rs, 0.0) == [4]
     rs2 = rs.copy()
     rs2[7:] = [-0.3, 0.4]                                                  # a gentle crossing
-    assert constraints.scan_brackets(ths, rs2, 0.0) == [7, 4]
-
-    def compiled_order(ths, rs, th0):
-        first = _nearest_bracket(ths, rs, th0, True)
-        second = _nearest_bracket(ths, rs, th0, False)
-        return [k for i, k in enumerate((first, second)) if k >= 0 and not (i and k == first)]
-
-    rng = np.random.default_rng(5)
-    for _ in range(2000):
-        n = int(rng.integers(3, 40))
-        ths = np.sort(rng.uniform(-4.0, 4.0, n))
-        rs = rng.choice([-3.1, -2.0, -1.0, -0.2, 0.0, 0.2, 1.0, 2.0, 3.1], n)
-        th0 = float(rng.choice(ths))
-        assert constraints.scan_brackets(ths, rs, th0) == compiled_order(ths, rs, th0)
+    assert _bracket_order(ths, rs2, 0.0) == [7, 4]
 
 
-def test_a_bracket_whose_bisection_ends_on_the_half_turn_gives_way_to_the_next(monkeypatch):
-    """`constraints._slide_start_scan` on a made-up tangential acceleration a_t(s(theta)) whose
-    angle from s is phi(theta) (theta0 = 0): -1.8 rad, then crossing zero steeply to 0.3 rad
-    over the step from the 37th scanned direction (the nearest bracket, but its ends are not
-    both within 90 deg), 0.3 rad, then turning through +180 deg to -0.3 rad over the step from
-    the 40th (a bracket within 90 deg, whose bisection ends where a_t is opposite s), and -0.3
-    rad after. The scan bisects the 40th step first, finds a_t against s there, and slides
-    along the 37th step's root, where phi = 0 (closed form)."""
-    n = constraints.SLIDE_START_SCAN
+def test_a_steep_bracket_comes_after_one_within_a_quarter_turn():
+    """The scan's brackets on the angle phi(theta) from s to a made-up tangential acceleration
+    (theta0 = 0): -1.8 rad, then crossing zero steeply to 0.3 rad over the step from the 37th
+    scanned direction (the nearest crossing, but its ends are not both within 90 deg), 0.3
+    rad, then turning through +180 deg to -0.3 rad over the step from the 40th (a sign change
+    within 90 deg at both ends): the 40th step is bisected first, then the 37th."""
+    n = SLIDE_START_SCAN
     th = [2.0 * math.pi * (k / n - 0.5) for k in range(n + 1)]
     b_lo, b_hi, a_lo, a_hi = th[37], th[38], th[40], th[41]
 
@@ -301,18 +299,6 @@ def test_a_bracket_whose_bisection_ends_on_the_half_turn_gives_way_to_the_next(m
             return 0.3 + (2.0 * math.pi - 0.6) * (t - a_lo) / (a_hi - a_lo)
         return 2.0 * math.pi - 0.3
 
-    class Made:
-        def __init__(self, dirs):
-            t = math.atan2(dirs[0][1], dirs[0][0])
-            self.at = [np.array([math.cos(t + phi(t)), math.sin(t + phi(t))])]
-
-    rs = [constraints.slip_angle(np.array([math.cos(t), math.sin(t)]),
-                                 Made([[math.cos(t), math.sin(t)]]).at[0]) for t in th]
-    assert constraints.scan_brackets(th, rs, 0.0) == [40, 37]
-    monkeypatch.setattr(constraints, "solve_given_modes",
-                        lambda Minv, a0, rows, modes, dirs, **kw: Made(dirs))
-    sol, ok = constraints._slide_start_scan(None, None, [], (SLIDE,), [np.array([1.0, 0.0])],
-                                            0, 0.0, None)
-    t_root = b_lo + (b_hi - b_lo) * 1.8 / 2.1
-    assert ok
-    assert sol.at[0] == pytest.approx([math.cos(t_root), math.sin(t_root)], abs=1e-9)
+    rs = [slip_angle(np.array([math.cos(t), math.sin(t)]),
+                     np.array([math.cos(t + phi(t)), math.sin(t + phi(t))])) for t in th]
+    assert _bracket_order(th, rs, 0.0) == [40, 37]

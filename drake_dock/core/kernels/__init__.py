@@ -8,9 +8,10 @@ chooses its directory (importing this package applies it before any kernel is de
 `prepare` compiles the kernels before a run needs them, in parallel, with a line per module.
 
 `drake_dock.core.couple` is the couple kernels' Python interface (it packs a pair's patches
-and poses and raises the typed errors); the pure-Python modules `drake_dock.core.seeking` and
-`drake_dock.core.constraints` stay the reference the compiled seek and constraints are tested
-against (tests/core/test_kernels_seek.py, tests/core/test_kernels_constraints.py).
+and poses and raises the typed errors); the pure-Python module `drake_dock.core.seeking` stays
+the reference the compiled seek is tested against (tests/core/test_kernels_seek.py), and
+`drake_dock.core.constraints` states the law the compiled constraints solve and holds its
+records.
 ``NUMBA_DISABLE_JIT=1`` runs the kernels as Python, for debugging."""
 from drake_dock.core.kernels import compile_cache
 

@@ -1,18 +1,19 @@
-"""The constraint solve and mode selection of `drake_dock.core.constraints` (Eq. 48-52, Coulomb
-friction, the Baumgarte-stabilised normal rows) compiled, over plain arrays:
+"""The constraint solve and mode selection of Eq. 48-52 (Coulomb friction, the
+Baumgarte-stabilised normal rows; `drake_dock.core.constraints` states the law, the modes and the
+selection's rules and holds the records), compiled over plain arrays:
 
 - `solve_given_modes` (the contact forces and accelerations for given modes) and
   `select_contact_modes` (the enumeration of the modes, the start of sliding, the consistency
-  tests and the preferences), with the signatures and results of the pure-Python reference,
-  which the tests compare them with (tests/core/test_kernels_constraints.py);
+  tests and the preferences), over `ContactRow`s, returning a `ContactSolution`; the tests check
+  them against the modes' equations and inequalities and against closed forms
+  (tests/core/test_kernels_constraints.py, test_constraints.py, test_squeeze.py);
 - `solve_packed`, the solve on rows already packed as arrays (`pack_rows`), for the derivative
   evaluation.
 
 A couple's row is packed as W (nv, 3), the columns W^3, W^1, W^2 of Eq. (11) (n, ta, tb), and
 its velocity-product terms (bn, bt) as one 3-vector. The modes are codes `STICK`, `SLIDE`,
-`DETACH`. The kernels return a status instead of raising; the wrappers raise the reference's
-typed errors. The solve uses the reference's operations in its order and array layouts (BLAS
-products, LAPACK's LU solve), so that its results equal the reference's to round-off.
+`DETACH`. The kernels return a status instead of raising; the wrappers raise the typed
+errors (`raise_status`).
 """
 from __future__ import annotations
 
@@ -33,8 +34,9 @@ from drake_dock.errors import (NumericalError, PainleveError, PainleveInconsiste
 
 @njit(cache=True)
 def _consistent(modes, lam_n, lam_t, gdd, vn, gap, mu_s, omega, tol_f, tol_a):
-    """`constraints._consistent`: complementarity on the stabilised normal row and the static
-    cone (Eq. 50-52), within tol_f (N) and tol_a (m/s^2)."""
+    """Complementarity on the stabilised normal row (lambda_n >= 0 in contact, Eq. 50-51;
+    g'' + 2 omega g' + omega^2 g >= 0 detached, Eq. 52) and the static cone (Eq. 51), within
+    tol_f (N) and tol_a (m/s^2)."""
     for i in range(modes.shape[0]):
         if modes[i] == DETACH:
             if stabilised(gdd[i], vn[i], gap[i], omega) < -tol_a:
@@ -50,7 +52,7 @@ def _consistent(modes, lam_n, lam_t, gdd, vn, gap, mu_s, omega, tol_f, tol_a):
 
 @njit(cache=True)
 def _select(P, vt, avoid, v_slip, omega, rtol, tie_rtol):
-    """`constraints.select_contact_modes` without its errors, for the `Problem` P and the
+    """`select_contact_modes` without its errors, for the `Problem` P and the
     couples' tangential velocities vt (k, 2): returns (status, modes (n, k), dirs
     (n, k, 2), vdot (n, nv), lam_n (n, k), lam_t (n, k, 2), gf (n, nv), best, other), with
     row ``best`` the choice, and for INDETERMINATE row ``other`` the second consistent
@@ -192,7 +194,7 @@ def _dirs_array(modes, dirs):
 def solve_packed(P, modes, dirs, omega, *, time=None, names=()):
     """(vdot, lam_n (k,), lam_t (k, 2), generalized force) for the `Problem` P of the packed
     rows and the mode codes ``modes`` (int array), ``dirs`` (k, 2) the sliding directions;
-    `SingularContactError` (naming ``names``) as the reference."""
+    `SingularContactError` (naming ``names``)."""
     k, nv = P.W.shape[0], len(P.a0)
     vdot, lam_n, lam_t, gf = np.empty(nv), np.empty(k), np.empty((k, 2)), np.empty(nv)
     st, cond = solve_modes(P, modes, dirs, omega, Solution(vdot, lam_n, lam_t, gf))
@@ -222,7 +224,14 @@ def _problem(Minv, a0, rows):
 
 
 def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None):
-    """`constraints.solve_given_modes` compiled: the same arguments and `ContactSolution`."""
+    """The contact forces and accelerations for the given modes (``dirs[i]`` the sliding
+    direction of a sliding couple, None for the others) of the `ContactRow`s ``rows``, the
+    inverse mass matrix ``Minv`` and the free acceleration ``a0``: a `ContactSolution`. Where
+    the constraint matrix is singular (redundant rows) the minimum-norm forces, squeezed into
+    the cones of two sticking couples where that helps (`drake_dock.core.squeeze`), if the
+    equations are consistent within the Baumgarte terms; else it raises
+    `SingularContactError` (with ``time`` and the couples). `NumericalError` if the equations
+    are not finite."""
     codes = np.array([CODE[m] for m in modes], dtype=np.int64)
     vdot, lam_n, lam_t, gf = solve_packed(_problem(Minv, a0, rows)[0], codes,
                                           _dirs_array(modes, dirs), omega, time=time,
@@ -232,7 +241,15 @@ def solve_given_modes(Minv, a0, rows, modes, dirs, *, omega=0.0, time=None):
 
 def select_contact_modes(Minv, a0, rows, *, v_slip=1e-6, omega=0.0, time=None, rtol=1e-9,
                          avoid=None):
-    """`constraints.select_contact_modes` compiled: the same arguments, choice and errors."""
+    """One consistent choice of modes for the contact set (`drake_dock.core.constraints`
+    states the rules), a `ContactSolution`. A couple whose sliding speed exceeds ``v_slip``
+    slides in its direction of motion (or detaches); one at rest may stick, start to slide or
+    detach. ``avoid[i]`` lists modes that couple i is leaving (its witness has just crossed
+    zero): at a tie, where a mode it leaves is still consistent within round-off, another
+    consistent mode is taken (a choice whose solve is singular or not finite is not
+    consistent). Raises `PainleveInconsistency` (no consistent mode), `PainleveError`
+    (several that differ in their normal modes) or, for more than `MAX_ENUMERATED` couples,
+    `NumericalError`, with ``time`` and the couples."""
     k = len(rows)
     names = [r.name for r in rows]
     if k == 0:

@@ -1,6 +1,8 @@
-"""The direction of a start of sliding (`drake_dock.core.constraints._slide_start` and its scan
-and grid) compiled: the fixed point s = a_t/|a_t|, then, where it does not converge, the scan
-of one couple's direction or the grid and Newton's method for two."""
+"""The direction of a start of sliding, compiled: friction opposes the tangential relative
+acceleration it produces, so a couple starting to slide from rest slides along s with a_t
+along s. The fixed point s = a_t/|a_t|, then, where a starting couple's a_t has no positive
+component along its s after it, the scan of one couple's direction or the grid and Newton's
+method for two (`slide_start` states what each accepts)."""
 from __future__ import annotations
 
 import math
@@ -38,9 +40,15 @@ def _solve(P, modes, dirs, omega, out):
 
 @njit(cache=True, inline="always")
 def slide_start(P, modes, dirs, starting, omega, out):
-    """`constraints._slide_start` for the `solve.Problem` P: the sliding directions (in dirs) of the
-    couples ``starting`` to slide, s = a_t/|a_t|, the solution in the `Outputs` out; returns
-    (status, directions found)."""
+    """The start of sliding for the `solve.Problem` P: the sliding directions (in dirs) of the
+    couples ``starting`` to slide, the solution in the `Outputs` out; returns (status,
+    directions found). The fixed point s = a_t/|a_t| runs until it converges or for
+    `SLIDE_START_ITER` iterations (none found where a starting couple's a_t is exactly 0);
+    its directions are found when every starting couple's a_t then has a positive component
+    along its s, converged or not. Otherwise one starting couple's direction is scanned
+    (`_slide_start_scan`: found at a bisected root with a_t.s > 0), two couples' by the grid
+    and Newton's method (`_slide_start_grid`: found at a root with a_t along s, or a_t below
+    1e-6 of the acceleration scale), and three or more are not found."""
     at = out.at
     for _ in range(SLIDE_START_ITER):
         st = _solve(P, modes, dirs, omega, out)
@@ -71,7 +79,7 @@ def slide_start(P, modes, dirs, starting, omega, out):
 
 @njit(cache=True)
 def _slip_residual(P, modes, dirs, i, th, omega, out):
-    """`constraints._slide_start_scan`'s residual: couple i sliding along theta; returns
+    """`_slide_start_scan`'s residual: couple i sliding along theta; returns
     (status, the angle from its direction to its tangential acceleration)."""
     dirs[i, 0], dirs[i, 1] = math.cos(th), math.sin(th)
     st = _solve(P, modes, dirs, omega, out)
@@ -82,15 +90,15 @@ def _slip_residual(P, modes, dirs, i, th, omega, out):
 
 @njit(cache=True)
 def _slip_angle(dirs, at, i):
-    """`constraints.slip_angle` of couple i: the angle from its direction to its tangential
-    acceleration."""
+    """The slip angle of couple i (`drake_dock.core.constraints.slip_angle`): the angle from
+    its direction to its tangential acceleration."""
     s0, s1, a0_, a1 = dirs[i, 0], dirs[i, 1], at[i, 0], at[i, 1]
     return math.atan2(s0 * a1 - s1 * a0_, s0 * a0_ + s1 * a1)
 
 
 @njit(cache=True)
 def _slip_residuals(P, modes, dirs, starting, th, omega, out, r, angle):
-    """`constraints._slide_start_grid`'s residual into r (2,): the starting couples sliding
+    """`_slide_start_grid`'s residual into r (2,): the starting couples sliding
     along th (2,); the angles between their directions and accelerations if ``angle``, else
     s x a_t. Returns the status."""
     for c in range(2):
@@ -108,7 +116,15 @@ def _slip_residuals(P, modes, dirs, starting, th, omega, out, r, angle):
 
 @njit(cache=True, inline="always")
 def _slide_start_grid(P, modes, dirs, starting, omega, out):
-    """`constraints._slide_start_grid` (the same grid, Newton steps and test)."""
+    """The directions of two couples starting to slide where the fixed point leaves a couple's
+    a_t with no positive component along its s: where each couple's tangential acceleration
+    lies along its direction. The point
+    of a `SLIDE_START_GRID`^2 grid of the two angles around the fixed point's last directions
+    with the least angles between directions and accelerations starts Newton's method on
+    s x a_t (smooth where a_t vanishes, unlike the angle; forward-difference Jacobian, steps
+    halved while it does not fall). Found (status, True) at a root with a_t along s, or with
+    a_t below 1e-6 of the acceleration scale (both couples at the stick-slip transition:
+    forces on the cones' edges), else (status, False)."""
     n = ref.SLIDE_START_GRID
     th0 = np.empty(2)
     for c in range(2):
@@ -169,7 +185,8 @@ def _slide_start_grid(P, modes, dirs, starting, omega, out):
 
 @njit(cache=True)
 def _nearest_bracket(ths, rs, th0, within_quarter):
-    """`constraints.scan_brackets`' bracket of one kind: the nearest th0 where the angle
+    """The slide-start scan's bracket of one kind (`_slide_start_scan` bisects the first kind's,
+    then the second's): the nearest th0 where the angle
     changes sign with both ends within 90 deg (``within_quarter``) or by less than 180 deg;
     -1 for none."""
     best, best_k = np.inf, -1
@@ -189,7 +206,14 @@ def _nearest_bracket(ths, rs, th0, within_quarter):
 
 @njit(cache=True, inline="always")
 def _slide_start_scan(P, modes, dirs, i, omega, out):
-    """`constraints._slide_start_scan` (the same scan, brackets and bisection)."""
+    """The direction of couple i starting to slide where the fixed point leaves its a_t with no
+    positive component along s: a direction s(theta) along which its tangential acceleration
+    lies, bracketed on
+    `SLIDE_START_SCAN` angles around the fixed point's last direction theta0 and bisected (the
+    bracket nearest theta0 whose ends lie within 90 deg of s; failing that, the nearest where
+    the angle crosses zero rather than +-180 deg, `_nearest_bracket`: next to the stick-slip
+    transition a_t is small and turns fast with theta). Found (status, True), or (status,
+    False) if there is none."""
     at = out.at
     th0 = math.atan2(dirs[i, 1], dirs[i, 0])
     n = ref.SLIDE_START_SCAN

@@ -1,4 +1,4 @@
-"""The constraint solve of `drake_dock.core.constraints.solve_given_modes` compiled (Eq. 48-52):
+"""The constraint solve of Eq. 48-52 compiled (`drake_dock.core.constraints` states the law):
 the forces and accelerations of a contact set for given modes, over the packed rows of
 `drake_dock.core.kernels.constraints`: the products in loops, LU with partial pivoting and the
 SVD for the singular case (`small_linalg`), and the squeeze of two sticking couples
@@ -58,7 +58,7 @@ def stabilised(x, vn, gap, omega):
 
 @njit(cache=True)
 def solve_modes(P, modes, dirs, omega, out):
-    """`constraints.solve_given_modes` of the `Problem` P under the mode codes ``modes`` and
+    """The contact forces and accelerations of the `Problem` P under the mode codes ``modes`` and
     the sliding directions ``dirs`` (k, 2) into the `Solution` out; returns (status,
     cond(A)): SINGULAR when the constraint matrix is singular and the equations inconsistent,
     NONFINITE when they hold an inf or a nan."""
@@ -74,10 +74,13 @@ def solve_modes(P, modes, dirs, omega, out):
         copy1(vdot, a0)
         gf[:] = 0.0
         return OK, 0.0
-    Ct = np.empty((m, nv))         # C^T and D^T, C-ordered: C = Ct.T as the reference's
+    # C: the force directions (a sticking couple's W^3, W^1, W^2; a sliding one's
+    # W^3 - mu W^t s), D: the constrained directions (W^3, W^1, W^2; W^3). C^T and D^T are
+    # kept C-ordered.
+    Ct = np.empty((m, nv))
     Dt = np.empty((m, nv))
     rhs = np.empty(m)
-    soft = 0.0       # the Baumgarte terms' squared norm (see the reference's singular case)
+    soft = 0.0       # the Baumgarte terms' squared norm (the singular case below)
     j = 0
     for i in range(k):
         if modes[i] != DETACH:
@@ -120,7 +123,10 @@ def solve_modes(P, modes, dirs, omega, out):
             A[r, c] = acc
     if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):
         return NONFINITE, np.nan
-    # The singularity test: the Hadamard ratio |det A| / prod of its row norms.
+    # Singular (redundant or degenerate rows) when the Hadamard ratio |det A| / prod of its
+    # row norms, a scale-free measure in [0, 1] that vanishes with the smallest singular value
+    # of the row-scaled matrix, is below 1e-12 (an SVD per evaluation would cost more than the
+    # rest of the solve).
     prod, positive = 1.0, True
     for r in range(m):
         s = 0.0
@@ -137,6 +143,10 @@ def solve_modes(P, modes, dirs, omega, out):
     else:
         U, sv, V = L.svd(A)
         cond = sv[0] / sv[-1] if sv[-1] > 0.0 else math.inf
+        # Redundant constraints (a body resting on several sticking couples is statically
+        # indeterminate): the minimum-norm forces, if the equations are consistent. The
+        # Baumgarte terms pull each couple's own drift to zero, so redundant rows disagree by
+        # as much as those terms: a residual within them is consistent.
         lam = L.svd_solve(U, sv, V, b, 1e-10)
         if L.norm(L.matvec(A, lam) - b) > (1e-8 * (1.0 + L.norm(b)) + math.sqrt(soft)):
             return SINGULAR, cond
