@@ -38,13 +38,12 @@ start-of-sliding (possible when mu_s > mu) are resolved by preferring stick: a c
 stays at rest.
 
 A start of sliding takes the direction along which the couple's tangential acceleration lies:
-a fixed point s = a_t/|a_t|, accepted when, after it (converged or after ``SLIDE_START_ITER``
-iterations), each starting couple's a_t has a positive component along its s; where one has
-none, a scan of one couple's direction (accepting a bisected root with a_t . s > 0) or a grid
-and Newton's method for two (accepting a root with a_t along s, or a_t below 1e-6 of the
-acceleration scale; `drake_dock.core.kernels.slide_start`). A fixed point that does not
-converge can so leave a starting couple sliding at an angle below 90 deg from its a_t; the
-next step's sliding velocity then sets its direction.
+a fixed point s = a_t/|a_t| (``SLIDE_START_ITER`` iterations at most), accepted where each
+starting couple's a_t lies along its s; where it does not, a scan of one couple's direction
+(accepting a bisected root with a_t . s > 0) or a grid and Newton's method for two (accepting
+a root with a_t along s, or a_t below 1e-6 of the acceleration scale); three or more couples
+whose fixed point does not converge have no start of sliding
+(`drake_dock.core.kernels.slide_start`).
 
 Two couples sticking between the same two bodies are fixed up to a squeeze, chosen to keep
 them in their cones (`drake_dock.core.squeeze`).

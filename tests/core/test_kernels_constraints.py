@@ -70,13 +70,12 @@ def consistent(a0, rows, sol, omega, rtol):
     return True
 
 
-def check_starts(rows, sol, v_slip=1e-6) -> int:
+def check_starts(rows, sol, v_slip=1e-6):
     """A couple moving faster than v_slip does not stick and slides against its velocity;
-    one starting to slide from rest has a tangential acceleration along its direction (the
-    slip angle within 1e-6 rad), or below 1e-6 of the acceleration scale, or (the start of
-    sliding's acceptance, `drake_dock.core.constraints`) at least a positive component along
-    it. Returns the number of starts of the last kind."""
-    lenient = 0
+    one starting to slide from rest has a tangential acceleration along its direction (a
+    positive component along it, the slip angle within 1e-6 rad: Eq. 50, friction opposes the
+    slip it starts), or one below 1e-6 of the acceleration scale (at its stick-slip
+    transition)."""
     for i, (r, m) in enumerate(zip(rows, sol.modes)):
         moving = np.hypot(*r.vt) > v_slip
         if m == STICK:
@@ -87,9 +86,7 @@ def check_starts(rows, sol, v_slip=1e-6) -> int:
             at = r.Wt.T @ sol.vdot + r.bt
             if np.hypot(*at) <= 1e-6 * (1.0 + np.abs(sol.vdot).max()):
                 continue
-            assert at @ sol.dirs[i] > 0
-            lenient += abs(slip_angle(sol.dirs[i], at)) > 1e-6
-    return lenient
+            assert at @ sol.dirs[i] > 0 and abs(slip_angle(sol.dirs[i], at)) < 1e-6
 
 
 def key(sol, rows, avoid) -> tuple:
@@ -230,10 +227,9 @@ def test_select_contact_modes_returns_a_consistent_choice(scene):
     without modes to avoid. Each choice holds its modes' equations and inequalities, and no
     choice without a start of sliding that is consistent to 1e-10 of the scales (tighter than
     the selection's 1e-9) is preferred to it; where the selection finds none consistent
-    (`PainleveInconsistency`, with the time), none of those is. A start of sliding whose
-    fixed point did not converge, with a_t not along s, is rare (at most 5 of the scenes)."""
+    (`PainleveInconsistency`, with the time), none of those is."""
     rng = np.random.default_rng(20)
-    kinds, lenient = set(), 0
+    kinds = set()
     for n in range(150):
         M, a0, rows = random_scene(rng) if scene == "plane" else general_scene(rng)
         Minv = np.linalg.inv(M)
@@ -255,14 +251,13 @@ def test_select_contact_modes_returns_a_consistent_choice(scene):
             continue
         check_equations(Minv, a0, rows, sol, OMEGA, tol=1e-8)
         assert consistent(a0, rows, sol, OMEGA, TIE_RTOL)
-        lenient += check_starts(rows, sol)
+        check_starts(rows, sol)
         assert all(key(sol, rows, avoid) <= key(o, rows, avoid) for o in others)
         kinds.update(sol.modes)
     # The scenes reach every mode (and, on general scenes, the Painleve paradox).
     assert {SLIDE, DETACH} <= kinds
     if scene == "general":
         assert {STICK, "PainleveInconsistency"} <= kinds
-    assert lenient <= 5
 
 
 def rod_critical_mu(theta):

@@ -142,6 +142,24 @@ def _slip_angles(Minv, a0, rows, v1, omega, th):
     return np.array(angle), np.array(along)
 
 
+def _fixed_point(Minv, a0, rows, j, other, omega):
+    """Couple j of two starting to slide, the other sliding along ``other``: the fixed point
+    s <- a_t/|a_t| from the direction opposite its sticking force (where the selection
+    starts), iterated as often as the selection does; (s, a_t) at its end."""
+    def modes(m):
+        return (m, SLIDE) if j == 0 else (SLIDE, m)
+
+    def dirs(e):
+        return [e, other] if j == 0 else [other, e]
+    stick = compiled.solve_given_modes(Minv, a0, rows, modes(STICK), dirs(None), omega=omega)
+    e = -stick.lam_t[j] / np.hypot(*stick.lam_t[j])
+    for _ in range(SLIDE_START_ITER):
+        at = compiled.solve_given_modes(Minv, a0, rows, modes(SLIDE), dirs(e), omega=omega).at[j]
+        e = at / np.hypot(*at)
+    return e, compiled.solve_given_modes(Minv, a0, rows, modes(SLIDE), dirs(e),
+                                         omega=omega).at[j]
+
+
 def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_contact_modes):
     """A docking selection (tests/core/slide_start_docking.json): couple 0 at rest, couple 1
     sliding. Couple 0 sticking needs more than its cone; the fixed point s = a_t/|a_t| for its
@@ -163,16 +181,36 @@ def test_a_start_of_sliding_the_fixed_point_misses_is_found(select_contact_modes
     # The fixed point alone misses it: s <- a_t/|a_t| from the sticking force's direction
     # (where the selection starts), iterated as often as the selection does, ends with a_t
     # not along s.
-    stick = compiled.solve_given_modes(Minv, a0, rows, (STICK, SLIDE), [None, v1],
-                                       omega=d["omega"])
-    e = -stick.lam_t[0] / np.hypot(*stick.lam_t[0])
-    for _ in range(SLIDE_START_ITER):
-        at = compiled.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), [e, v1],
-                                        omega=d["omega"]).at[0]
-        e = at / np.hypot(*at)
-    at = compiled.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), [e, v1],
-                                    omega=d["omega"]).at[0]
+    e, at = _fixed_point(Minv, a0, rows, 0, v1, d["omega"])
     assert not at @ e > 0
+
+
+def test_a_start_of_sliding_whose_fixed_point_does_not_converge_lies_along_a_t(
+        select_contact_modes):
+    """A docking selection (tests/core/slide_start_fixed_point.json): couple 0 sliding, couple
+    1 at rest and leaving stick. The fixed point s = a_t/|a_t| for couple 1 does not converge:
+    from the sticking force's direction, as many iterations as the selection makes leave a_t
+    off s, though with a positive component along it. The selection slides along a direction
+    where a_t lies along s (Eq. 50), the one a dense sampling (3600 angles) finds."""
+    Minv, a0, rows, d = _docking_selection("slide_start_fixed_point.json")
+    v0 = rows[0].vt / np.hypot(*rows[0].vt)
+    e, at = _fixed_point(Minv, a0, rows, 1, v0, d["omega"])
+    assert at @ e > 0 and abs(slip_angle(e, at)) > 1e-3
+    sol = select_contact_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
+                               avoid=[tuple(a) for a in d["avoid"]])
+    assert sol.modes == (SLIDE, SLIDE) and (sol.lam_n > 0).all()
+    s = sol.dirs[1]
+    assert abs(slip_angle(s, sol.at[1])) < 1e-9 and sol.at[1] @ s > 0
+    th = np.linspace(-math.pi, math.pi, 3601)
+    res = []
+    for t in th:
+        u = np.array([math.cos(t), math.sin(t)])
+        a = compiled.solve_given_modes(Minv, a0, rows, (SLIDE, SLIDE), [v0, u],
+                                       omega=d["omega"]).at[1]
+        res.append(abs(slip_angle(u, a)) if a @ u > 0 else math.pi)
+    k = int(np.argmin(res))
+    assert res[k] < 5 * 2 * math.pi / 3600      # a_t turns faster than s there
+    assert math.atan2(s[1], s[0]) == pytest.approx(th[k], abs=2 * math.pi / 3600)
 
 
 def test_two_couples_starting_to_slide_are_found(select_contact_modes):

@@ -7,11 +7,11 @@ of sliding in `slide_start`). `compile_cache` keys the compiled code's cache per
 chooses its directory (importing this package applies it before any kernel is defined);
 `prepare` compiles the kernels before a run needs them, in parallel, with a line per module.
 
-`drake_dock.core.couple` is the couple kernels' Python interface (it packs a pair's patches
-and poses and raises the typed errors); the pure-Python module `drake_dock.core.seeking` stays
-the reference the compiled seek is tested against (tests/core/test_kernels_seek.py), and
+`drake_dock.core.couple` and `drake_dock.core.seeking` are the couple kernels' and the seek's
+Python interfaces (they pack a pair's patches and poses and raise the typed errors), and
 `drake_dock.core.constraints` states the law the compiled constraints solve and holds its
-records.
+records; the tests check the kernels against closed forms and references that share nothing
+with them (tests/core/test_kernels_seek.py, test_kernels_constraints.py).
 ``NUMBA_DISABLE_JIT=1`` runs the kernels as Python, for debugging."""
 from drake_dock.core.kernels import compile_cache
 

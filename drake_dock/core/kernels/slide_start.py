@@ -1,8 +1,8 @@
 """The direction of a start of sliding, compiled: friction opposes the tangential relative
-acceleration it produces, so a couple starting to slide from rest slides along s with a_t
-along s. The fixed point s = a_t/|a_t|, then, where a starting couple's a_t has no positive
-component along its s after it, the scan of one couple's direction or the grid and Newton's
-method for two (`slide_start` states what each accepts)."""
+acceleration it produces, so a couple starting to slide from rest slides along s with a_t along
+s. The fixed point s = a_t/|a_t|, then, where it leaves a starting couple's a_t off its s, the
+scan of one couple's direction or the grid and Newton's method for two (`slide_start` states
+what each accepts)."""
 from __future__ import annotations
 
 import math
@@ -14,6 +14,10 @@ from numba import njit
 from drake_dock.core import constraints as ref
 from drake_dock.core.kernels.solve import (OK, SLIDE_START_ITER, Solution, accelerations,
                                            solve_modes)
+
+#: a_t lies along s where its component across s is below this fraction of |a_t| (the fixed
+#: point's and the grid's root test)
+ALONG_RTOL = 1e-9
 
 
 class Outputs(NamedTuple):
@@ -44,8 +48,9 @@ def slide_start(P, modes, dirs, starting, omega, out):
     couples ``starting`` to slide, the solution in the `Outputs` out; returns (status,
     directions found). The fixed point s = a_t/|a_t| runs until it converges or for
     `SLIDE_START_ITER` iterations (none found where a starting couple's a_t is exactly 0);
-    its directions are found when every starting couple's a_t then has a positive component
-    along its s, converged or not. Otherwise one starting couple's direction is scanned
+    its directions are found when every starting couple's a_t then lies along its s (a
+    positive component along it, and across it below `ALONG_RTOL` of |a_t|: a fixed point
+    that converged). Otherwise one starting couple's direction is scanned
     (`_slide_start_scan`: found at a bisected root with a_t.s > 0), two couples' by the grid
     and Newton's method (`_slide_start_grid`: found at a root with a_t along s, or a_t below
     1e-6 of the acceleration scale), and three or more are not found."""
@@ -68,7 +73,12 @@ def slide_start(P, modes, dirs, starting, omega, out):
     if st != OK:
         return st, False
     for i in starting:
-        if not at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0:
+        # Found where a_t lies along s (Eq. 50: the friction of a start of sliding opposes
+        # the slip it starts): a positive component along s, across it below ALONG_RTOL |a_t|.
+        a0_, a1 = at[i, 0], at[i, 1]
+        d0, d1 = dirs[i, 0], dirs[i, 1]
+        if not (a0_ * d0 + a1 * d1 > 0
+                and abs(d0 * a1 - d1 * a0_) <= ALONG_RTOL * math.hypot(a0_, a1)):
             if len(starting) == 1:
                 return _slide_start_scan(P, modes, dirs, i, omega, out)
             if len(starting) == 2:
@@ -117,14 +127,13 @@ def _slip_residuals(P, modes, dirs, starting, th, omega, out, r, angle):
 @njit(cache=True, inline="always")
 def _slide_start_grid(P, modes, dirs, starting, omega, out):
     """The directions of two couples starting to slide where the fixed point leaves a couple's
-    a_t with no positive component along its s: where each couple's tangential acceleration
-    lies along its direction. The point
-    of a `SLIDE_START_GRID`^2 grid of the two angles around the fixed point's last directions
-    with the least angles between directions and accelerations starts Newton's method on
-    s x a_t (smooth where a_t vanishes, unlike the angle; forward-difference Jacobian, steps
-    halved while it does not fall). Found (status, True) at a root with a_t along s, or with
-    a_t below 1e-6 of the acceleration scale (both couples at the stick-slip transition:
-    forces on the cones' edges), else (status, False)."""
+    a_t off its s: where each couple's tangential acceleration lies along its direction. The
+    point of a `SLIDE_START_GRID`^2 grid of the two angles around the fixed point's last
+    directions with the least angles between directions and accelerations starts Newton's method
+    on s x a_t (smooth where a_t vanishes, unlike the angle; forward-difference Jacobian, steps
+    halved while it does not fall). Found (status, True) at a root with a_t along s, or with a_t
+    below 1e-6 of the acceleration scale (both couples at the stick-slip transition: forces on
+    the cones' edges), else (status, False)."""
     n = ref.SLIDE_START_GRID
     th0 = np.empty(2)
     for c in range(2):
@@ -178,7 +187,7 @@ def _slide_start_grid(P, modes, dirs, starting, omega, out):
     for c in range(2):
         i = starting[c]
         na = math.hypot(at[i, 0], at[i, 1])
-        ok = ok and (na <= small or (abs(r[c]) <= 1e-9 * na
+        ok = ok and (na <= small or (abs(r[c]) <= ALONG_RTOL * na
                                      and at[i, 0] * dirs[i, 0] + at[i, 1] * dirs[i, 1] > 0))
     return OK, ok
 
@@ -206,14 +215,13 @@ def _nearest_bracket(ths, rs, th0, within_quarter):
 
 @njit(cache=True, inline="always")
 def _slide_start_scan(P, modes, dirs, i, omega, out):
-    """The direction of couple i starting to slide where the fixed point leaves its a_t with no
-    positive component along s: a direction s(theta) along which its tangential acceleration
-    lies, bracketed on
+    """The direction of couple i starting to slide where the fixed point leaves its a_t off s: a
+    direction s(theta) along which its tangential acceleration lies, bracketed on
     `SLIDE_START_SCAN` angles around the fixed point's last direction theta0 and bisected (the
     bracket nearest theta0 whose ends lie within 90 deg of s; failing that, the nearest where
     the angle crosses zero rather than +-180 deg, `_nearest_bracket`: next to the stick-slip
-    transition a_t is small and turns fast with theta). Found (status, True), or (status,
-    False) if there is none."""
+    transition a_t is small and turns fast with theta). Found (status, True), or (status, False)
+    if there is none."""
     at = out.at
     th0 = math.atan2(dirs[i, 1], dirs[i, 0])
     n = ref.SLIDE_START_SCAN
