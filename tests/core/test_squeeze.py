@@ -7,12 +7,15 @@ acceleration lies along the direction (dense samplings, scipy's least squares). 
 solve and mode selection (drake_dock.core.kernels.constraints); runs without Drake."""
 import json
 import math
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from drake_dock.core.constraints import (SLIDE, SLIDE_START_ITER, SLIDE_START_SCAN, STICK,
+from drake_dock.core.constraints import (SLIDE, SLIDE_START_ITER, STICK,
                                          ContactRow, slip_angle)
 from drake_dock.core.kernels import constraints as compiled
 from drake_dock.core.squeeze import SHRINK, cone_interval, sorted_values
@@ -316,27 +319,63 @@ def test_the_scan_brackets_cross_zero_not_the_half_turn():
     assert _bracket_order(ths, rs2, 0.0) == [7, 4]
 
 
-def test_a_steep_bracket_comes_after_one_within_a_quarter_turn():
-    """The scan's brackets on the angle phi(theta) from s to a made-up tangential acceleration
-    (theta0 = 0): -1.8 rad, then crossing zero steeply to 0.3 rad over the step from the 37th
-    scanned direction (the nearest crossing, but its ends are not both within 90 deg), 0.3
-    rad, then turning through +180 deg to -0.3 rad over the step from the 40th (a sign change
-    within 90 deg at both ends): the 40th step is bisected first, then the 37th."""
-    n = SLIDE_START_SCAN
-    th = [2.0 * math.pi * (k / n - 0.5) for k in range(n + 1)]
-    b_lo, b_hi, a_lo, a_hi = th[37], th[38], th[40], th[41]
+SCAN_WITH_MADE_UP_ACCELERATION = """
+import math, sys
+import numpy as np
+import numba
+from drake_dock.core.kernels import slide_start as S
+assert numba.config.DISABLE_JIT
+from drake_dock.core.constraints import SLIDE_START_SCAN as n
+th = [2.0 * math.pi * (k / n - 0.5) for k in range(n + 1)]
+b_lo, b_hi, a_lo, a_hi = th[37], th[38], th[40], th[41]
 
-    def phi(t):
-        if t <= b_lo:
-            return -1.8
-        if t <= b_hi:
-            return -1.8 + 2.1 * (t - b_lo) / (b_hi - b_lo)
-        if t <= a_lo:
-            return 0.3
-        if t <= a_hi:
-            return 0.3 + (2.0 * math.pi - 0.6) * (t - a_lo) / (a_hi - a_lo)
-        return 2.0 * math.pi - 0.3
+def phi(t):
+    if t <= b_lo:
+        return -1.8
+    if t <= b_hi:
+        return -1.8 + 2.1 * (t - b_lo) / (b_hi - b_lo)
+    if t <= a_lo:
+        return 0.3
+    if t <= a_hi:
+        return 0.3 + (2.0 * math.pi - 0.6) * (t - a_lo) / (a_hi - a_lo)
+    return 2.0 * math.pi - 0.3
 
-    rs = [slip_angle(np.array([math.cos(t), math.sin(t)]),
-                     np.array([math.cos(t + phi(t)), math.sin(t + phi(t))])) for t in th]
-    assert _bracket_order(th, rs, 0.0) == [40, 37]
+def made_up(P, modes, dirs, i, t, omega, out):
+    dirs[i, 0], dirs[i, 1] = math.cos(t), math.sin(t)
+    out.at[i, 0], out.at[i, 1] = math.cos(t + phi(t)), math.sin(t + phi(t))
+    return S.OK, S._slip_angle(dirs, out.at, i)
+
+
+rs = [made_up(None, None, np.zeros((1, 2)), 0, t, 0.0,
+               S.Outputs(None, np.zeros(1), np.zeros((1, 2))))[1] for t in th]
+first = S._nearest_bracket(np.array(th), np.array(rs), 0.0, True)
+second = S._nearest_bracket(np.array(th), np.array(rs), 0.0, False)
+print(first, second)
+S._slip_residual = made_up
+dirs = np.array([[1.0, 0.0]])
+out = S.Outputs(None, np.zeros(1), np.zeros((1, 2)))
+st, found = S._slide_start_scan(None, None, dirs, 0, 0.0, out)
+print(st == S.OK, found, *out.at[0], b_lo + (b_hi - b_lo) * 1.8 / 2.1)
+"""
+
+
+def test_a_bracket_whose_bisection_ends_on_the_half_turn_gives_way_to_the_next():
+    """The scan (`slide_start._slide_start_scan`, run as Python by the debugging path,
+    ``NUMBA_DISABLE_JIT=1``, its residual replaced) on a made-up tangential acceleration
+    a_t(s(theta)) whose angle from s is phi(theta) (theta0 = 0): -1.8 rad, then crossing zero
+    steeply to 0.3 rad over the step from the 37th scanned direction (the nearest crossing,
+    but its ends are not both within 90 deg), 0.3 rad, then turning through +180 deg to -0.3
+    rad over the step from the 40th (a sign change within 90 deg at both ends), and -0.3 rad
+    after. Its brackets are the 40th step, then the 37th; it bisects the 40th first, finds
+    a_t against s there, and slides along the 37th step's root, where phi = 0 (closed
+    form)."""
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    out = subprocess.run([sys.executable, "-c", SCAN_WITH_MADE_UP_ACCELERATION], env=env,
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr
+    first, second, ok, found, a0, a1, t_root = out.stdout.split()
+    assert (first, second) == ("40", "37")
+    assert ok == "True" and found == "True"
+    assert [float(a0), float(a1)] == pytest.approx([math.cos(float(t_root)),
+                                                    math.sin(float(t_root))], abs=1e-9)
+
