@@ -154,7 +154,8 @@ def _stem(name: str) -> str:
     return name[:-1] if name.endswith("e") and len(name) >= 5 else name
 
 
-# A compiled kernel and the pure-Python reference it compiles: one thing twice, by design.
+# A compiled kernel and its Python interface (which packs the patches and poses, raises the
+# typed errors, and for covers holds the record and the covers of patches no kernel describes).
 KERNEL_TWINS = [{"core/couple.py", "core/kernels/couples.py"},
                 {"core/covers.py", "core/kernels/cover.py"},
                 {"core/seeking.py", "core/kernels/seek.py"}]

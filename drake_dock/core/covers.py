@@ -1,6 +1,8 @@
 """Bounding-sphere and slab covers of patches (Definition 1) and where two covers can touch
 along a straight relative translation: a lower bound on the distance of two patches that needs
-no seek.
+no seek. This module holds the covers' record (`Cover`), their cell layout and the covers of
+patches no kernel describes (`patch_cover`); the compiled `drake_dock.core.kernels.cover` makes
+the others' and computes the gaps and the touched steps below.
 
 A cover splits the parameter box into n cells per parameter. Cell c, centre u_c and half-widths
 h, is enclosed by the sphere about r(u_c) of radius
@@ -30,8 +32,8 @@ n_c . e = 0), intersected with the spheres'. Where a curve passes close to a sur
 side of it (a ring just inside a petal's cone), the slab is far thinner than the sphere.
 
 At a fixed pose the least of |c1 - c2| - (rho1 + rho2) over the sphere pairs is a lower bound of
-the distance of the two patches (`cover_gap`): every point of a patch lies in a sphere of its
-cover.
+the distance of the two patches (`drake_dock.core.kernels.cover.cover_gap`): every point of a
+patch lies in a sphere of its cover.
 """
 from __future__ import annotations
 
@@ -124,82 +126,3 @@ def patch_cover(patch, n: int, block: int) -> Cover:
         hit = cache[(n, block)] = Cover.from_cells(patch.position(U), cell_radii(patch, U, half),
                                                    blocks, *slabs)
     return hit
-
-
-def cover_gap(a: Cover, b: Cover) -> float:
-    """The least |c_a - c_b| - (rho_a + rho_b) over the cell sphere pairs of the posed covers a
-    and b: a lower bound of the distance of their patches (negative where spheres overlap)."""
-    d = np.linalg.norm(a.centres[:, None, :] - b.centres[None, :, :], axis=-1)
-    return float((d - a.radii[:, None] - b.radii[None, :]).min())
-
-
-def _intervals(w, r, e):
-    """Per sphere pair (rows of w = c1(0) - c2, summed radii r): the interval of lam where
-    |w - lam e| <= r, as (lo, hi, ok); ok False where there is none."""
-    ee = e @ e
-    b = w @ e
-    D = b * b - ee * (np.einsum("...k,...k->...", w, w) - r * r)
-    ok = D >= 0.0
-    s = np.sqrt(np.where(ok, D, 0.0))
-    return (b - s) / ee, (b + s) / ee, ok
-
-
-def _slab_intervals(w, r, n, flat, e):
-    """Per cell pair (rows of w = c1(0) - c2, the other cell's radius r, a slab's normal n and
-    half-thickness flat): the interval of lam where |n . (w - lam e)| <= r + flat, as
-    (lo, hi); (-inf, inf) for no slab (flat inf) and an empty one (inf, -inf) for none."""
-    nw = np.einsum("...k,...k->...", n, w)
-    ne = n @ e
-    t = r + flat
-    with np.errstate(divide="ignore", invalid="ignore"):
-        a, b = (nw - t) / ne, (nw + t) / ne
-    lo, hi = np.minimum(a, b), np.maximum(a, b)
-    flat_e = ne == 0.0
-    lo = np.where(flat_e, np.where(np.abs(nw) <= t, -np.inf, np.inf), lo)
-    hi = np.where(flat_e, np.where(np.abs(nw) <= t, np.inf, -np.inf), hi)
-    free = np.isinf(flat)
-    return np.where(free, -np.inf, lo), np.where(free, np.inf, hi)
-
-
-def touch_set(moving: Cover, fixed: Cover, e, lam_lo, lam_hi, slack=1e-9):
-    """(lo, hi) arrays: intervals of lam in [lam_lo, lam_hi] outside whose union the patches of
-    the two posed covers are apart, ``moving`` translated by -lam e. Blocks first, then the cells
-    of the block pairs that can touch in the range, each cell pair's sphere interval cut by the
-    cells' slabs; each interval widened by ``slack``."""
-    e = np.asarray(e, dtype=float)
-    w = moving.block_centres[:, None, :] - fixed.block_centres[None, :, :]
-    lo, hi, ok = _intervals(w, moving.block_radii[:, None] + fixed.block_radii[None, :], e)
-    I, J = np.nonzero(ok & (lo <= lam_hi + slack) & (hi >= lam_lo - slack))
-    ci, cj = np.broadcast_arrays(moving.blocks[I][:, :, None], fixed.blocks[J][:, None, :])
-    ci, cj = ci.ravel(), cj.ravel()
-    w = moving.centres[ci] - fixed.centres[cj]
-    lo, hi, ok = _intervals(w, moving.radii[ci] + fixed.radii[cj], e)
-    for n, flat, r in ((fixed.normals[cj], fixed.flat[cj], moving.radii[ci]),
-                       (moving.normals[ci], moving.flat[ci], fixed.radii[cj])):
-        slo, shi = _slab_intervals(w, r, n, flat, e)
-        lo, hi = np.maximum(lo, slo), np.minimum(hi, shi)
-    ok &= lo <= hi + 2 * slack
-    lo, hi = lo[ok] - slack, hi[ok] + slack
-    keep = (lo <= lam_hi) & (hi >= lam_lo)
-    return lo[keep], hi[keep]
-
-
-def touched_steps(lo, hi, grid):
-    """Booleans (K,): step k of the decreasing travel grid (from grid[k] to grid[k + 1], K + 1
-    points) meets one of the intervals [lo, hi]."""
-    K = len(grid) - 1
-    neg = -np.asarray(grid, dtype=float)
-    first = np.maximum(np.searchsorted(neg, -hi, "left") - 1, 0)
-    last = np.minimum(np.searchsorted(neg, -lo, "right") - 1, K - 1)
-    ok = first <= last
-    marks = np.zeros(K + 1, dtype=int)
-    np.add.at(marks, first[ok], 1)
-    np.add.at(marks, last[ok] + 1, -1)
-    return np.cumsum(marks[:K]) > 0
-
-
-def touch_steps(moving: Cover, fixed: Cover, e, grid, slack=1e-9):
-    """Booleans (K,): the steps of the decreasing travel grid (K + 1 points) in which the posed
-    covers can touch, ``moving`` translated by -lam e (`touch_set`, `touched_steps`)."""
-    lo, hi = touch_set(moving, fixed, e, grid[-1], grid[0], slack)
-    return touched_steps(lo, hi, grid)

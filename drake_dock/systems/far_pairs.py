@@ -64,7 +64,7 @@ class FarPairs:
 
     def cover_gap(self, i, poses, below=-math.inf):
         """The least gap of pair i's covers at ``poses``, patch 1 placed in frame 2: a lower
-        bound of the pair's distance (`drake_dock.core.covers.cover_gap`); with ``below``, a
+        bound of the pair's distance (`drake_dock.core.kernels.cover.cover_gap`); with ``below``, a
         gap below it as soon as one is found."""
         c1, c2 = self.covers(i)
         return compiled_cover.cover_gap(c1.posed(*self.reference(i, poses)), c2, below)

@@ -1,11 +1,11 @@
 """The bounding-sphere covers (`drake_dock.core.covers`, compiled in
 `drake_dock.core.kernels.cover`): every sampled point of a cell lies in its sphere and its slab,
-every cell in its block's sphere; the compiled covers and touched steps equal the reference
-(a patch no kernel describes, a point, has the reference's cover);
-without slabs the touched steps equal a brute force over every sphere pair and step (the exact
-least distance of a sphere pair over a step), with them they lie between that and the steps
-where the pointwise bound (spheres and slabs) reaches 0 at sampled travels; and the covers'
-distance bound lies below the seek's distance."""
+every cell in its block's sphere; the compiled covers equal those of the Python patches (which
+cover a patch no kernel describes, a point); without slabs the touched steps equal a brute
+force over every sphere pair and step (the exact least distance of a sphere pair over a step),
+with them they lie among those and include the steps where the pointwise bound (spheres and
+slabs) reaches 0 at sampled travels; the least gap is the least sphere-pair gap; and the
+covers' distance bound lies below the seek's distance."""
 import dataclasses
 import math
 
@@ -61,7 +61,7 @@ def test_a_patch_without_kernel_description_has_the_reference_cover():
 
 def _posed_covers(pr, approach):
     R, p0 = approach.pose(0.0)
-    c1, c2 = (covers.patch_cover(p, *COVER_CELLS[p.dim]) for p in (pr.patch1, pr.patch2))
+    c1, c2 = (compiled.patch_cover(p, *COVER_CELLS[p.dim]) for p in (pr.patch1, pr.patch2))
     moving, fixed = (c1, c2) if pr.body1 == CHASER_APDS else (c2, c1)
     return moving.posed(R, p0), fixed, -(approach.pose(1.0)[1] - p0)
 
@@ -70,19 +70,38 @@ APPROACHES = [Approach(math.radians(5.0)),
               Approach(0.05, (0.04, -0.03), (0.06, 0.02), (0.3, -0.2, -0.932737905308882))]
 
 
+def _spheres_only(cover):
+    return dataclasses.replace(cover, flat=np.full_like(cover.flat, np.inf))
+
+
+def _brute_force_steps(moving, fixed, e, grid):
+    """The steps of the decreasing grid in which some sphere pair of the posed covers touches:
+    its least distance over the step is |w - lam* e| - r at the clamped projection lam* of
+    w = c1 - c2 on e (the block spheres left out: every cell pair)."""
+    w = (moving.centres[:, None, :] - fixed.centres[None, :, :]).reshape(-1, 3)
+    r = (moving.radii[:, None] + fixed.radii[None, :]).ravel()
+    out = np.zeros(len(grid) - 1, dtype=bool)
+    for k in range(len(grid) - 1):
+        lam = np.clip((w @ e) / (e @ e), grid[k + 1], grid[k])
+        out[k] = (np.linalg.norm(w - lam[:, None] * e, axis=-1) - r <= 1e-9).any()
+    return out
+
+
 @pytest.mark.parametrize("approach", APPROACHES)
-def test_compiled_touch_steps_equal_the_reference(approach):
+def test_touch_steps_of_every_pair_lie_within_its_spheres_brute_force(approach):
+    """The touched steps of every pair of the paper's set (`pair_touch_steps`, the search's):
+    with the spheres only they are the brute force's (`_brute_force_steps`), and the slabs
+    only take steps away."""
     g = ApdsGeometry()
     pairs = DockingScene(g, "paper").pairs
     grid = np.array(travel_grid(g, approach))
     got = pair_touch_steps(pairs, approach, grid)
     for j, pr in enumerate(pairs):
-        np.testing.assert_array_equal(got[j], covers.touch_steps(*_posed_covers(pr, approach),
-                                                                 grid), pr.name)
-
-
-def _spheres_only(cover):
-    return dataclasses.replace(cover, flat=np.full_like(cover.flat, np.inf))
+        moving, fixed, e = _posed_covers(pr, approach)
+        brute = _brute_force_steps(moving, fixed, e, grid)
+        spheres = compiled.touch_steps(_spheres_only(moving), _spheres_only(fixed), e, grid)
+        np.testing.assert_array_equal(spheres, brute, pr.name)
+        assert not (got[j] & ~brute).any(), pr.name
 
 
 def _least_bound(moving, fixed, shift):
@@ -109,14 +128,10 @@ def test_touch_steps_equal_a_brute_force(name):
     pr = next(p for p in DockingScene(g, "paper").pairs if p.name == name)
     moving, fixed, e = _posed_covers(pr, approach)
     grid = np.array(travel_grid(g, approach))
-    w = (moving.centres[:, None, :] - fixed.centres[None, :, :]).reshape(-1, 3)
-    r = (moving.radii[:, None] + fixed.radii[None, :]).ravel()
-    lam = np.clip((w @ e) / (e @ e), grid[1:, None], grid[:-1, None])   # (steps, pairs)
-    least = np.linalg.norm(w[None] - lam[..., None] * e, axis=-1) - r
-    brute = (least <= 1e-9).any(axis=1)
-    spheres = covers.touch_steps(_spheres_only(moving), _spheres_only(fixed), e, grid)
+    brute = _brute_force_steps(moving, fixed, e, grid)
+    spheres = compiled.touch_steps(_spheres_only(moving), _spheres_only(fixed), e, grid)
     np.testing.assert_array_equal(spheres, brute)
-    got = covers.touch_steps(moving, fixed, e, grid)
+    got = compiled.touch_steps(moving, fixed, e, grid)
     assert not (got & ~spheres).any()
     for k in np.flatnonzero(spheres & ~got):
         for lam in np.linspace(grid[k + 1], grid[k], 17):
@@ -149,10 +164,11 @@ def test_bound_lies_below_the_seek_distance():
                 assert bound > 0.0, (pr.name, lam)
 
 
-def test_cover_gap_compiled_equals_reference_and_lies_below_the_seek():
-    """`cover_gap` (block-pruned, compiled) equals the reference over every sphere pair to
-    1e-12 (given a threshold, a cell gap below it where the least gap is), and lies below the
-    seek's distance, for the complete set's pairs at random
+def test_cover_gap_is_the_least_sphere_gap_and_lies_below_the_seek():
+    """`cover_gap` (block-pruned, compiled) equals the least |c1 - c2| - (rho1 + rho2) over
+    every cell sphere pair (numpy, here) to 1e-12 (given a threshold, a cell gap below it where
+    the least gap is), and lies below the seek's distance, for the complete set's pairs at
+    random
     relative poses of the two APDS (tilt up to 10 deg, offset up to 0.15 m, ring distance -0.2
     to 0.5 m)."""
     from drake_dock.docking.geometry.pairs import R_MATCHED
@@ -167,7 +183,9 @@ def test_cover_gap_compiled_equals_reference_and_lies_below_the_seek():
         for pr in pairs[trial::6]:
             c1, c2 = (compiled.patch_cover(p, *COVER_CELLS[p.dim]) for p in (pr.patch1, pr.patch2))
             a, b = c1.posed(*X[pr.body1]), c2.posed(*X[pr.body2])
-            got, ref = compiled.cover_gap(a, b), covers.cover_gap(a, b)
+            got = compiled.cover_gap(a, b)
+            ref = (np.linalg.norm(a.centres[:, None] - b.centres[None], axis=-1)
+                   - a.radii[:, None] - b.radii[None]).min()
             assert got == pytest.approx(ref, rel=0, abs=1e-12), pr.name
             # With a threshold: a gap below it when the least gap is, else the least gap.
             for below in (ref - 0.01, ref + 1e-6, ref + 0.05):

@@ -1,6 +1,7 @@
-"""The covers of `drake_dock.core.covers` compiled: the cell spheres and slabs from the
-patches' jets (`jets.jet`) and the steps of a travel grid in which two covers can touch, with
-the same bounds (tests compare them with the reference)."""
+"""The covers of `drake_dock.core.covers` (its docstring states the bounds) compiled: the cell
+spheres and slabs from the patches' jets (`jets.jet`), the least gap of two posed covers and
+the steps of a travel grid in which two covers can touch (tests/core/test_covers.py checks them
+against sampled points of the patches, a brute force over every sphere pair and the seek)."""
 from __future__ import annotations
 
 import math
@@ -47,7 +48,9 @@ def cell_spheres(kind, prm, U, half):
 
 @njit(cache=True)
 def _interval(c1, c2, r, e, ee):
-    """`covers._intervals` for one sphere pair: (lo, hi, ok)."""
+    """The interval of lam where the sphere pair (centres c1, c2, summed radii r) touches,
+    |w - lam e| <= r with w = c1 - c2 and ee = e . e, as (lo, hi, ok); ok False where there is
+    none."""
     w0, w1, w2 = c1[0] - c2[0], c1[1] - c2[1], c1[2] - c2[2]
     b = w0 * e[0] + w1 * e[1] + w2 * e[2]
     D = b * b - ee * (w0 * w0 + w1 * w1 + w2 * w2 - r * r)
@@ -59,7 +62,8 @@ def _interval(c1, c2, r, e, ee):
 
 @njit(cache=True)
 def _slab(n, w0, w1, w2, t, e, lo, hi):
-    """[lo, hi] cut by the lam where |n . (w - lam e)| <= t (`covers._slab_intervals`)."""
+    """[lo, hi] cut by the lam where |n . (w - lam e)| <= t (the slab of normal n and
+    half-thickness t less the other cell's radius); an empty interval (inf, -inf) for none."""
     nw = n[0] * w0 + n[1] * w1 + n[2] * w2
     ne = n[0] * e[0] + n[1] * e[1] + n[2] * e[2]
     if ne == 0.0:
@@ -70,8 +74,11 @@ def _slab(n, w0, w1, w2, t, e, lo, hi):
 
 @njit(cache=True)
 def touched_steps(moving, fixed, e, grid, slack):
-    """`covers.touched_steps` of `covers.touch_set`: the steps of the decreasing grid in which
-    the `CoverCells` ``moving``, translated by -lam e, can touch the `CoverCells` ``fixed``."""
+    """The steps of the decreasing grid in which the `CoverCells` ``moving``, translated by
+    -lam e, can touch the `CoverCells` ``fixed``: blocks first, then the cells of the block
+    pairs that can touch in the grid's range, each cell pair's sphere interval cut by the
+    cells' slabs and widened by ``slack``; a step is touched where one of the intervals meets
+    it."""
     mc, mr, mn, mflat, mbc, mbr, mblocks = moving
     fc, fr, fn, fflat, fbc, fbr, fblocks = fixed
     K = grid.shape[0] - 1
@@ -147,7 +154,8 @@ def _sphere_gap(c1, r1, c2, r2):
 
 @njit(cache=True)
 def least_gap(a, b, below):
-    """`covers.cover_gap` of the `CoverCells` a and b: the block pairs in increasing order of
+    """The least |c_a - c_b| - (rho_a + rho_b) over the cell sphere pairs of the posed
+    `CoverCells` a and b, a lower bound of their patches' distance: the block pairs in increasing order of
     their spheres' gap, each one's cells only while that gap is below the least cell gap found
     (a block's sphere holds its cells' spheres). Stops at the first cell gap below ``below``,
     returning it (a gap known to be below that is all a screen needs); -inf for the least gap
@@ -175,13 +183,13 @@ def least_gap(a, b, below):
 
 
 def cover_gap(a, b, below: float = -np.inf) -> float:
-    """`drake_dock.core.covers.cover_gap` compiled (`least_gap`); with ``below``, any gap of
+    """The least gap of the posed covers a and b (`least_gap`); with ``below``, any gap of
     two cells below it once one is found (the least gap when it is not below)."""
     return float(least_gap(cells_of(a), cells_of(b), float(below)))
 
 
 def patch_cover(patch, n: int, block: int):
-    """`drake_dock.core.covers.patch_cover` from the compiled jets, or the reference's own for
+    """`drake_dock.core.covers.patch_cover` from the compiled jets, or that Python one for
     a patch no kernel describes (a `Point`, say); kept on the patch."""
     cache = patch.__dict__.setdefault("_compiled_covers", {})
     hit = cache.get((n, block))

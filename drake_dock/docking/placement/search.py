@@ -177,7 +177,7 @@ def pair_covers(pr: PairSpec):
 
 def pair_touch_steps(pairs, approach: Approach, grid):
     """Booleans (pairs, steps): the covers of pair j's patches can touch between grid[k] and
-    grid[k + 1] (`drake_dock.core.covers.touch_steps`); elsewhere the pair is apart."""
+    grid[k + 1] (`drake_dock.core.kernels.cover.touch_steps`); elsewhere the pair is apart."""
     return _TouchSteps(pairs, approach, grid).chunk(0, len(grid) - 1)
 
 
