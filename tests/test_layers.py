@@ -155,7 +155,7 @@ def _stem(name: str) -> str:
 
 
 # A compiled kernel and its Python interface (which packs the patches and poses, raises the
-# typed errors, and for covers holds the record and the covers of patches no kernel describes).
+# typed errors, and for covers holds the record and builds a cover from a patch's Python jets).
 KERNEL_TWINS = [{"core/couple.py", "core/kernels/couples.py"},
                 {"core/covers.py", "core/kernels/cover.py"},
                 {"core/seeking.py", "core/kernels/seek.py"}]

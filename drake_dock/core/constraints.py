@@ -42,7 +42,7 @@ a fixed point s = a_t/|a_t| (``SLIDE_START_ITER`` iterations at most), accepted 
 starting couple's a_t lies along its s; where it does not, a scan of one couple's direction
 (accepting a bisected root with a_t . s > 0) or a grid and Newton's method for two (accepting
 a root with a_t along s, or a_t below 1e-6 of the acceleration scale); three or more couples
-whose fixed point does not converge have no start of sliding
+whose fixed point leaves an a_t off its s have no start of sliding
 (`drake_dock.core.kernels.slide_start`).
 
 Two couples sticking between the same two bodies are fixed up to a squeeze, chosen to keep

@@ -1,8 +1,9 @@
 """Bounding-sphere and slab covers of patches (Definition 1) and where two covers can touch
 along a straight relative translation: a lower bound on the distance of two patches that needs
-no seek. This module holds the covers' record (`Cover`), their cell layout and the covers of
-patches no kernel describes (`patch_cover`); the compiled `drake_dock.core.kernels.cover` makes
-the others' and computes the gaps and the touched steps below.
+no seek. This module holds the covers' record (`Cover`), their cell layout and `patch_cover`,
+which builds any patch's cover from its Python jets (the kernels use it for patches they do
+not describe); the compiled `drake_dock.core.kernels.cover` builds the others' and computes the
+gaps and the touched steps below.
 
 A cover splits the parameter box into n cells per parameter. Cell c, centre u_c and half-widths
 h, is enclosed by the sphere about r(u_c) of radius

@@ -55,7 +55,7 @@ def test_cells_enclose_the_patch(patch):
 
 
 
-def test_a_patch_without_kernel_description_has_the_reference_cover():
+def test_a_patch_without_kernel_description_has_the_python_cover():
     point = Point((0.1, 0.2, 0.3), 0.01)
     assert compiled.patch_cover(point, 1, 1) is covers.patch_cover(point, 1, 1)
 
@@ -90,8 +90,9 @@ def _brute_force_steps(moving, fixed, e, grid):
 @pytest.mark.parametrize("approach", APPROACHES)
 def test_touch_steps_of_every_pair_lie_within_its_spheres_brute_force(approach):
     """The touched steps of every pair of the paper's set (`pair_touch_steps`, the search's):
-    with the spheres only they are the brute force's (`_brute_force_steps`), and the slabs
-    only take steps away."""
+    with the spheres only they are the brute force's (`_brute_force_steps`); the slabs only
+    take steps away, each where the pointwise bound of spheres and slabs is positive at both
+    ends and the middle of the step."""
     g = ApdsGeometry()
     pairs = DockingScene(g, "paper").pairs
     grid = np.array(travel_grid(g, approach))
@@ -102,6 +103,9 @@ def test_touch_steps_of_every_pair_lie_within_its_spheres_brute_force(approach):
         spheres = compiled.touch_steps(_spheres_only(moving), _spheres_only(fixed), e, grid)
         np.testing.assert_array_equal(spheres, brute, pr.name)
         assert not (got[j] & ~brute).any(), pr.name
+        for k in np.flatnonzero(brute & ~got[j]):
+            for lam in (grid[k + 1], 0.5 * (grid[k] + grid[k + 1]), grid[k]):
+                assert _least_bound(moving, fixed, -lam * e) > 0.0, (pr.name, k, lam)
 
 
 def _least_bound(moving, fixed, shift):

@@ -202,8 +202,8 @@ def test_a_start_of_sliding_whose_fixed_point_does_not_converge_lies_along_a_t(
     sol = select_contact_modes(Minv, a0, rows, v_slip=d["v_slip"], omega=d["omega"],
                                avoid=[tuple(a) for a in d["avoid"]])
     assert sol.modes == (SLIDE, SLIDE) and (sol.lam_n > 0).all()
-    s = sol.dirs[1]
-    assert abs(slip_angle(s, sol.at[1])) < 1e-9 and sol.at[1] @ s > 0
+    s, at = sol.dirs[1], rows[1].Wt.T @ sol.vdot + rows[1].bt
+    assert abs(slip_angle(s, at)) < 1e-9 and at @ s > 0
     th = np.linspace(-math.pi, math.pi, 3601)
     res = []
     for t in th:
@@ -340,7 +340,10 @@ def phi(t):
         return 0.3 + (2.0 * math.pi - 0.6) * (t - a_lo) / (a_hi - a_lo)
     return 2.0 * math.pi - 0.3
 
+tried = []
+
 def made_up(P, modes, dirs, i, t, omega, out):
+    tried.append(t)
     dirs[i, 0], dirs[i, 1] = math.cos(t), math.sin(t)
     out.at[i, 0], out.at[i, 1] = math.cos(t + phi(t)), math.sin(t + phi(t))
     return S.OK, S._slip_angle(dirs, out.at, i)
@@ -352,10 +355,13 @@ first = S._nearest_bracket(np.array(th), np.array(rs), 0.0, True)
 second = S._nearest_bracket(np.array(th), np.array(rs), 0.0, False)
 print(first, second)
 S._slip_residual = made_up
+del tried[:]
 dirs = np.array([[1.0, 0.0]])
 out = S.Outputs(None, np.zeros(1), np.zeros((1, 2)))
 st, found = S._slide_start_scan(None, None, dirs, 0, 0.0, out)
-print(st == S.OK, found, *out.at[0], b_lo + (b_hi - b_lo) * 1.8 / 2.1)
+inside = [t for t in tried if b_lo < t < b_hi or a_lo < t < a_hi]
+print(st == S.OK, found, *out.at[0], b_lo + (b_hi - b_lo) * 1.8 / 2.1,
+      a_lo < inside[0] < a_hi, any(b_lo < t < b_hi for t in inside))
 """
 
 
@@ -373,8 +379,9 @@ def test_a_bracket_whose_bisection_ends_on_the_half_turn_gives_way_to_the_next()
     out = subprocess.run([sys.executable, "-c", SCAN_WITH_MADE_UP_ACCELERATION], env=env,
                          capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr
-    first, second, ok, found, a0, a1, t_root = out.stdout.split()
+    first, second, ok, found, a0, a1, t_root, fortieth_first, then_37th = out.stdout.split()
     assert (first, second) == ("40", "37")
+    assert fortieth_first == then_37th == "True"      # bisected in that order
     assert ok == "True" and found == "True"
     assert [float(a0), float(a1)] == pytest.approx([math.cos(float(t_root)),
                                                     math.sin(float(t_root))], abs=1e-9)

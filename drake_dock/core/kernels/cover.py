@@ -62,8 +62,8 @@ def _interval(c1, c2, r, e, ee):
 
 @njit(cache=True)
 def _slab(n, w0, w1, w2, t, e, lo, hi):
-    """[lo, hi] cut by the lam where |n . (w - lam e)| <= t (the slab of normal n and
-    half-thickness t less the other cell's radius); an empty interval (inf, -inf) for none."""
+    """[lo, hi] cut by the lam where |n . (w - lam e)| <= t, t the half-thickness of the slab
+    of normal n plus the other cell's radius; an empty interval (inf, -inf) for none."""
     nw = n[0] * w0 + n[1] * w1 + n[2] * w2
     ne = n[0] * e[0] + n[1] * e[1] + n[2] * e[2]
     if ne == 0.0:
@@ -155,11 +155,11 @@ def _sphere_gap(c1, r1, c2, r2):
 @njit(cache=True)
 def least_gap(a, b, below):
     """The least |c_a - c_b| - (rho_a + rho_b) over the cell sphere pairs of the posed
-    `CoverCells` a and b, a lower bound of their patches' distance: the block pairs in increasing order of
-    their spheres' gap, each one's cells only while that gap is below the least cell gap found
-    (a block's sphere holds its cells' spheres). Stops at the first cell gap below ``below``,
-    returning it (a gap known to be below that is all a screen needs); -inf for the least gap
-    itself."""
+    `CoverCells` a and b, a lower bound of their patches' distance: the block pairs in
+    increasing order of their spheres' gap, each one's cells only while that gap is below the
+    least cell gap found (a block's sphere holds its cells' spheres). Stops at the first cell
+    gap below ``below``, returning it (a gap known to be below that is all a screen needs); -inf
+    for the least gap itself."""
     ac, ar, _an, _aflat, abc, abr, ablocks = a
     bc, br, _bn, _bflat, bbc, bbr, bblocks = b
     m, k = abc.shape[0], bbc.shape[0]

@@ -16,7 +16,7 @@ from drake_dock.core.kernels.solve import (OK, SLIDE_START_ITER, Solution, accel
                                            solve_modes)
 
 #: a_t lies along s where its component across s is below this fraction of |a_t| (the fixed
-#: point's and the grid's root test)
+#: point's test, and the grid's at a root where a_t is not below 1e-6 of the acceleration scale)
 ALONG_RTOL = 1e-9
 
 
@@ -49,8 +49,8 @@ def slide_start(P, modes, dirs, starting, omega, out):
     directions found). The fixed point s = a_t/|a_t| runs until it converges or for
     `SLIDE_START_ITER` iterations (none found where a starting couple's a_t is exactly 0);
     its directions are found when every starting couple's a_t then lies along its s (a
-    positive component along it, and across it below `ALONG_RTOL` of |a_t|: a fixed point
-    that converged). Otherwise one starting couple's direction is scanned
+    positive component along it, and across it below `ALONG_RTOL` of |a_t|). Otherwise one
+    starting couple's direction is scanned
     (`_slide_start_scan`: found at a bisected root with a_t.s > 0), two couples' by the grid
     and Newton's method (`_slide_start_grid`: found at a root with a_t along s, or a_t below
     1e-6 of the acceleration scale), and three or more are not found."""
