@@ -22,9 +22,12 @@ Drake's integrator, the witnesses, the step control and the recording), then the
 evaluation, the ratio of (1) to (3) (the cost per evaluation that compiled stepping would
 leave, taken at the costliest state, so the run's average state costs less), and the share
 of (1) that the kernel itself takes over the run's states; and the sample's projected wall
-time with compiled stepping: the run's seeking and impacts as measured (the contact system's
-`timing`), everything else replaced by the run's evaluations at the cost of (3). No target:
-the floor of a design not built.
+time with compiled stepping, twice: the run's seeking and impacts as measured (the contact
+system's `timing`), everything else replaced by the run's evaluations at the cost of (3);
+and the run's event handling as measured (every event's transitions, `_on_event`, and every
+step start's seeks of far pairs, `reseek_far`, with the evaluations they make), the other
+evaluations at the cost of (3), which is what compiled stepping with Python at the events
+would leave. No target: the floor of a design not built.
 
     python bench/stepping_floor.py [--sample 6] [--seconds 0.1] [--repeats 3]
 """
@@ -114,6 +117,37 @@ def dormand_prince(mp, sp, x0, tau, size, xd, sc, t_end, h_max, accuracy, coeffs
     return evals, accepted, rejected, capped, t, flagged
 
 
+class EventTime:
+    """The wall time and the evaluations computed inside the contact system's event handlers
+    (`RigidContactSystem._on_event` and `reseek_far`) while ``with``: both are wrapped for
+    the block (before the Diagram is built: the system registers its handlers then)."""
+
+    def __enter__(self):
+        from drake_dock.systems import contact_system as cs
+        self.seconds, self.evaluations, self._cs = 0.0, 0, cs
+        self._saved = cs.RigidContactSystem._on_event, cs.reseek_far
+
+        def timed(f, engine_of):
+            def run(*args, **kw):
+                engine = engine_of(args)
+                t0, n0 = time.perf_counter(), engine.evaluations
+                try:
+                    return f(*args, **kw)
+                finally:
+                    self.seconds += time.perf_counter() - t0
+                    self.evaluations += engine.evaluations - n0
+            return run
+        cs.RigidContactSystem._on_event = timed(self._saved[0], lambda a: a[0].engine)
+        cs.reseek_far = timed(self._saved[1], lambda a: a[0].eng)
+        return self
+
+    def __exit__(self, *exc):
+        self._cs.RigidContactSystem._on_event, self._cs.reseek_far = self._saved
+
+    def reset(self):
+        self.seconds, self.evaluations = 0.0, 0
+
+
 def _kernel_loop(mp, sp, x, tau, buf, n):
     for _ in range(n):
         evaluate(mp, sp, x, tau, buf)
@@ -145,9 +179,15 @@ def main():
     plan, base, fields = load_plan(PLAN)
     (spec,) = sample_specs(plan, fields, [args.sample])
     scenario = sample_scenario(base, spec[2])
+    events = EventTime().__enter__()
     dd = build_docking_diagram(DiagramSpec.of(scenario))
     state = place(scenario, PlacementCache(dd.scene))
-    runs = [simulate(scenario, state, dd=dd) for _ in range(args.repeats)]
+    runs, in_events = [], []
+    for _ in range(args.repeats):
+        events.reset()
+        runs.append(simulate(scenario, state, dd=dd))
+        in_events.append((events.seconds, events.evaluations))
+    events.__exit__()
     run = runs[0]
     per_run = statistics.median(r.wall_time / r.evaluations for r in runs)
     wall = statistics.median(r.wall_time for r in runs)
@@ -208,6 +248,14 @@ def main():
               f"seeking and impacts as they are, {kept:.3f} s, and each of its evaluations at "
               f"the compiled loop's cost; medians over the runs), {wall / projected:.1f}x less "
               f"than the run")
+        handled = statistics.median(s_ for s_, _ in in_events)
+        with_events = statistics.median(s_ + (r.evaluations - n_) * per_loop
+                                        for (s_, n_), r in zip(in_events, runs))
+        print(f"projected wall with compiled stepping and the events in Python as they are: "
+              f"{with_events:.3f} s (the event handling, {handled:.3f} s with the "
+              f"{statistics.median(n_ for _, n_ in in_events):.0f} evaluations it makes, and "
+              f"the other evaluations at the compiled loop's cost), {wall / with_events:.1f}x "
+              f"less than the run")
 
 
 if __name__ == "__main__":
