@@ -220,18 +220,20 @@ def test_non_finite_equations_raise_a_typed_error():
     assert err.value.time == 0.125 and "c0" in err.value.couples
 
 
-@pytest.mark.parametrize("scene", ["plane", "general"])
+@pytest.mark.parametrize("scene", ["plane", "general", "at rest"])
 def test_select_contact_modes_returns_a_consistent_choice(scene):
     """The choice of mode selection on random scenes: contacts on a plane in the lift-off
-    window (test_constraints.random_scene), and general scenes with couples at rest, with and
-    without modes to avoid. Each choice holds its modes' equations and inequalities, and no
-    choice without a start of sliding that is consistent to 1e-10 of the scales (tighter than
-    the selection's 1e-9) is preferred to it; where the selection finds none consistent
-    (`PainleveInconsistency`, with the time), none of those is."""
+    window (test_constraints.random_scene), general scenes with couples at rest, and general
+    scenes with every couple at rest (among them choices with three or more couples starting to
+    slide at once), with and without modes to avoid. Each choice holds its modes' equations and
+    inequalities, and no choice without a start of sliding that is consistent to 1e-10 of the
+    scales (tighter than the selection's 1e-9) is preferred to it; where the selection finds
+    none consistent (`PainleveInconsistency`, with the time), none of those is."""
     rng = np.random.default_rng(20)
     kinds = set()
     for n in range(150):
-        M, a0, rows = random_scene(rng) if scene == "plane" else general_scene(rng)
+        M, a0, rows = (random_scene(rng) if scene == "plane" else
+                       general_scene(rng, slow=1.0 if scene == "at rest" else 0.5))
         Minv = np.linalg.inv(M)
         avoid = None
         if n % 2:
@@ -252,12 +254,16 @@ def test_select_contact_modes_returns_a_consistent_choice(scene):
         check_equations(Minv, a0, rows, sol, OMEGA, tol=1e-8)
         assert consistent(a0, rows, sol, OMEGA, TIE_RTOL)
         check_starts(rows, sol)
+        starts = sum(m == SLIDE and not np.hypot(*r.vt) > 1e-6 for r, m in zip(rows, sol.modes))
+        kinds.add(f"{min(starts, 3)} starting")
         assert all(key(sol, rows, avoid) <= key(o, rows, avoid) for o in others)
         kinds.update(sol.modes)
     # The scenes reach every mode (and, on general scenes, the Painleve paradox).
     assert {SLIDE, DETACH} <= kinds
-    if scene == "general":
-        assert {STICK, "PainleveInconsistency"} <= kinds
+    if scene != "plane":
+        assert {STICK, "PainleveInconsistency", "1 starting", "2 starting"} <= kinds
+    if scene == "at rest":
+        assert "3 starting" in kinds            # three or more couples starting at once
 
 
 def rod_critical_mu(theta):
