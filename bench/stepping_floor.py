@@ -179,15 +179,14 @@ def main():
     plan, base, fields = load_plan(PLAN)
     (spec,) = sample_specs(plan, fields, [args.sample])
     scenario = sample_scenario(base, spec[2])
-    events = EventTime().__enter__()
-    dd = build_docking_diagram(DiagramSpec.of(scenario))
-    state = place(scenario, PlacementCache(dd.scene))
     runs, in_events = [], []
-    for _ in range(args.repeats):
-        events.reset()
-        runs.append(simulate(scenario, state, dd=dd))
-        in_events.append((events.seconds, events.evaluations))
-    events.__exit__()
+    with EventTime() as events:
+        dd = build_docking_diagram(DiagramSpec.of(scenario))
+        state = place(scenario, PlacementCache(dd.scene))
+        for _ in range(args.repeats):
+            events.reset()
+            runs.append(simulate(scenario, state, dd=dd))
+            in_events.append((events.seconds, events.evaluations))
     run = runs[0]
     per_run = statistics.median(r.wall_time / r.evaluations for r in runs)
     wall = statistics.median(r.wall_time for r in runs)

@@ -62,7 +62,7 @@ import math
 import numpy as np
 
 from drake_dock.core.kernels import couples as K
-from drake_dock.core.kernels.frames import Frame
+from drake_dock.core.kernels.frames import frame
 from drake_dock.core.kernels.jets import jet, patch_spec
 from drake_dock.core.relations import relation
 from drake_dock.errors import SingularCoupleError
@@ -163,12 +163,10 @@ def evaluate_couple(kind, patch1, X1, V1, patch2, X2, V2, u_state, sigma, *,
     pair, k1, q1, p, k2, q2 = _pair(kind, patch1, patch2)
     m = patch1.dim + patch2.dim
     u = _padded(u_state, m)
-    R1, o1, R2, o2 = _rotation(X1[0]), _vec(X1[1]), _rotation(X2[0]), _vec(X2[1])
-    w1, v1, w2, v2 = _vec(V1[0]), _vec(V1[1]), _vec(V2[0]), _vec(V2[1])
+    f1, f2 = frame(X1[0], X1[1], *V1), frame(X2[0], X2[1], *V2)
     out = np.zeros(K.ROW)
     project = np.bool_(project)
     sigma = float(sigma)
-    f1, f2 = Frame(R1, o1, w1, v1), Frame(R2, o2, w2, v2)
     if pair == K.PC:
         K.evaluate_pc_one(k2, q2, p, patch1.radius, f1, f2, u[0], sigma, project, out)
         if math.isnan(out[K.GAP]):

@@ -15,7 +15,7 @@ import pytest
 from drake_dock.core.kernels.bushing import (GIMBAL_LOCK, GIMBAL_LOCK_COS_PITCH, NONFINITE, OK,
                                              bushing_coordinates, bushing_wrenches,
                                              half_rotation, roll_pitch_yaw)
-from drake_dock.core.kernels.frames import Frame
+from drake_dock.core.kernels.frames import frame
 
 RNG = np.random.default_rng(5)
 K_T = np.array([105.0, 120.0, 938.0])      # distinct per axis, to catch a permutation
@@ -38,22 +38,15 @@ def _random_rotation():
     return _rot(RNG.normal(size=3), RNG.uniform(0, math.pi))
 
 
-def _frame(R, p, w=(0.0, 0.0, 0.0), v=(0.0, 0.0, 0.0)):
-    """The kernels' `Frame` of a pose (R, p) and a twist (w, v)."""
-    def vec(a):
-        return tuple(float(x) for x in a)
-    return Frame(np.ascontiguousarray(R, dtype=float), vec(p), vec(w), vec(v))
-
-
 def _call(R_WA, p_WA, w_WA, v_WA, R_WC, p_WC, w_WC, v_WC, k_t=K_T, d_t=D_T, k_f=K_F, d_f=D_F):
     out = np.zeros((4, 6))
-    status = bushing_wrenches(_frame(R_WA, p_WA, w_WA, v_WA), _frame(R_WC, p_WC, w_WC, v_WC),
+    status = bushing_wrenches(frame(R_WA, p_WA, w_WA, v_WA), frame(R_WC, p_WC, w_WC, v_WC),
                               np.array([k_t, d_t, k_f, d_f], dtype=float), out)
     return status, out
 
 
 def _coordinates(R_WA, p_WA, R_WC, p_WC, xyz, rpy):
-    return bushing_coordinates(_frame(R_WA, p_WA), _frame(R_WC, p_WC), xyz, rpy)
+    return bushing_coordinates(frame(R_WA, p_WA), frame(R_WC, p_WC), xyz, rpy)
 
 
 def _random_frames(tilt=math.radians(40), stroke=0.2):

@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from drake_dock.core.constraints import DETACH, SLIDE, TIE_RTOL, ContactRow, stabilised_gddot
+from drake_dock.core.constraints import (DETACH, SLIDE, STICK, TIE_RTOL, ContactRow,
+                                         ContactSolution, stabilised_gddot)
 from drake_dock.core.kernels import constraints as compiled
 from drake_dock.errors import PainleveError
 
@@ -51,23 +52,53 @@ def tip_A(theta, l, mass, mu, s):
     return (1.0 + 3.0 * c * (c + mu * s * sn)) / mass
 
 
-def modes_by_enumeration(M, a0, rows, omega, rtol=1e-9):
-    """Every consistent choice of {slide, detach} for couples that all slide, each solved from
-    the Newton-Euler equations and the constraint rows together (a KKT system in M, not the
-    select_contact_modes' Schur complement): [(modes, vdot, lam_n)]."""
+def choices_by_kkt(M, a0, rows, omega, v_slip=1e-6):
+    """Every choice of modes without a start of sliding (stick or detach for a couple at rest,
+    slide against its velocity or detach for a moving one), each solved from the Newton-Euler
+    equations and the constraint rows together (a KKT system in M, not the mode selection's
+    Schur complement): a `ContactSolution` per choice whose system is regular."""
     nv, out = len(a0), []
-    for modes in itertools.product((SLIDE, DETACH), repeat=len(rows)):
-        on = [r for r, m in zip(rows, modes) if m == SLIDE]
-        C = np.array([r.Wn - r.mu * r.Wt @ (r.vt / np.linalg.norm(r.vt))
-                      for r in on]).reshape(-1, nv)
-        D = np.array([r.Wn for r in on]).reshape(-1, nv)
-        k = len(on)
+    moving = [np.linalg.norm(r.vt) > v_slip for r in rows]
+    for modes in itertools.product(*[(SLIDE, DETACH) if mv else (STICK, DETACH)
+                                     for mv in moving]):
+        dirs = [r.vt / np.linalg.norm(r.vt) if m == SLIDE else None
+                for r, m in zip(rows, modes)]
+        C, D, rhs = [], [], []
+        for r, m, s in zip(rows, modes, dirs):
+            stab = -(r.bn + 2 * omega * r.vn + omega ** 2 * r.gap)
+            if m == SLIDE:
+                C.append(r.Wn - r.mu * r.Wt @ s)
+                D.append(r.Wn)
+                rhs.append(stab)
+            elif m == STICK:
+                C += [r.Wn, r.Wt[:, 0], r.Wt[:, 1]]
+                D += [r.Wn, r.Wt[:, 0], r.Wt[:, 1]]
+                rhs += [stab, -r.bt[0], -r.bt[1]]
+        C, D = np.array(C).reshape(-1, nv), np.array(D).reshape(-1, nv)
+        k = len(rhs)
         K = np.block([[M, -C.T], [D, np.zeros((k, k))]])
-        rhs = np.concatenate([M @ a0, [-(r.bn + 2 * omega * r.vn + omega ** 2 * r.gap)
-                                       for r in on]])
-        x = np.linalg.solve(K, rhs)
+        try:
+            x = np.linalg.solve(K, np.concatenate([M @ a0, rhs]))
+        except np.linalg.LinAlgError:
+            continue
         vdot, lam = x[:nv], iter(x[nv:])
-        lam_n = np.array([next(lam) if m == SLIDE else 0.0 for m in modes])
+        lam_n, lam_t = np.zeros(len(rows)), np.zeros((len(rows), 2))
+        for i, (r, m, s) in enumerate(zip(rows, modes, dirs)):
+            if m == SLIDE:
+                lam_n[i] = next(lam)
+                lam_t[i] = -r.mu * lam_n[i] * s
+            elif m == STICK:
+                lam_n[i], lam_t[i] = next(lam), [next(lam), next(lam)]
+        out.append(ContactSolution(modes, dirs, vdot, lam_n, lam_t, C.T @ x[nv:], list(rows)))
+    return out
+
+
+def modes_by_enumeration(M, a0, rows, omega, rtol=1e-9):
+    """Every consistent choice of {slide, detach} for couples that all slide (`choices_by_kkt`):
+    [(modes, vdot, lam_n)]."""
+    out = []
+    for sol in choices_by_kkt(M, a0, rows, omega):
+        modes, vdot, lam_n = sol.modes, sol.vdot, sol.lam_n
         stab = np.array([r.Wn @ vdot + r.bn + 2 * omega * r.vn + omega ** 2 * r.gap
                          for r in rows])
         f_tol = rtol * (1.0 + np.abs(lam_n).max())

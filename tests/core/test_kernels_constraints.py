@@ -4,7 +4,6 @@ on random seeded scenes of one or two free bodies with sticking, sliding and det
 redundant sticking rows against the minimum-norm forces, inconsistent ones and non-finite ones
 against their typed errors, and Painleve's rod on both sides of its critical friction (closed
 form). tests/core/test_constraints.py and test_squeeze.py hold the closed-form scenes."""
-import itertools
 import math
 
 import numpy as np
@@ -15,7 +14,7 @@ from drake_dock.core.constraints import (DETACH, SLIDE, STICK, TIE_RTOL, Contact
 from drake_dock.core.kernels import constraints as KC
 from drake_dock.errors import (NumericalError, PainleveError, PainleveInconsistency,
                                SingularContactError)
-from test_constraints import G, OMEGA, random_scene, rod
+from test_constraints import G, OMEGA, choices_by_kkt, random_scene, rod
 
 
 def check_equations(Minv, a0, rows, sol, omega, tol=1e-9):
@@ -95,22 +94,6 @@ def key(sol, rows, avoid) -> tuple:
     avoid = avoid or [()] * len(rows)
     return (sum(m in a for m, a in zip(sol.modes, avoid)), -sol.modes.count(STICK),
             sol.modes.count(DETACH))
-
-
-def enumerated(Minv, a0, rows, omega, v_slip=1e-6):
-    """Every choice without a start of sliding (stick or detach for a couple at rest, slide
-    against its velocity or detach for a moving one), solved by `solve_given_modes` (checked
-    on its own by `check_equations`); the singular ones left out."""
-    moving = [np.hypot(*r.vt) > v_slip for r in rows]
-    out = []
-    for modes in itertools.product(*[(SLIDE, DETACH) if mv else (STICK, DETACH)
-                                     for mv in moving]):
-        dirs = [r.vt / np.hypot(*r.vt) if m == SLIDE else None for r, m in zip(rows, modes)]
-        try:
-            out.append(KC.solve_given_modes(Minv, a0, rows, modes, dirs, omega=omega))
-        except NumericalError:
-            pass
-    return out
 
 
 def general_scene(rng, *, slow=0.5):
@@ -227,7 +210,8 @@ def test_select_contact_modes_returns_a_consistent_choice(scene):
     scenes with every couple at rest (among them choices with three or more couples starting to
     slide at once), with and without modes to avoid. Each choice holds its modes' equations and
     inequalities, and no choice without a start of sliding that is consistent to 1e-10 of the
-    scales (tighter than the selection's 1e-9) is preferred to it; where the selection finds
+    scales (tighter than the selection's 1e-9), solved by its KKT system
+    (`test_constraints.choices_by_kkt`), is preferred to it; where the selection finds
     none consistent (`PainleveInconsistency`, with the time), none of those is."""
     rng = np.random.default_rng(20)
     kinds = set()
@@ -239,8 +223,8 @@ def test_select_contact_modes_returns_a_consistent_choice(scene):
         if n % 2:
             avoid = [tuple(m for m in (STICK, SLIDE, DETACH) if rng.random() < 0.3)
                      for _ in rows]
-        others = [o for o in enumerated(Minv, a0, rows, OMEGA) if consistent(a0, rows, o, OMEGA,
-                                                                              1e-10)]
+        others = [o for o in choices_by_kkt(M, a0, rows, OMEGA)
+                  if consistent(a0, rows, o, OMEGA, 1e-10)]
         try:
             sol = KC.select_contact_modes(Minv, a0, rows, omega=OMEGA, time=0.5, avoid=avoid)
         except PainleveInconsistency as err:

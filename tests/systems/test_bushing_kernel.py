@@ -24,7 +24,7 @@ from pydrake.multibody.math import SpatialVelocity
 from pydrake.multibody.tree import MultibodyForces
 
 from drake_dock.core.kernels.bushing import GIMBAL_LOCK, OK, bushing_wrenches
-from drake_dock.core.kernels.frames import Frame
+from drake_dock.core.kernels.frames import frame
 from drake_dock.docking.model.plant import PlantSpec, StewartDamperPower, make_docking_plant
 
 RNG = np.random.default_rng(2024)
@@ -63,9 +63,9 @@ def _set_state(dp, ctx, R_AC=None, tilt=math.radians(40.0), stroke=0.2):
     return plant.GetPositions(ctx), plant.GetVelocities(ctx)
 
 
-def _frame(frame, ctx):
-    X = frame.CalcPoseInWorld(ctx)
-    V = frame.CalcSpatialVelocityInWorld(ctx)
+def _frame(drake_frame, ctx):
+    X = drake_frame.CalcPoseInWorld(ctx)
+    V = drake_frame.CalcSpatialVelocityInWorld(ctx)
     return [np.ascontiguousarray(X.rotation().matrix()), np.array(X.translation()),
             np.array(V.rotational()), np.array(V.translational())]
 
@@ -81,14 +81,8 @@ def _kernel(dp, ctx):
     A = _frame(dp.bushing.frameA(), ctx)
     C = _frame(dp.bushing.frameC(), ctx)
     out = np.full((4, 6), -1.0)
-    status = bushing_wrenches(_record(A), _record(C), np.array(_constants(dp.bushing)), out)
+    status = bushing_wrenches(frame(*A), frame(*C), np.array(_constants(dp.bushing)), out)
     return (status, *out, A, C)
-
-
-def _record(frame):
-    """The kernel's `Frame` of [R, p, w, v]."""
-    R, p, w, v = frame
-    return Frame(R, tuple(p.tolist()), tuple(w.tolist()), tuple(v.tolist()))
 
 
 def _in_world(F, R):

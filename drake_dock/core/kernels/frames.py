@@ -20,6 +20,15 @@ class Frame(NamedTuple):
     v: tuple
 
 
+def frame(R, o, w=(0.0, 0.0, 0.0), v=(0.0, 0.0, 0.0)) -> Frame:
+    """The `Frame` of a pose (R, o) and a twist (w, v) given as any arrays, in the types the
+    kernels are compiled for: R C-contiguous float64, the vectors 3-tuples of floats (from
+    Python; `frame_of` builds them in compiled code)."""
+    def vec(a):
+        return float(a[0]), float(a[1]), float(a[2])
+    return Frame(np.ascontiguousarray(R, dtype=float), vec(o), vec(w), vec(v))
+
+
 @njit(cache=True)
 def frame_of(a, R, o, w, vf):
     """Frame a's `Frame` from the frames' stacked poses and twists: R (F, 3, 3), o, w, vf
