@@ -3,16 +3,10 @@
 For each chain case, prints the error of v_plus against the continuous limit of the chain
 (`drake_dock.core.lzb.limit`, integrated in time by scipy's DOP853 at rtol 1e-12) and the
 wall time (best of several runs, side by side in this run) of
-- `solve_lzb` (adaptive 8th order, located events) at several rtol, and
+- `solve_lzb` (the compiled Dormand-Prince 5(4), located events) at several rtol, and
 - `solve_lzb_fixed_step` (the same equations, explicit Euler in fixed impulse steps dP, phase
   changes at step ends: first order in dP, like Siconos's MultipleImpact).
 Then a column over the restitution e for each law, so that a low-e regression shows at once.
-Then the compiled LZB (`solve_lzb(..., compiled=True)`, `drake_dock.core.kernels.lzb`) beside
-the reference in this run: per chain size its error against the continuous limit and
-`compiled LZB speed-up: <N>x` at rtol 1e-10; and (without --quick) for the paper example's
-impacts (their inputs recorded from a run of models/paper_example.yaml), and the paper example
-run with `ContactOptions.lzb_compiled` on and off: both capture times and the whole-run wall
-time ratio.
 
 Run: .venv/bin/python bench/lzb_chains.py [--quick]
 """
@@ -23,7 +17,7 @@ import numpy as np
 
 from drake_dock.core.lzb.inputs import check_inputs, per_couple
 from drake_dock.core.lzb.limit import continuous_limit_chain
-from drake_dock.core.lzb.problem import ImpactProblem
+from drake_dock.core.kernels import lzb_forces, lzb_phases as LP, lzb_records as LR
 from drake_dock.core.lzb.solve import solve_lzb
 
 E_GRID = (0.0, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 0.9, 1.0)
@@ -53,28 +47,31 @@ def solve_lzb_fixed_step(M, Wn, v_minus, stiffness, eta, restitution, *, dP, law
     if np.any(u0 > 0):
         raise ValueError("v_minus: a couple is already separating")
     zeros = np.zeros(s)
-    prob = ImpactProblem(np.pad(G, ((0, 2 * s), (0, 2 * s))), np.concatenate([u0, np.zeros(2 * s)]),
-                    K, eta_, e, zeros, zeros, law, zeros, False)
-    y = prob.y0.copy()
-    events = []
-    g_old = prob.event_values(y)
+    imp = LR.ImpactConstants(s, s, np.ascontiguousarray(G), K, eta_, e, zeros, zeros, False,
+                             LR.LAW_NAMES.index(law), 1e-10, 1e-10, 1e-12, 0, 1.0)
+    ph = LR.new_phases(s)
+    y = np.zeros(4 * s + 2 * s)
+    y[s:2 * s] = u0
+    dy, lam, g_old, g_new = np.empty_like(y), np.empty(s), np.empty((3, s)), np.empty((3, s))
+    log = LR.EventLog(np.empty(16), np.empty(16, np.int64), np.empty(16, np.int64), np.int64(0))
+    LP.event_values(y, g_old, imp, ph, lam)
     j0 = int(np.argmin(u0))
     # First step from zero energy (Eq. 33-34): the time in which the fastest couple's impulse
     # reaches dP, x = |u| t, P = K |u|^eta t^(eta+1) / (eta+1).
     t_step = (dP * (eta_[j0] + 1) / (K[j0] * abs(u0[j0]) ** eta_[j0])) ** (1 / (eta_[j0] + 1))
     for _ in range(50_000_000):
-        if prob.finished(y) and _ > 0:
+        if LP.finished(y, imp, ph) and _ > 0:
             break
-        y = y + t_step * prob.rhs(0.0, y)
-        g_new = prob.event_values(y)
+        lzb_forces.rhs(y, dy, imp, ph, lam)
+        y = y + t_step * dy
+        LP.event_values(y, g_new, imp, ph, lam)
         for kind, j in zip(*np.nonzero((g_old > 0) & (g_new <= 0))):
-            prob.apply_event(y, kind, j, events, 0.0)
-        g_old = prob.event_values(y)
-        lam = K * np.maximum(y[prob.layout.x], 0.0) ** eta_
-        if lam.max() > 0:
-            t_step = dP / lam.max()
-    P = y[prob.layout.P]
-    return v + MinvW @ P
+            log = LP.apply_event(y, int(kind), int(j), 0.0, imp, ph, log, lam)
+        LP.event_values(y, g_old, imp, ph, lam)
+        lam_n = K * np.maximum(y[:s], 0.0) ** eta_
+        if lam_n.max() > 0:
+            t_step = dP / lam_n.max()
+    return v + MinvW @ y[2 * s:3 * s]
 
 
 def best_time(f, repeat):
@@ -110,82 +107,6 @@ def restitution_column(quick):
             print(f"{name:24s} {law:6s} " + " ".join(f"{c:>15s}" for c in cells))
 
 
-def compiled_chains(quick):
-    """The compiled LZB beside the reference on chains of 3 to 9 balls (Hertz, e = 1 and 0.5,
-    rtol 1e-10): the error of each against the continuous limit and the speed-up."""
-    print("\ncompiled LZB (Dormand-Prince 5(4) in numba) beside the reference (scipy's DOP853), "
-          "rtol 1e-10")
-    print(f"{'chain':24s} {'ref error':>10s} {'compiled error':>15s} {'ref [ms]':>9s} "
-          f"{'compiled [ms]':>14s}")
-    for n in (3, 5) if quick else (3, 5, 7, 9):
-        for e in (1.0, 0.5):
-            M, Wn = chain(n)
-            K = np.full(n - 1, 1e8)
-            v0 = np.zeros(n)
-            v0[0] = 1.0
-            ref = continuous_limit_chain(np.ones(n), v0, K, 1.5, e, "paper")
-            solve_lzb(M, Wn, v0, K, 1.5, e, rtol=1e-10, compiled=True)     # compiled or loaded
-            t_r, r = best_time(lambda: solve_lzb(M, Wn, v0, K, 1.5, e, rtol=1e-10), 3)
-            t_c, c = best_time(lambda: solve_lzb(M, Wn, v0, K, 1.5, e, rtol=1e-10,
-                                                 compiled=True), 5)
-            name = f"{n} balls, Hertz, e = {e:g}"
-            print(f"{name:24s} {np.abs(r.v_plus - ref).max():10.2e} "
-                  f"{np.abs(c.v_plus - ref).max():15.2e} {t_r * 1e3:9.2f} {t_c * 1e3:14.3f}")
-            print(f"{name}: compiled LZB speed-up: {t_r / t_c:.0f}x")
-
-
-def paper_example_impacts():
-    """The paper example's impacts (recorded from a run) solved by both, and the example run
-    with the compiled LZB on and off."""
-    import dataclasses
-    from drake_dock.docking.model.diagram import DiagramSpec, build_docking_diagram
-    from drake_dock.docking.model.simulate import simulate
-    from drake_dock.docking.placement.place import place
-    from drake_dock.docking.scenario.loading import load_scenario
-    from drake_dock.docking.scenario.models_dir import PAPER_EXAMPLE
-    from drake_dock.systems import transitions
-    scenario = load_scenario(PAPER_EXAMPLE)
-    state = place(scenario)
-    calls = []
-
-    def recorder(*args, **kw):
-        calls.append((args, kw))
-        return solve_lzb(*args, **kw)
-    transitions.solve_lzb = recorder
-    try:
-        dd = build_docking_diagram(DiagramSpec.of(scenario))
-        simulate(scenario, state=state, dd=dd)
-    finally:
-        transitions.solve_lzb = solve_lzb
-    t_r = t_c = dv = 0.0
-    for args, kw in calls:
-        kw = dict(kw, compiled=False)
-        solve_lzb(*args, **dict(kw, compiled=True))
-        t1, r = best_time(lambda: solve_lzb(*args, **kw), 3)
-        t2, c = best_time(lambda: solve_lzb(*args, **dict(kw, compiled=True)), 3)
-        t_r, t_c = t_r + t1, t_c + t2
-        dv = max(dv, np.abs(r.v_plus - c.v_plus).max() / np.abs(r.v_plus).max())
-    print(f"\npaper example: {len(calls)} impacts, reference {t_r * 1e3:.1f} ms, compiled "
-          f"{t_c * 1e3:.2f} ms in all; largest relative difference of v+ {dv:.1e}")
-    print(f"paper example's impacts: compiled LZB speed-up: {t_r / t_c:.0f}x")
-    runs = {}
-    for on in (False, True):
-        opts = dataclasses.replace(dd.contact.options, lzb_compiled=on)
-        simulate(scenario, state, dd=build_docking_diagram(DiagramSpec.of(scenario, options=opts)))
-        walls = []
-        for _ in range(3):
-            d = build_docking_diagram(DiagramSpec.of(scenario, options=opts))
-            t0 = time.perf_counter()
-            res = simulate(scenario, state=state, dd=d)
-            walls.append(time.perf_counter() - t0)
-        runs[on] = (res, float(np.median(walls)))
-    (off, w_off), (on, w_on) = runs[False], runs[True]
-    print(f"paper example capture time: lzb_compiled off {off.capture_time!r} s, on "
-          f"{on.capture_time!r} s (difference {abs(on.capture_time - off.capture_time):.1e} s)")
-    print(f"paper example whole run (median of 3): off {w_off:.3f} s, on {w_on:.3f} s; "
-          f"wall ratio off/on {w_off / w_on:.2f}x")
-
-
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="fewer points (CI)")
@@ -216,9 +137,6 @@ def main():
             err = np.abs(v - ref).max()
             print(f"{name:28s} {'fixed dP=%.0e' % dP:24s} {err:10.2e} {t * 1e3:10.2f}")
     restitution_column(args.quick)
-    compiled_chains(args.quick)
-    if not args.quick:
-        paper_example_impacts()
     if target:
         rtol, err, t = target
         print(f"\ntarget (1e-9 on the 3-ball Hertz chain in under 20 ms): rtol={rtol:.0e} gives "

@@ -8,9 +8,7 @@ alternating with them), the real-time factor (simulated s per wall s), the deriv
 evaluations and the share of them spent isolating witness events (steps of more than 50
 evaluations), and the ratio of the two runs, all measured in this run; and the same example with
 Drake's plain witness isolation (`simulate(..., witness_approach=False)`), for the ratio of the
-step shortening; and with a coarser step cap (``--coarse-step``) for its cost; and with the
-impacts by the reference LZB (scipy's DOP853, `ContactOptions.lzb_compiled` off), with the
-difference of the capture times; and with one witness function per transition instead of the
+step shortening; and with a coarser step cap (``--coarse-step``) for its cost; and with one witness function per transition instead of the
 joint one (`ContactOptions.joint_witness` off; median of as many runs); and, per evaluation,
 drake_dock's time against the plant's own and an empty Python LeafSystem's. Also the set-up (the initial state: the first-contact
 placement, its seeks, and their number; and that of another approach of the same geometry) and
@@ -113,9 +111,6 @@ def main():
     wall = float(np.median(walls))
     t_free, n_free = float(np.median([f[0] for f in frees])), frees[0][1]
     t_leaf = empty_leaf_cost(scenario.simulator_config.integration_scheme)
-    reference_lzb = dataclasses.replace(dd.contact.options, lzb_compiled=False)
-    py = simulate(scenario, state, dd=build_docking_diagram(
-        DiagramSpec.of(scenario, options=reference_lzb)))
     # One witness function per transition instead of the joint one, alternating as above.
     each_options = dataclasses.replace(dd.contact.options, joint_witness=False)
     each = [simulate(scenario, state, dd=build_docking_diagram(
@@ -171,11 +166,6 @@ def main():
           f"evaluations; capture {each[0].capture_time!r} s vs {r.capture_time!r} s "
           f"(difference {abs(each[0].capture_time - r.capture_time):.1e} s); ratio "
           f"{wall_each / wall:.2f}x")
-    print(f"with the impacts by the reference LZB (scipy's DOP853) instead of the compiled "
-          f"one: {py.wall_time:.3f} s, "
-          f"{py.evaluations} evaluations; capture {py.capture_time!r} s vs "
-          f"{r.capture_time!r} s (difference {abs(py.capture_time - r.capture_time):.1e} s); "
-          f"ratio {py.wall_time / wall:.2f}x")
     print(f"same plant without contact (Drake alone): {t_free:.4f} s (median of {len(frees)} "
           "runs, each beside one of drake_dock's: " + ", ".join(f"{f[0]:.4f}" for f in frees)
           + ")")

@@ -89,9 +89,6 @@ class ContactOptions:
     painleve: str = "impact"         # no consistent mode (`PainleveInconsistency`): "impact",
                                      # an impact without collision (`drake_dock.core.iwc`), or
                                      # "error", stop with it
-    lzb_compiled: bool = True        # LZB impacts by the compiled kernel (`solve_lzb`'s
-                                     # compiled; False: scipy's DOP853, the reference;
-                                     # docs/performance.md, "The compiled LZB")
     joint_witness: bool = True       # Drake is given one witness, the least of the armed
                                      # ones positive after an event, beside each of the others
                                      # (False: one witness function per transition;

@@ -95,8 +95,8 @@ class EventImpulses:
 
     def lzb_impact(self, kin, evs, S, v):
         """The LZB impact of the couples S (their couples in evs, the bodies' `Kinematics`
-        kin; `admit`), solved by `solve_lzb` (compiled, then by the reference where the
-        compiled driver's steps stall); returns (v+, the couples' v_n+, the approach speed)."""
+        kin; `admit`), solved by `solve_lzb`; returns (v+, the couples' v_n+, the approach
+        speed)."""
         ev, t = self.ev, self.t
         opt, law = ev.options, ev.law
         names = [ev.pairs[i].name for i in S]
@@ -107,19 +107,9 @@ class EventImpulses:
         M = ev.engine.mass_matrix(kin)
         approach = float(-min(r.vn for r in rows))
         e = hybrid.zeno_restitution(approach, law.restitution, opt.zeno_speed)
-        def solve(compiled):
-            return solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt, mu=law.mu,
-                             mu_s=law.static_mu, law=law.impact_law, rtol=opt.impact_rtol,
-                             compiled=compiled)
         try:
-            try:
-                res = solve(opt.lzb_compiled)
-            except NumericalError:
-                if not opt.lzb_compiled:
-                    raise
-                # The compiled driver's steps can stall where the reference's DOP853 steps over
-                # (two couples that stick and slip in turn): the impact is solved again by it.
-                res = solve(False)
+            res = solve_lzb(M, Wn, v, law.stiffness, law.eta, e, Wt=Wt, mu=law.mu,
+                            mu_s=law.static_mu, law=law.impact_law, rtol=opt.impact_rtol)
         except NumericalError as err:
             if os.environ.get("DRAKE_DOCK_DUMP_LZB"):
                 np.savez(os.environ["DRAKE_DOCK_DUMP_LZB"], M=M, Wn=Wn, Wt=Wt, v=v, e=e)

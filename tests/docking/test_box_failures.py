@@ -50,8 +50,8 @@ def test_two_centimetres_off_the_axis_jams_at_the_lips(tmp_path):
 
 def test_five_centimetres_off_at_twice_the_speed_jams_at_the_lips(tmp_path):
     """A scenario file holding only the approach, 5 cm off at 0.2 m/s: the impact of the two
-    tips on the lips is solved (the compiled LZB stalled on it; the reference solves it) and
-    the run jams there."""
+    tips on the lips is solved (two couples that start to slide from rest together, one of
+    them just outside its static cone) and the run jams there."""
     _held_at_the_lips(_run(tmp_path, {"initial": {"lateral_offset": [0.05, 0.0],
                                                    "chaser_speed": 0.2}}, "offset_5cm"))
 

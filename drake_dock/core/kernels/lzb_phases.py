@@ -1,145 +1,33 @@
-"""The phases of a compiled LZB impact (`drake_dock.core.kernels.lzb`) over plain arrays: the
-right-hand side, the event functions, the end test and the events the kernel applies, as
-`drake_dock.core.lzb.problem.ImpactProblem` has them for states with no couple stuck or
-locked; the restitution laws of `drake_dock.core.lzb.laws` by code.
-
-The functions take the impact's constants as an `ImpactConstants`, the couples' phase arrays
-(which the events change in place) as a `Phases` and the event log as an `EventLog`: typed
-records (NamedTuples) that numba passes as structures of arrays and scalars. Each function
-reads the fields it uses at its top: a record still in use further down holds a reference to
-each of its arrays, taken and released on every call."""
+"""The phases of a compiled LZB impact (`drake_dock.core.kernels.lzb`) over the records of
+`drake_dock.core.kernels.lzb_records`: the event functions, the end test and every phase event
+(maximal compression with the restitution law, end of expansion, separation, re-compression,
+re-loading, lock and release at e = 0; the friction events and stick-slip decisions of
+`drake_dock.core.kernels.lzb_friction`). The rules are stated in `drake_dock.core.lzb.solve`'s
+docstring. A couple is *held* when it is locked or stuck (`drake_dock.core.kernels.lzb_forces`);
+its event functions then need the force rates.
+"""
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from drake_dock.core.kernels.copies import copy1
 
-# Phases (`drake_dock.core.lzb.state`) and event rows (`drake_dock.core.lzb.problem`).
-COMPRESSION, EXPANSION, LOCKED = 0, 1, 2
-NORMAL, FRICTION, APPROACH = 0, 1, 2
-# Event kinds logged by the kernel, as codes into KINDS.
-KINDS = ("max_compression", "recompression", "end", "re_impact")
-MAXC, RECOMP, END, REIMPACT = 0, 1, 2, 3
-# Restitution laws, as codes into LAW_NAMES.
-LAW_NAMES = ("paper", "mono", "bi")
-_V_TINY = 1e-12       # `ImpactProblem.v_tiny`
+from drake_dock.core.kernels.lzb_forces import forces, probe_loads
+from drake_dock.core.kernels.lzb_friction import on_friction_event, select_friction_modes
+from drake_dock.core.kernels.lzb_records import (APPROACH, COMPRESSION, END, EXPANSION,
+                                                 FRICTION, LOCK, LOCKED, MAXC, NORMAL, RECOMP,
+                                                 REIMPACT, RELEASE, any_held, any_locked,
+                                                 log_event, set_phase, stored_energy,
+                                                 unloading)
 
 
-# The records -------------------------------------------------------------------------------
-class ImpactConstants(NamedTuple):
-    """The constants of one impact (`ImpactProblem`'s, nondimensional): s couples and nu force
-    components (s, or 3 s with friction); the Delassus matrix G (nu, nu) in contact space; per
-    couple the stiffness kappa and exponent eta of Eq. (28), the energetic restitution e of
-    Eq. (36) and the sliding friction mu of Eq. (27); ``friction``; ``law``, a code into
-    LAW_NAMES; ``settle``, the relative velocity below which the impact has ended and the
-    sliding speed at which a couple has come to rest; the integration's rtol, atol and step
-    budget; ``imp_scale`` (m_s v_s), the impulses' unit."""
-    s: int
-    nu: int
-    G: np.ndarray
-    kappa: np.ndarray
-    eta: np.ndarray
-    e: np.ndarray
-    mu: np.ndarray
-    friction: bool
-    law: int
-    settle: float
-    rtol: float
-    atol: float
-    max_steps: int
-    imp_scale: float
-
-
-class Phases(NamedTuple):
-    """The couples' phase arrays (`ImpactProblem`'s of the same names), changed in place by
-    the events: the phase, ``sep`` (unloaded and separating), ``rate`` (dx/dtau = -rate u_n),
-    ``x_end`` (the indentation at which expansion ends), ``slip_dir`` (s, 2), the compression
-    work ``wc`` summed over episodes, ``e_start`` (the stored energy when the current
-    compression began) and ``wc_open`` (the compression work since the contact began)."""
-    phase: np.ndarray
-    sep: np.ndarray
-    rate: np.ndarray
-    x_end: np.ndarray
-    slip_dir: np.ndarray
-    wc: np.ndarray
-    e_start: np.ndarray
-    wc_open: np.ndarray
-
-
-class EventLog(NamedTuple):
-    """The events applied, as `ImpactEvent`: the first n entries of the total normal impulse,
-    the kind (a code into KINDS) and the couple; n an int64."""
-    impulse: np.ndarray
-    kind: np.ndarray
-    couple: np.ndarray
-    n: int
-
-
-# The problem -------------------------------------------------------------------------------
+# Event functions ---------------------------------------------------------------------------
 @njit(cache=True)
-def stored_energy(kappa, eta, x):
-    """Eq. (28) integrated (`laws.stored_energy`)."""
-    return kappa * max(x, 0.0) ** (eta + 1.0) / (eta + 1.0)
-
-
-@njit(cache=True)
-def indentation(kappa, eta, E):
-    """The inverse of `stored_energy` (`laws.indentation`)."""
-    return ((eta + 1.0) * max(E, 0.0) / kappa) ** (1.0 / (eta + 1.0))
-
-
-@njit(cache=True)
-def rhs(y, out, imp, ph, lam):
-    """dy/dtau into ``out`` (`ImpactProblem.rhs` with `forces.sliding_rates`: no couple stuck
-    or locked): lambda_n = kappa max(x, 0)^eta (Eq. 28), lambda_t = -mu lambda_n d along the
-    slip direction d (Eq. 27), du = G lambda, dP = lambda, the works of Eq. (30-31); ``lam``
-    (nu) receives lambda."""
-    s, nu, G, kappa, eta, mu = imp.s, imp.nu, imp.G, imp.kappa, imp.eta, imp.mu
-    friction, phase, rate, slip_dir = imp.friction, ph.phase, ph.rate, ph.slip_dir
-    for j in range(s):
-        lam[j] = kappa[j] * max(y[j], 0.0) ** eta[j]
-    ox, ou, oP = 0, s, s + nu
-    ow = s + 2 * nu
-    for j in range(s):
-        un = y[ou + j]
-        dx = -rate[j] * un
-        if phase[j] == COMPRESSION and y[j] <= 0.0 and dx < 0.0:
-            dx = 0.0     # an unloaded couple indents only while it approaches
-        out[ox + j] = dx
-        power = lam[j] * un
-        cf = 0.0 if phase[j] == EXPANSION else 1.0
-        out[ow + j] = -power * cf
-        out[ow + s + j] = power * (cf - 1.0)
-        out[ow + 2 * s + j] = 0.0
-    if friction:
-        for j in range(s):
-            a, b = y[ou + s + 2 * j], y[ou + s + 2 * j + 1]
-            nt = math.sqrt(a * a + b * b)
-            if nt > _V_TINY:
-                d0, d1 = a / nt, b / nt
-            else:
-                d0, d1 = slip_dir[j, 0], slip_dir[j, 1]
-            ml = mu[j] * lam[j]
-            lam[s + 2 * j] = -ml * d0
-            lam[s + 2 * j + 1] = -ml * d1
-            out[ow + 2 * s + j] = ml * (d0 * a + d1 * b)
-    for i in range(nu):
-        acc = 0.0
-        for k in range(nu):
-            acc += G[i, k] * lam[k]
-        out[ou + i] = acc
-        out[oP + i] = lam[i]
-
-
-@njit(cache=True)
-def event_value(y, kind, j, imp, ph):
-    """Row ``kind`` of couple j of `ImpactProblem.event_values` (no couple stuck or locked; a
-    sliding couple's u_t along its slip direction down to ``imp.settle``, the speed of rest)."""
-    s, friction, v_rest = imp.s, imp.friction, imp.settle
-    phase, sep, x_end, slip_dir = ph.phase, ph.sep, ph.x_end, ph.slip_dir
+def normal_value(y, kind, j, imp, ph):
+    """Row NORMAL or APPROACH of couple j (`event_value`) but a locked couple's release (inf):
+    they need no forces, so a step's dense output is sampled with them."""
+    s, phase, sep, x_end = imp.s, ph.phase, ph.sep, ph.x_end
     x, un = y[j], y[s + j]
     if kind == NORMAL:
         if phase[j] == COMPRESSION and not sep[j]:
@@ -147,27 +35,67 @@ def event_value(y, kind, j, imp, ph):
         if phase[j] == EXPANSION:
             return x - x_end[j]
         return np.inf
-    if kind == APPROACH:
-        if phase[j] == EXPANSION or sep[j]:
-            return un
-        return np.inf
-    if friction and x > 0.0:
-        o = 2 * s + 2 * j
-        return y[o] * slip_dir[j, 0] + y[o + 1] * slip_dir[j, 1] - v_rest
+    if phase[j] == EXPANSION or sep[j]:
+        return un
     return np.inf
 
 
 @njit(cache=True)
-def event_values(y, g, imp, ph):
-    """Every row of every couple (`event_value`) into g (3, s)."""
-    for kind in range(3):
-        for j in range(imp.s):
-            g[kind, j] = event_value(y, kind, j, imp, ph)
+def event_value(y, kind, j, imp, ph, lam):
+    """Couple j's function of row ``kind`` whose crossing from > 0 to <= 0 is a phase event:
+    NORMAL, maximal compression (-u_n), the end of expansion (x - x_end) or a locked couple's
+    release (its lambda_n); FRICTION, a loaded sliding couple's u_t along its slip direction
+    down to ``settle``, the speed of rest (it came to rest, or turned), or a stuck loaded
+    couple's force at its static cone (mu_s lambda_n - |lambda_t|); APPROACH, re-compression
+    in expansion or the re-loading of a separated couple (u_n). ``lam`` (nu): work space."""
+    if kind == APPROACH or (kind == NORMAL and ph.phase[j] != LOCKED):
+        return normal_value(y, kind, j, imp, ph)
+    if kind == FRICTION and not imp.friction:
+        return np.inf
+    held = any_held(ph)
+    if held:
+        forces(y, imp, ph, lam)
+    return _force_value(y, kind, j, imp, ph, lam, held)
+
+
+@njit(cache=True, inline='always')
+def _force_value(y, kind, j, imp, ph, lam, held):
+    """`event_value` of a FRICTION row, or a locked couple's NORMAL row, ``lam`` holding the
+    force rates at y where couples are ``held``."""
+    s, settle, mu_s, stuck, slip_dir = imp.s, imp.settle, imp.mu_s, ph.stuck, ph.slip_dir
+    o = 2 * s + 2 * j
+    if not held:
+        if y[j] > 0.0:      # a loaded couple slides
+            return y[o] * slip_dir[j, 0] + y[o + 1] * slip_dir[j, 1] - settle
+        return np.inf
+    if kind == NORMAL:
+        return lam[j]
+    if lam[j] <= 0.0:
+        return np.inf
+    if not stuck[j]:
+        return y[o] * slip_dir[j, 0] + y[o + 1] * slip_dir[j, 1] - settle
+    return mu_s[j] * lam[j] - math.sqrt(lam[s + 2 * j] ** 2 + lam[s + 2 * j + 1] ** 2)
+
+
+@njit(cache=True)
+def event_values(y, g, imp, ph, lam):
+    """Every row of every couple (`event_value`) into g (3, s), the forces solved once."""
+    s, friction, phase = imp.s, imp.friction, ph.phase
+    held = any_held(ph)
+    if held:
+        forces(y, imp, ph, lam)
+    for j in range(s):
+        g[NORMAL, j] = normal_value(y, NORMAL, j, imp, ph) if phase[j] != LOCKED else \
+            _force_value(y, NORMAL, j, imp, ph, lam, held)
+        g[APPROACH, j] = normal_value(y, APPROACH, j, imp, ph)
+        g[FRICTION, j] = _force_value(y, FRICTION, j, imp, ph, lam, held) if friction \
+            else np.inf
 
 
 @njit(cache=True)
 def classify(y, imp, ph):
-    """`ImpactProblem.classify`: True where a couple was marked separating."""
+    """Marks the unloaded couples in compression that separate (x = 0, u_n > 0 beyond
+    round-off), whose next event is their approach; True where one was marked."""
     s, phase, sep = imp.s, ph.phase, ph.sep
     changed = False
     for j in range(s):
@@ -179,11 +107,15 @@ def classify(y, imp, ph):
 
 @njit(cache=True)
 def finished(y, imp, ph):
-    """`ImpactProblem.finished` (no couple locked)."""
+    """Every couple unloaded and none approaching (a locked couple aside), or the bodies
+    settled: no couple approaches, nor could the stored energy move one, by more than
+    ``settle`` times the impact's velocity scale (u is scaled by the largest approach speed: a
+    residual approach of 1e-12 of it, the round-off left when symmetric couples end together,
+    does not start a new impact)."""
     s, kappa, eta, phase, settle = imp.s, imp.kappa, imp.eta, ph.phase, imp.settle
     done = True
     for j in range(s):
-        if y[j] > 0.0 or phase[j] == EXPANSION or y[s + j] < -1e-12:
+        if y[j] > 0.0 or phase[j] == EXPANSION or (y[s + j] < -1e-12 and phase[j] != LOCKED):
             done = False
     if done:
         return True
@@ -196,77 +128,104 @@ def finished(y, imp, ph):
     return stored <= 0.5 * settle * settle
 
 
-# Events ------------------------------------------------------------------------------------
-@njit(cache=True)
-def _log(log, impulse, kind, j):
-    """``log`` with the event (impulse, kind, j) appended, its arrays doubled when full."""
-    ev_imp, ev_kind, ev_couple, n = log
-    if n >= len(ev_kind):
-        m = 2 * len(ev_kind)
-        a, b, c = np.empty(m), np.empty(m, np.int64), np.empty(m, np.int64)
-        copy1(a[:n], ev_imp[:n])
-        copy1(b[:n], ev_kind[:n])
-        copy1(c[:n], ev_couple[:n])
-        ev_imp, ev_kind, ev_couple = a, b, c
-    ev_imp[n], ev_kind[n], ev_couple[n] = impulse, kind, j
-    return EventLog(ev_imp, ev_kind, ev_couple, n + 1)
+
+@njit(cache=True, inline='always')
+def _lock(y, j, impulse, imp, ph, log, lam):
+    """e = 0: the stored energy is lost and the couple is held at u_n = 0 by a constraint
+    force rate lambda_n >= 0 (the limit e -> 0 of every law, which otherwise re-impacts
+    without end); a couple whose constraint force would pull, or that nothing presses, is
+    released instead (`_released`)."""
+    y[j] = 0.0
+    ph.e_start[j] = ph.wc_open[j] = 0.0
+    set_phase(ph, j, LOCKED, 0.0)
+    log = _released(y, impulse, imp, ph, log, lam, j)
+    return log_event(log, impulse, LOCK if ph.phase[j] == LOCKED else END, j)
+
+
+@njit(cache=True, inline='always')
+def release_pulled(y, impulse, imp, ph, log, lam):
+    """After the events of an instant: a locked couple whose constraint force rate would pull,
+    or is zero (nothing presses it), is released and separates (`_released`); an event
+    elsewhere can change a locked couple's force rate at once, past the zero its release
+    event would find. Returns the log."""
+    return _released(y, impulse, imp, ph, log, lam, -1)
+
+
+@njit(cache=True, inline='always')
+def _released(y, impulse, imp, ph, log, lam, locking):
+    """The locked couples whose constraint force rate is not positive released, the one
+    pulled most first and the others tested again; each separates and is logged, but the
+    couple ``locking`` (-1 for none), whose lock is being decided. Returns the log."""
+    phase, sep = ph.phase, ph.sep
+    while any_locked(ph):
+        lam_n = probe_loads(y, imp, ph, lam)
+        k = -1
+        for i in range(imp.s):
+            if phase[i] == LOCKED and (k < 0 or lam_n[i] < lam_n[k]):
+                k = i
+        if lam_n[k] > 0.0:
+            break
+        set_phase(ph, k, COMPRESSION, 1.0)
+        if k != locking:
+            sep[k] = True
+            log = log_event(log, impulse, RELEASE, k)
+    return log
 
 
 @njit(cache=True)
-def apply_event(y, kind, j, impulse, imp, ph, log):
-    """`ImpactProblem.apply_event` for the events the kernel takes, the phases changed in
-    place: (True, the log with the event), or (False, the log) with nothing changed for one
-    that needs Python: a stick-slip decision or a lock. A sliding couple's friction event is a
-    rest (`friction.on_friction_event`) where |u_t| <= max(2 settle, 1e-9 of the largest
-    velocity), else a turn of its direction."""
-    s, nu, friction, kappa, eta, e = imp.s, imp.nu, imp.friction, imp.kappa, imp.eta, imp.e
-    law, v_rest = imp.law, imp.settle
-    phase, sep, rate, x_end, slip_dir = ph.phase, ph.sep, ph.rate, ph.x_end, ph.slip_dir
+def apply_event(y, kind, j, impulse, imp, ph, log, lam):
+    """Couple j's event function of row ``kind`` crossed zero at the state y: the phases
+    changed in place; returns the log with the events."""
+    s, friction, kappa, eta, e, law = imp.s, imp.friction, imp.kappa, imp.eta, imp.e, imp.law
+    phase, sep, x_end = ph.phase, ph.sep, ph.x_end
     wc, e_start, wc_open = ph.wc, ph.e_start, ph.wc_open
     if kind == FRICTION:
-        o = 2 * s + 2 * j
-        nt = math.sqrt(y[o] ** 2 + y[o + 1] ** 2)
-        scale = 0.0
-        for i in range(s, s + nu):
-            scale = max(scale, abs(y[i]))
-        if nt <= max(1e-9 * scale, 2.0 * v_rest):     # `friction.rest_speed`
-            return False, log           # came to rest: `select_impact_friction_modes`
-        slip_dir[j, 0], slip_dir[j, 1] = y[o] / nt, y[o + 1] / nt
-        return True, log
+        return on_friction_event(y, j, impulse, imp, ph, log, lam)
     if kind == APPROACH:
         if phase[j] == EXPANSION:
-            phase[j], rate[j] = COMPRESSION, 1.0
+            # Approaching again during expansion: compression resumes on the loading curve
+            # from the energy stored now.
+            set_phase(ph, j, COMPRESSION, 1.0)
             e_start[j] = stored_energy(kappa[j], eta[j], y[j])
-            return True, _log(log, impulse, RECOMP, j)
-        if friction:
-            return False, log           # a re-impact decides stick or slip
+            return log_event(log, impulse, RECOMP, j)
+        # A separated couple approaches again: it re-loads from zero indentation.
         sep[j] = False
         y[j] = 0.0
-        return True, _log(log, impulse, REIMPACT, j)
+        log = log_event(log, impulse, REIMPACT, j)
+        if friction:
+            js = np.zeros(s, np.bool_)
+            js[j] = True
+            log = select_friction_modes(y, js, impulse, imp, ph, log, lam,
+                                        np.zeros(s, np.bool_))
+        return log
     if phase[j] == COMPRESSION and y[j] > 0.0:
-        if e[j] == 0.0:
-            return False, log           # a lock
+        # Maximal compression: the work of this compression, W = E - E_start, enters W_c
+        # (Eq. 36) and the law sets the expansion.
         E = stored_energy(kappa[j], eta[j], y[j])
         work = E - e_start[j]
         wc[j] += work
         wc_open[j] += work
-        log = _log(log, impulse, MAXC, j)
-        r, xe = 1.0, 0.0
-        if law == 0:        # paper, Eq. (54)
-            y[j] = indentation(kappa[j], eta[j], E - (1.0 - e[j] * e[j]) * work)
-        elif law == 1:      # mono
-            xe = indentation(kappa[j], eta[j], (1.0 - e[j] * e[j]) * wc_open[j])
-        else:               # bi
-            r = 1.0 / (e[j] * e[j])
-        phase[j], rate[j], x_end[j] = EXPANSION, r, xe
-        return True, log
+        log = log_event(log, impulse, MAXC, j)
+        if e[j] == 0.0:
+            return _lock(y, j, impulse, imp, ph, log, lam)
+        x_start, x_end[j], r = unloading(law, kappa[j], eta[j], e[j], E, work, wc_open[j])
+        if not math.isnan(x_start):
+            y[j] = x_start
+        set_phase(ph, j, EXPANSION, r)
+        return log
     if phase[j] == COMPRESSION:
+        # u_n turned positive at zero indentation: the couple separates unloaded.
         sep[j] = True
-        return True, log
+        return log
     if phase[j] == LOCKED:
-        return False, log
+        # A locked couple's force rate reached zero: it is released and separates.
+        set_phase(ph, j, COMPRESSION, 1.0)
+        sep[j] = True
+        return log_event(log, impulse, RELEASE, j)
+    # The end of expansion (mono drops the remaining (1 - e^2) W_c here).
     y[j] = 0.0
-    phase[j], rate[j], x_end[j] = COMPRESSION, 1.0, 0.0
-    e_start[j] = 0.0
-    wc_open[j] = 0.0
-    return True, _log(log, impulse, END, j)
+    set_phase(ph, j, COMPRESSION, 1.0)
+    x_end[j] = 0.0
+    e_start[j] = wc_open[j] = 0.0
+    ph.stuck[j] = False
+    return log_event(log, impulse, END, j)

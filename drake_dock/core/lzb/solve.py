@@ -1,5 +1,6 @@
 """LZB multiple impacts with Coulomb friction and energetic restitution (Sect. 6, Eq. 26-36,
-53-54), for any multibody system at a fixed configuration. Plain numpy and scipy, no Drake.
+53-54), for any multibody system at a fixed configuration, without Drake: the problem checked
+and scaled here, integrated by the compiled kernel `drake_dock.core.kernels.lzb`.
 
 The model
 ---------
@@ -32,10 +33,9 @@ physical time, as the tests' reference.
 - Expansion, then either the end (x reaches x_end: the couple is unloaded, its remaining
   energy lost), or a re-compression when u_n turns negative again before the end: compression
   resumes on the loading curve from the energy stored then (E_start = E).
-- A couple at u_n = 0 within round-off after an event takes the phase its motion starts with
-  (`ImpactProblem.turn_at_once`).
+- A couple at u_n = 0 within round-off after an event takes the phase its motion starts with.
 
-The laws, at each maximal compression (`drake_dock.core.lzb.laws`):
+The laws, at each maximal compression (`drake_dock.core.kernels.lzb_records.unloading`):
 
 - ``"paper"``, Eq. (54): E' = E - (1 - e^2) W, so x jumps to the loading curve at E' and
   unloads on it to x_end = 0; over a contact's compressions the work returned is e^2 times
@@ -51,7 +51,8 @@ Repeated impacts
 - e = 0: at its maximal compression a couple loses its stored energy and is locked: a
   constraint force rate lambda_n >= 0 keeps u_n = 0 (the limit e -> 0 of every law, which
   would otherwise re-impact without end). It is released, and separates, when lambda_n
-  reaches zero. A plastic chain thus ends with the balls moving together.
+  reaches zero, or at once where an event of another couple leaves it pulling. A plastic
+  chain thus ends with the balls moving together.
 - Small e: the couples can re-compress many times with ever smaller amplitudes. The impact
   ends when no couple approaches faster, nor could the stored energy move one faster, than
   ``rtol`` times the largest initial approach speed (the bodies have settled).
@@ -61,11 +62,16 @@ With one couple the three laws give the same post-impact velocity; with several 
 Friction, Eq. (27) and (53): a loaded couple slides with dP^t = -mu dP^3 u_t/|u_t|, or sticks
 (u_t = 0 held by the tangential impulse rate that keeps it zero) while that rate stays inside
 the static cone mu_s dP^3. Slip-to-stick, stick-to-slip and slip reversal are located events.
+The couples at rest when they load (at the impact's start, a re-impact, a sliding couple come
+to rest) take stick or slip jointly: all stick if the tangential forces that keep them at rest
+lie in their static cones, otherwise the one furthest outside slips and the rest are tested
+again.
 
-Numerics: scipy's DOP853 (8th order, error controlled by ``rtol``), every phase change located
-on its dense output and the integration restarted there. The normal event functions are also
-sampled inside each step, so that u_n crossing zero twice within one step (a brief separation
-between two compressions) is not missed. The problem is nondimensionalised
+Numerics: the compiled kernel `drake_dock.core.kernels.lzb`, one call per impact: the
+Dormand-Prince 5(4) pair with error control by ``rtol`` (atol 1e-2 of it), every phase change
+located on its dense output and the integration restarted there. The normal event functions
+are also sampled inside each step, so that u_n crossing zero twice within one step (a brief
+separation between two compressions) is not missed. The problem is nondimensionalised
 (velocity scale: the largest initial relative velocity; mass scale: the smallest effective mass
 of a couple; stiffness scale: the largest K), so all thresholds are relative to the impact's
 scale and scaling every K by the same factor leaves the result unchanged.
@@ -76,13 +82,15 @@ import dataclasses
 
 import numpy as np
 
-from drake_dock.core.lzb.driver import integrate
-from drake_dock.core.lzb.friction import select_impact_friction_modes
+from drake_dock.core.kernels import lzb as kernel
+from drake_dock.core.kernels.lzb_records import KINDS, LAW_NAMES, ImpactConstants, new_phases
 from drake_dock.core.lzb.inputs import check_inputs, per_couple
-from drake_dock.core.lzb.laws import LAWS
-from drake_dock.core.lzb.problem import ImpactProblem
+from drake_dock.core.lzb.state import ImpactEvent, StateLayout
+from drake_dock.errors import NumericalError
 
 __all__ = ["LAWS", "ImpactResult", "solve_lzb", "check_inputs", "per_couple"]
+
+LAWS = LAW_NAMES                    # the restitution laws ("paper", "mono", "bi")
 
 SEPARATING_RTOL = 1e-6              # normal velocities up to this fraction of the largest are
                                     # a couple at rest (`drake_dock.core.hybrid.CLOSED_RTOL`)
@@ -106,8 +114,8 @@ class ImpactResult:
 
 
 def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, mu_s=None,
-              law="paper", initial_energy=None, rtol=1e-10, max_steps=200_000,
-              compiled=False) -> ImpactResult:
+              law="paper", initial_energy=None, rtol=1e-10,
+              max_steps=200_000) -> ImpactResult:
     """Solves a (multiple) impact by the LZB method at a fixed configuration.
 
     Parameters
@@ -124,9 +132,7 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     law : "paper" (Eq. 54), "mono" or "bi"; see the module docstring.
     initial_energy : stored energy E_j(t^-) per couple (default zero).
     rtol : relative accuracy of the impulse-domain integration.
-    compiled : integrate by the compiled kernel (`drake_dock.core.lzb.compiled`: Dormand-Prince
-        5(4) in numba, one call per impact where no couple sticks or is locked) instead of
-        scipy's DOP853; the same events and results to the integration's accuracy.
+    max_steps : the integration's step budget.
 
     Returns an `ImpactResult`. Raises ValueError naming the argument for degenerate input (M not
     SPD, wrong shapes, non-finite values, a couple already separating) and NumericalError when
@@ -178,30 +184,41 @@ def solve_lzb(M, Wn, v_minus, stiffness, eta, restitution, *, Wt=None, mu=0.0, m
     t_s = d_s / v_s
     kappa = K * d_s**eta_ * t_s / (m_s * v_s)   # nondimensional stiffness (Eq. 28)
     x0 = ((eta_ + 1.0) * (E0 / (m_s * v_s**2)) / kappa) ** (1.0 / (eta_ + 1.0))
-    prob = ImpactProblem(G * m_s, u_minus / v_s, kappa, eta_, e, mu_, mu_s_, law, x0, friction,
-                         settle=rtol)
-    events = []
-    y = prob.y0.copy()
-    if friction:
-        select_impact_friction_modes(prob, y, [j for j in range(s) if x0[j] > 0 or un0[j] < 0],
-                                     events, 0.0)
-    if compiled:
-        # Imported here: it imports numba, and this module.
-        from drake_dock.core.lzb.compiled import integrate_compiled
-        run = integrate_compiled
-    else:
-        run = integrate
-    y, steps, history = run(prob, y, events, rtol=rtol, max_steps=max_steps,
-                            impulse_scale=(m_s, v_s))
-    L = prob.layout
-    P = y[L.P] * m_s * v_s
+    nu = 3 * s if friction else s
+    lay = StateLayout(s, nu)
+    y = np.zeros(lay.size)
+    y[lay.x] = x0
+    y[lay.u] = (u_minus / v_s)[:nu]
+    imp = ImpactConstants(s, nu, np.ascontiguousarray((G * m_s)[:nu, :nu]), kappa, eta_, e,
+                          mu_, mu_s_, bool(friction), LAW_NAMES.index(law), rtol, rtol,
+                          rtol * 1e-2, max_steps, m_s * v_s)
+    ph = new_phases(s)
+    decide = (x0 > 0) | (un0 < 0)
+    status, tau, y, _, steps, log, hist, nh = kernel.lzb_impact(y, decide, imp, ph)
+    events = [ImpactEvent(float(log.impulse[i]), KINDS[log.kind[i]], int(log.couple[i]))
+              for i in range(log.n)]
+    _raise_for(status, tau, max_steps, events)
+    P = y[lay.P] * m_s * v_s
     if not friction:
         P = np.concatenate([P, np.zeros(2 * s)])
     v_plus = v + MinvW @ P
     E_scale = m_s * v_s**2
     return ImpactResult(
         v_plus=v_plus, normal_impulse=P[:s], tangential_impulse=P[s:].reshape(s, 2),
-        compression_work=prob.wc * E_scale, restitution_work=-y[L.w_exp] * E_scale,
-        friction_loss=y[L.w_fric] * E_scale, steps=steps, events=events,
+        compression_work=ph.wc * E_scale, restitution_work=-y[lay.w_exp] * E_scale,
+        friction_loss=y[lay.w_fric] * E_scale, steps=steps, events=events,
         kinetic_energy_minus=KE_minus, kinetic_energy_plus=0.5 * v_plus @ M @ v_plus,
-        impulse_history=np.array(history))
+        impulse_history=hist[:nh].copy())
+
+
+def _raise_for(status, tau, max_steps, events):
+    """The kernel's status as a typed error (none for `kernel.DONE`)."""
+    if status == kernel.BUDGET:
+        raise NumericalError(f"LZB impact did not end within {max_steps} steps "
+                             f"(events so far: {len(events)})",
+                             couples=sorted({ev.couple for ev in events[-10:]}))
+    if status == kernel.STEP_FAILED:
+        raise NumericalError(f"LZB integration failed: step size below the smallest at "
+                             f"tau = {tau:.6g}")
+    if status == kernel.NONFINITE:
+        raise NumericalError(f"LZB integration failed: non-finite state at tau = {tau:.6g}")

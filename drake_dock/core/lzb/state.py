@@ -1,10 +1,9 @@
 """The state of one LZB impact in contact space (Sect. 6): the named slices of the integrated
-vector, the phases of a couple and the event log."""
+vector and the event log (the phases of the couples are the kernel's,
+`drake_dock.core.kernels.lzb_phases`)."""
 from __future__ import annotations
 
 import dataclasses
-
-COMPRESSION, EXPANSION, LOCKED = 0, 1, 2     # phases of a couple (LOCKED: e = 0, held)
 
 
 @dataclasses.dataclass
@@ -35,7 +34,3 @@ class StateLayout:
         self.w_comp = slice(s + 2 * nu, 2 * s + 2 * nu)
         self.w_exp = slice(2 * s + 2 * nu, 3 * s + 2 * nu)
         self.w_fric = slice(3 * s + 2 * nu, 4 * s + 2 * nu)
-
-    def ut_of(self, j: int) -> slice:
-        """Couple j's tangential pair in y."""
-        return slice(2 * self.s + 2 * j, 2 * self.s + 2 * j + 2)
